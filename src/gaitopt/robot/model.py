@@ -1,0 +1,225 @@
+"""The robot model: an immutable description of a planar kinematic tree.
+
+A model is data only. Algorithms (``gaitopt.dynamics``) are free functions of it and never
+modify it.
+
+Frames and conventions (see ``docs/conventions.md``):
+
+* World frame: x forward, y up, z out of the page; angles and torques CCW positive about z.
+* Every link has a frame whose origin is its proximal joint (for the floating base: the base
+  point, the hip of the five-link biped) and which is rotated by the link's absolute angle.
+* A link extends from its origin along its *axis*, a unit vector fixed in its frame:
+  ``(0, -1)`` for ``direction: down`` (legs: a link at absolute angle phi points along
+  ``(sin phi, -cos phi)``), ``(0, 1)`` for ``direction: up`` (the torso).
+* A point on a link is given as ``(along, across)``: ``along`` metres along the axis from the
+  link origin, ``across`` metres along the axis turned 90 degrees CCW. Its coordinates in the
+  link frame are ``along * axis + across * perp(axis)`` (see :meth:`Link.local_point`).
+* Generalized coordinates: ``q = [x, y, angle_base, q_joint_1, ..., q_joint_n]`` where
+  ``(x, y)`` is the world position of the base origin, ``angle_base`` the base's absolute angle
+  and the joints follow in the order their links appear in the model. A revolute joint angle is
+  the child's angle relative to its parent; 0 makes their frames parallel.
+* Controls ``u``: one entry per actuator, in file order. A joint actuator applies +tau to the
+  child link and -tau to the parent. A contact actuator (an ankle) applies +tau to the link
+  carrying the contact point and -tau to the ground, only while that point is held.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+Direction = Literal["up", "down"]
+
+AXIS_OF_DIRECTION: dict[str, tuple[float, float]] = {"up": (0.0, 1.0), "down": (0.0, -1.0)}
+
+#: Names of the three coordinates of the floating base, in order.
+BASE_COORDINATES: tuple[str, str, str] = ("x", "y", "angle")
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A revolute joint between a link and its parent.
+
+    ``at`` is the joint position on the parent as ``(along, across)`` in metres (see the module
+    docstring); ``limits`` are the joint angle bounds in radians, ``lower <= upper``.
+    """
+
+    name: str
+    at: tuple[float, float]
+    limits: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid link of the planar tree.
+
+    Attributes:
+        name: unique name.
+        parent: name of the parent link; ``None`` for the floating base.
+        joint: the revolute joint to the parent; ``None`` for the floating base.
+        direction: ``"up"`` or ``"down"``: the link axis in its own frame.
+        length: metres, > 0.
+        mass: kilograms, > 0.
+        com: centre of mass as ``(along, across)`` in metres.
+        inertia: rotational inertia about the centre of mass, about z, kg m^2, > 0.
+        shape: the shape the inertia was computed from (for the record), or ``None``.
+    """
+
+    name: str
+    parent: str | None
+    joint: Joint | None
+    direction: Direction
+    length: float
+    mass: float
+    com: tuple[float, float]
+    inertia: float
+    shape: dict[str, Any] | None = None
+
+    @property
+    def axis(self) -> tuple[float, float]:
+        """Unit vector of the link axis in the link frame."""
+        return AXIS_OF_DIRECTION[self.direction]
+
+    def local_point(self, along: float, across: float = 0.0) -> tuple[float, float]:
+        """Coordinates in the link frame (m) of the point ``(along, across)``."""
+        ax, ay = self.axis
+        return (along * ax - across * ay, along * ay + across * ax)
+
+    @property
+    def com_local(self) -> tuple[float, float]:
+        """Centre of mass in the link frame (m)."""
+        return self.local_point(*self.com)
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A point on a link that can touch the ground (a leg tip), as ``(along, across)`` in m."""
+
+    name: str
+    link: str
+    at: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """A torque source with bounds ``limits = (lower, upper)`` in N m.
+
+    Exactly one of ``joint`` (a joint torque) and ``contact`` (a torque between the ground and
+    the link carrying the contact point, e.g. an ankle) is set.
+    """
+
+    name: str
+    limits: tuple[float, float]
+    joint: str | None = None
+    contact: str | None = None
+
+    @property
+    def kind(self) -> Literal["joint", "contact"]:
+        return "joint" if self.joint is not None else "contact"
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    """An immutable planar multibody model (a tree with a floating base).
+
+    ``links[0]`` is the floating base; every other link comes after its parent. ``gravity`` is
+    the world gravity vector in m/s^2.
+    """
+
+    name: str
+    links: tuple[Link, ...]
+    contacts: tuple[Contact, ...]
+    actuators: tuple[Actuator, ...]
+    gravity: tuple[float, float] = (0.0, -9.81)
+    description: str = ""
+    _index: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_index", {link.name: i for i, link in enumerate(self.links)})
+
+    # -- sizes -------------------------------------------------------------------------------
+    @property
+    def base(self) -> Link:
+        return self.links[0]
+
+    @property
+    def nq(self) -> int:
+        """Number of generalized coordinates (= velocities): 3 for the base + one per joint."""
+        return 3 + len(self.links) - 1
+
+    @property
+    def nu(self) -> int:
+        """Number of actuators (controls)."""
+        return len(self.actuators)
+
+    @property
+    def total_mass(self) -> float:
+        return sum(link.mass for link in self.links)
+
+    # -- names and indices -------------------------------------------------------------------
+    @property
+    def joints(self) -> tuple[Joint, ...]:
+        return tuple(link.joint for link in self.links[1:] if link.joint is not None)
+
+    @property
+    def coordinate_names(self) -> tuple[str, ...]:
+        """Names of the entries of ``q``: ``x, y, <base>``, then the joints."""
+        return ("x", "y", self.base.name) + tuple(j.name for j in self.joints)
+
+    def link_index(self, name: str) -> int:
+        try:
+            return self._index[name]
+        except KeyError:
+            raise KeyError(f"model {self.name!r} has no link {name!r}") from None
+
+    def link(self, name: str) -> Link:
+        return self.links[self.link_index(name)]
+
+    def parent_index(self, i: int) -> int:
+        """Index of the parent of link ``i`` (-1 for the base)."""
+        parent = self.links[i].parent
+        return -1 if parent is None else self.link_index(parent)
+
+    def coordinate_of_link(self, i: int) -> int:
+        """Index in ``q`` of the joint coordinate of link ``i >= 1`` (the base uses 0, 1, 2)."""
+        return 2 if i == 0 else 2 + i
+
+    def joint_coordinate(self, joint: str) -> int:
+        """Index in ``q`` of a joint's angle."""
+        for i, link in enumerate(self.links[1:], start=1):
+            if link.joint is not None and link.joint.name == joint:
+                return self.coordinate_of_link(i)
+        raise KeyError(f"model {self.name!r} has no joint {joint!r}")
+
+    def contact(self, name: str) -> Contact:
+        for c in self.contacts:
+            if c.name == name:
+                return c
+        raise KeyError(f"model {self.name!r} has no contact point {name!r}")
+
+    def actuator_index(self, name: str) -> int:
+        for i, a in enumerate(self.actuators):
+            if a.name == name:
+                return i
+        raise KeyError(f"model {self.name!r} has no actuator {name!r}")
+
+    def chain(self, i: int) -> tuple[int, ...]:
+        """Link indices from the base to link ``i`` inclusive."""
+        out = [i]
+        while (p := self.parent_index(out[-1])) >= 0:
+            out.append(p)
+        return tuple(reversed(out))
+
+    # -- identity ----------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The model as plain data in the model-file schema (see ``gaitopt.robot.loader``)."""
+        from gaitopt.robot.loader import model_to_dict
+
+        return model_to_dict(self)
+
+    def content_hash(self) -> str:
+        """A short hash of everything that affects dynamics (for on-disk caches)."""
+        text = json.dumps(self.to_dict(), sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
