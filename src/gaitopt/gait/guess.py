@@ -1,0 +1,146 @@
+"""A naive initial guess for the walking problem, built from geometry alone.
+
+No guess files: for any speed ``v`` and step length ``L`` the guess is
+
+* the hip moving forward at constant speed ``v`` at a constant height chosen so that both
+  legs reach the ground with ``r <= r_max`` throughout (centred so that double support is
+  symmetric about the middle of the two tips), the torso upright;
+* the swing tip travelling from ``(-L, 0)`` to ``(L, 0)`` on a smooth arc (smoothstep in x,
+  a half sine of height ``clearance`` in y), the swing leg from inverse kinematics;
+* rates and accelerations by differentiating these curves;
+* the torques that realise this motion with the least ``u'u``: at each knot the least-squares
+  solution of ``M qdd + h = B u + J^T f`` over torques ``u`` and contact forces ``f``
+  (forces weighted lightly so the torques are what is minimised).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from gaitopt.dynamics.actuation import actuation_matrix
+from gaitopt.dynamics.crba import crba
+from gaitopt.dynamics.kinematics import contact_jacobian
+from gaitopt.dynamics.reduced import checked_biped, leg_inverse_kinematics
+from gaitopt.dynamics.rnea import bias_forces
+from gaitopt.gait import walking
+from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.robot.model import RobotModel
+
+Array = NDArray[np.float64]
+
+#: Samples per phase used to differentiate the guess curves.
+_FINE = 400
+
+
+@dataclass(frozen=True)
+class PhaseGuess:
+    """Knot values of one phase: ``t`` (K,), ``x`` (K, n), ``u`` (K, m)."""
+
+    name: str
+    t: Array
+    x: Array
+    u: Array
+
+
+@dataclass(frozen=True)
+class WalkingGuess:
+    phases: tuple[PhaseGuess, ...]
+    parameters: dict[str, float]
+
+
+def default_step_length(speed: float) -> float:
+    """A plausible step length (m) for a speed (m/s) to start from: grows with speed."""
+    return float(np.clip(0.06 + 0.35 * speed, 0.05, 0.5))
+
+
+def _smoothstep(s: Array) -> Array:
+    return s * s * (3.0 - 2.0 * s)
+
+
+def _knots(t0: float, duration: float, count: int) -> Array:
+    return t0 + duration * np.linspace(0.0, 1.0, count)
+
+
+def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple[str, ...],
+             held: list[str]) -> Array:
+    """Least-``u'u`` torques (and any contact forces) realising ``qdd``."""
+    m_q = np.asarray(crba(model, q), dtype=float)
+    h = np.asarray(bias_forces(model, q, qd), dtype=float).reshape(-1)
+    b_full = np.asarray(actuation_matrix(model, q, held), dtype=float)
+    cols = [model.actuator_index(n) for n in controls]
+    j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(2 * len(held), -1)
+    force_scale = 100.0  # forces are cheap in the least-squares norm
+    a = np.hstack([b_full[:, cols], force_scale * j.T])
+    sol, *_ = np.linalg.lstsq(a, m_q @ qdd + h, rcond=None)
+    return np.asarray(sol[: len(cols)], dtype=float)
+
+
+def naive_guess(model: RobotModel, *, speed: float, step_length: float,
+                single_support_fraction: float, knots: tuple[int, int], ankle: bool,
+                r_max: float, clearance: float | None = None) -> WalkingGuess:
+    """The geometric guess described in the module docstring (knot values per phase)."""
+    legs = checked_biped(model).legs
+    v, step, f = speed, step_length, single_support_fraction
+    total = step / v
+    t1, t2 = f * total, (1.0 - f) * total
+    offset = step * (1.0 - f / 2.0)
+    height = 0.995 * float(np.sqrt(max(r_max**2 - offset**2, 1e-4)))
+    lift = clearance if clearance is not None else min(0.04, 0.01 + 0.1 * step)
+
+    def hip(t: Array) -> Array:
+        return np.stack([-step * f / 2.0 + v * t, np.full_like(t, height)], axis=1)
+
+    phases = []
+    # Phase 1: single support on leg 1, swing leg 2 along an arc.
+    t_fine = np.linspace(0.0, t1, _FINE)
+    s = t_fine / t1
+    tip2 = np.stack([-step + 2.0 * step * _smoothstep(s), lift * np.sin(np.pi * s)], axis=1)
+    p_hip = hip(t_fine)
+    q_fine = np.zeros((_FINE, model.nq))
+    q_fine[:, 0:2] = p_hip
+    for k in range(_FINE):
+        for leg, tip in ((legs[0], (0.0, 0.0)), (legs[1], tuple(tip2[k]))):
+            joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip), 0.0,
+                                            0.0)
+            q_fine[k, leg.hip_index] = float(joints.hip)
+            q_fine[k, leg.knee_index] = float(joints.knee)
+    phases.append(_phase_guess(model, SINGLE, t_fine, q_fine, _knots(0.0, t1, knots[0]),
+                               ankle, [legs[0].contact], step))
+    if f < 1.0:
+        t_fine = np.linspace(t1, t1 + t2, _FINE)
+        p_hip = hip(t_fine)
+        q_fine = np.zeros((_FINE, model.nq))
+        q_fine[:, 0:2] = p_hip
+        for k in range(_FINE):
+            for leg, tip in ((legs[0], (0.0, 0.0)), (legs[1], (step, 0.0))):
+                joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),
+                                                0.0, 0.0)
+                q_fine[k, leg.hip_index] = float(joints.hip)
+                q_fine[k, leg.knee_index] = float(joints.knee)
+        phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
+                                   _knots(t1, t2, knots[1]), ankle,
+                                   [legs[0].contact, legs[1].contact], step))
+    return WalkingGuess(phases=tuple(phases),
+                        parameters={"step_length": step, "speed": v, "impulse": 0.0})
+
+
+def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_knots: Array,
+                 ankle: bool, held: list[str], step: float) -> PhaseGuess:
+    qd_fine = np.gradient(q_fine, t_fine, axis=0)
+    qdd_fine = np.gradient(qd_fine, t_fine, axis=0)
+    controls = walking.control_names(model, phase, ankle=ankle)
+    xs, us = [], []
+    for t in t_knots:
+        q = np.array([np.interp(t, t_fine, q_fine[:, i]) for i in range(model.nq)])
+        qd = np.array([np.interp(t, t_fine, qd_fine[:, i]) for i in range(model.nq)])
+        qdd = np.array([np.interp(t, t_fine, qdd_fine[:, i]) for i in range(model.nq)])
+        if phase == SINGLE:
+            x = walking.full_to_single_support(model, q, qd)
+        else:
+            x = walking.full_to_double_support(model, q, qd)
+        xs.append(np.asarray(x, dtype=float).reshape(-1))
+        us.append(_torques(model, q, qd, qdd, controls, held))
+    return PhaseGuess(name=phase, t=np.asarray(t_knots), x=np.array(xs), u=np.array(us))

@@ -1,0 +1,184 @@
+"""Options of the walking problem: the variant, the targets and every bound, validated.
+
+Defaults follow the paper: ankle torques and the liftoff impulse on, single support 85 % of the
+step, 8 + 5 knots, periodic states and controls, the speed given (12 m/min, the paper's
+globally optimal speed) and the step length free. Every field is documented in
+``docs/walking.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from gaitopt.robot.biped import BipedStructure
+from gaitopt.units import format_speed
+
+Transcription = Literal["hermite-simpson", "trapezoidal"]
+
+
+class GaitOptionsError(ValueError):
+    """A walking-problem option is out of range (names the field and what is allowed)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class GaitOptions:
+    """Every option of the walking problem (SI units).
+
+    Attributes:
+        speed: average forward speed (m/s), or ``None`` for free (the optimal walk).
+        speed_bounds: bounds (m/s) when the speed is free.
+        step_length: step length (m), or ``None`` for free.
+        step_length_bounds: bounds (m) when the step length is free.
+        ankle: ankle torques on (at the tips on the ground).
+        impulse: liftoff impulse on.
+        single_support_fraction: phase-1 share of the step time, in (0, 1]; 1 gives the
+            single-support gait (no double support, the trailing leg leaves at heel strike).
+        knots: grid points per phase (single support, double support), as in the paper.
+        transcription: ``"hermite-simpson"`` (DIRCOL's) or ``"trapezoidal"``.
+        periodic_controls: controls periodic (paper) as well as the states.
+        friction: a friction coefficient for an optional friction-cone constraint, or None.
+        min_stance_knee_flexion: smallest knee bend (rad, > 0) of a leg on the ground; it sets
+            the largest hip-to-tip distance, the polar box ``r <= r_max`` (paper section 3.5),
+            and keeps the leg inverse kinematics away from its singularity at a straight knee.
+        torso_bounds: torso angle bounds (rad).
+        rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates.
+        max_impulse: upper bound of the liftoff impulse (N s).
+        tol: IPOPT tolerance; max_iter: IPOPT iteration limit per stage.
+        continuation: use the automatic continuation from a naive start (else one solve).
+    """
+
+    speed: float | None = 0.2
+    speed_bounds: tuple[float, float] = (0.02, 1.5)
+    step_length: float | None = None
+    step_length_bounds: tuple[float, float] = (0.02, 0.8)
+    ankle: bool = True
+    impulse: bool = True
+    single_support_fraction: float = 0.85
+    knots: tuple[int, int] = (8, 5)
+    transcription: Transcription = "hermite-simpson"
+    periodic_controls: bool = True
+    friction: float | None = None
+    min_stance_knee_flexion: float = 0.1
+    torso_bounds: tuple[float, float] = (-0.8, 0.8)
+    rate_bound: float = 15.0
+    max_impulse: float = 30.0
+    tol: float = 1e-7
+    max_iter: int = 1000
+    continuation: bool = True
+
+    # -- derived -------------------------------------------------------------------------------
+    @property
+    def double_support(self) -> bool:
+        """Whether the step has a double-support phase (fraction < 1)."""
+        return self.single_support_fraction < 1.0
+
+    @property
+    def variant(self) -> str:
+        """``ankle+impulse``, ``ankle``, ``impulse`` or ``plain``."""
+        parts = [name for name, on in (("ankle", self.ankle), ("impulse", self.impulse)) if on]
+        return "+".join(parts) or "plain"
+
+    def replace(self, **changes: Any) -> GaitOptions:
+        """A copy with some fields changed (validated again by the caller)."""
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for the gait file (``None`` means free)."""
+        data = dataclasses.asdict(self)
+        for key, value in data.items():
+            if isinstance(value, tuple):
+                data[key] = list(value)
+        return data
+
+    @staticmethod
+    def from_dict(data: dict[str, Any]) -> GaitOptions:
+        fields = {f.name for f in dataclasses.fields(GaitOptions)}
+        unknown = sorted(set(data) - fields)
+        if unknown:
+            raise GaitOptionsError(f"unknown gait option(s) {', '.join(unknown)}; known: "
+                                   f"{', '.join(sorted(fields))}")
+        clean = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
+        return GaitOptions(**clean)
+
+
+def _finite(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise GaitOptionsError(f"{name} = {value!r}: must be a finite number")
+    return float(value)
+
+
+def _bounds(name: str, value: Any, *, positive: bool = False) -> tuple[float, float]:
+    if not isinstance(value, tuple | list) or len(value) != 2:
+        raise GaitOptionsError(f"{name} = {value!r}: must be a pair (lower, upper)")
+    lo, hi = _finite(f"{name}[0]", value[0]), _finite(f"{name}[1]", value[1])
+    if lo > hi:
+        raise GaitOptionsError(f"{name} = ({lo:g}, {hi:g}): lower bound must be <= upper bound")
+    if positive and lo <= 0.0:
+        raise GaitOptionsError(f"{name} = ({lo:g}, {hi:g}): bounds must be > 0")
+    return lo, hi
+
+
+def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
+    """Check every option before any solve; raise :class:`GaitOptionsError` naming the field,
+    the bad value and the allowed range."""
+    o = options
+    v_lo, v_hi = _bounds("speed_bounds", o.speed_bounds, positive=True)
+    if o.speed is not None:
+        speed = _finite("speed", o.speed)
+        if speed <= 0.0:
+            raise GaitOptionsError(f"speed = {speed:g} m/s: must be > 0 (or free)")
+        if not v_lo <= speed <= v_hi:
+            raise GaitOptionsError(f"speed = {format_speed(speed)}: must lie in speed_bounds "
+                                   f"[{format_speed(v_lo)}, {format_speed(v_hi)}]")
+    l_lo, l_hi = _bounds("step_length_bounds", o.step_length_bounds, positive=True)
+    flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
+    if not 0.0 < flex < 1.5:
+        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5)")
+    reach = min(leg.reach(-flex) for leg in biped.legs)
+    longest = 2.0 * reach * 0.97
+    if o.step_length is not None:
+        step = _finite("step_length", o.step_length)
+        if step <= 0.0:
+            raise GaitOptionsError(f"step_length = {step:g} m: must be > 0 (or free)")
+        if step >= longest:
+            raise GaitOptionsError(
+                f"step_length = {step:g} m: longer than the legs can reach (both tips on the "
+                f"ground with the hip above them needs step_length < {longest:.3f} m)")
+        if not l_lo <= step <= l_hi:
+            raise GaitOptionsError(f"step_length = {step:g} m: must lie in step_length_bounds "
+                                   f"[{l_lo:g}, {l_hi:g}] m")
+    if l_lo >= longest:
+        raise GaitOptionsError(f"step_length_bounds = ({l_lo:g}, {l_hi:g}) m: the legs reach "
+                               f"steps shorter than {longest:.3f} m only")
+    f = _finite("single_support_fraction", o.single_support_fraction)
+    if not 0.05 <= f <= 1.0:
+        raise GaitOptionsError(f"single_support_fraction = {f:g}: must lie in [0.05, 1]")
+    if (not isinstance(o.knots, tuple | list) or len(o.knots) != 2
+            or not all(isinstance(k, int) and not isinstance(k, bool) for k in o.knots)):
+        raise GaitOptionsError(f"knots = {o.knots!r}: must be two integers "
+                               "(single support, double support)")
+    if o.knots[0] < 3 or (o.double_support and o.knots[1] < 2):
+        raise GaitOptionsError(f"knots = {tuple(o.knots)}: need >= 3 knots in single support "
+                               "and >= 2 in double support")
+    if max(o.knots) > 400:
+        raise GaitOptionsError(f"knots = {tuple(o.knots)}: at most 400 per phase")
+    if o.transcription not in ("hermite-simpson", "trapezoidal"):
+        raise GaitOptionsError(f"transcription = {o.transcription!r}: must be "
+                               "'hermite-simpson' or 'trapezoidal'")
+    if o.friction is not None and not _finite("friction", o.friction) > 0.0:
+        raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 (or None for no cone)")
+    t_lo, t_hi = _bounds("torso_bounds", o.torso_bounds)
+    if not t_lo <= 0.0 <= t_hi:
+        raise GaitOptionsError(f"torso_bounds = ({t_lo:g}, {t_hi:g}) rad: must contain 0 "
+                               "(upright), or the biped cannot stand")
+    if not _finite("rate_bound", o.rate_bound) > 0.0:
+        raise GaitOptionsError(f"rate_bound = {o.rate_bound!r}: must be > 0")
+    if not _finite("max_impulse", o.max_impulse) >= 0.0:
+        raise GaitOptionsError(f"max_impulse = {o.max_impulse!r}: must be >= 0")
+    if not 0.0 < _finite("tol", o.tol) < 1.0:
+        raise GaitOptionsError(f"tol = {o.tol!r}: must lie in (0, 1)")
+    if not isinstance(o.max_iter, int) or o.max_iter < 1:
+        raise GaitOptionsError(f"max_iter = {o.max_iter!r}: must be a positive integer")

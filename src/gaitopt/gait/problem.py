@@ -1,0 +1,310 @@
+"""The paper's minimum-energy walking problem stated on the generic OCP engine.
+
+Decision parameters ``p = [step_length L, speed v, impulse P]``; phase durations are
+expressions of them: ``T1 = f L / v`` (single support) and ``T2 = (1 - f) L / v`` (double
+support), ``f`` the single-support fraction. The objective is the paper's eq. 5::
+
+    J = ( int_0^T1 u'u dt + int_T1^T u'u dt + P^2 ) / L
+
+Constraints (``docs/walking.md`` lists each with its reason): torque bounds, joint limits, the
+polar box ``r_min <= r <= r_max`` on the stance leg, the swing tip above the ground, normal
+contact forces ``>= -relax`` at knots and midpoints, normal impulses ``>= -relax`` at the heel
+strike and the liftoff, the lifting tip moving up after liftoff, tip 2 landing at ``(L, 0)``,
+the front leg's reach in double support, optional friction cones, continuity of controls
+between the phases and periodicity of states (through the liftoff map) and controls with the
+legs relabelled.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+
+from gaitopt.dynamics.backend import as_scalars, vector
+from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.gait import walking
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.ocp.problem import (
+    BoundaryConstraint,
+    ControlLinkage,
+    Duration,
+    Linkage,
+    Parameter,
+    PathConstraint,
+    Phase,
+    Problem,
+)
+from gaitopt.robot.model import RobotModel
+
+STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
+PARAMETERS = (STEP_LENGTH, SPEED, IMPULSE)
+_L, _V, _P = range(3)
+
+#: Largest forward lean of the virtual stance leg considered (rad), a generous box on alpha.
+ALPHA_BOUND = 1.3
+
+
+@dataclass(frozen=True)
+class Relaxation:
+    """How far the unilateral contact conditions may be violated (N, N s): 0 enforces them.
+
+    The continuation solves a relaxed problem first (the paper's two-stage process)."""
+
+    force: float = 0.0
+    impulse: float = 0.0
+
+
+class _PointCache:
+    """Evaluate a phase's dynamics once per symbolic point and share the result between the
+    dynamics, the path constraints and the cost (the engine calls each with the same
+    symbols)."""
+
+    def __init__(self, compute: Callable[[Any, Any, Any], walking.PhasePoint]) -> None:
+        self._compute = compute
+        self._key: tuple[Any, Any, Any] | None = None
+        self._value: walking.PhasePoint | None = None
+
+    def __call__(self, x: Any, u: Any, p: Any) -> walking.PhasePoint:
+        key = self._key
+        if key is None or not (key[0] is x and key[1] is u and key[2] is p):
+            self._value = self._compute(x, u, p)
+            self._key = (x, u, p)
+        assert self._value is not None
+        return self._value
+
+
+def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
+    """Bounds of ``L, v, P`` for a variant: a given value becomes equal bounds."""
+    if options.step_length is None:
+        step = options.step_length_bounds
+    else:
+        step = (options.step_length, options.step_length)
+    speed = options.speed_bounds if options.speed is None else (options.speed, options.speed)
+    impulse = (0.0, options.max_impulse) if options.impulse else (0.0, 0.0)
+    return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
+
+
+def _limits(model: RobotModel, joint: str) -> tuple[float, float]:
+    for j in model.joints:
+        if j.name == joint:
+            return j.limits
+    raise KeyError(joint)
+
+
+def walking_problem(model: RobotModel, options: GaitOptions,
+                    relax: Relaxation = Relaxation()) -> Problem:
+    """The OCP of one periodic step for ``model`` with ``options`` (see the module docstring).
+
+    Call :func:`gaitopt.gait.options.validate_options` first.
+    """
+    legs = checked_biped(model).legs
+    stance, swing = legs
+    f = options.single_support_fraction
+    two_phases = options.double_support
+    r_max = min(leg.reach(-options.min_stance_knee_flexion) for leg in legs)
+    r_min = max(leg.reach(_limits(model, leg.knee)[0]) for leg in legs)
+    rate = options.rate_bound
+    mu = options.friction
+
+    ss_states = walking.state_names(model, SINGLE)
+    ss_controls = walking.control_names(model, SINGLE, ankle=options.ankle)
+    ds_states = walking.state_names(model, DOUBLE)
+    ds_controls = walking.control_names(model, DOUBLE, ankle=options.ankle)
+
+    def control_bounds(names: Sequence[str]) -> dict[str, tuple[float, float]]:
+        return {n: model.actuators[model.actuator_index(n)].limits for n in names}
+
+    def state_bounds(names: Sequence[str]) -> dict[str, tuple[float, float]]:
+        bounds: dict[str, tuple[float, float]] = {
+            "r": (r_min, r_max), "alpha": (-ALPHA_BOUND, ALPHA_BOUND),
+            "torso": options.torso_bounds}
+        for leg in legs:
+            bounds[leg.hip] = _limits(model, leg.hip)
+            bounds[leg.knee] = _limits(model, leg.knee)
+        for n in names:
+            if n.endswith("_rate"):
+                bounds[n] = (-rate, rate)
+        return {n: bounds[n] for n in names}
+
+    def usq(u: Any) -> Any:
+        return ca.sumsqr(u)
+
+    # -- phase 1: single support on leg 1 ----------------------------------------------------
+    ss = _PointCache(lambda x, u, p: walking.single_support_point(model, x, u, ss_controls))
+
+    def ss_dynamics(x: Any, u: Any, p: Any, t: Any) -> Any:
+        return ss(x, u, p).xdot
+
+    def ss_contact(x: Any, u: Any, p: Any, t: Any) -> Any:
+        fx, fy = as_scalars(ss(x, u, p).solution.forces, 2, "forces")
+        rows = [fy]
+        if mu is not None:
+            rows += [mu * fy - fx, mu * fy + fx]
+        return vector(rows)
+
+    def ss_geometry(x: Any, u: Any, p: Any, t: Any) -> Any:
+        q = ss(x, u, p).solution.q
+        qs = as_scalars(q, model.nq, "q")
+        return vector([walking.tip_height(model, q, swing), qs[stance.hip_index]])
+
+    hip_lo, hip_hi = _limits(model, stance.hip)
+    ss_path = [
+        PathConstraint("stance contact force", ss_contact, lower=-relax.force, upper=ca.inf,
+                       scale=model.total_mass * 9.81),
+        PathConstraint("swing clearance and stance hip limit", ss_geometry,
+                       lower=[0.0, hip_lo], upper=[ca.inf, hip_hi], scale=[0.1, 1.0]),
+    ]
+    phase1 = Phase(
+        name=SINGLE, states=ss_states, controls=ss_controls, dynamics=ss_dynamics,
+        duration=Duration.of_parameters(lambda p: f * p[_L] / p[_V]),
+        state_bounds=state_bounds(ss_states), control_bounds=control_bounds(ss_controls),
+        path_constraints=ss_path, lagrange=lambda x, u, p, t: usq(u),
+        intervals=options.knots[0] - 1)
+
+    phases = [phase1]
+    linkages: list[Linkage | ControlLinkage] = []
+    events: list[BoundaryConstraint] = []
+
+    def landing(ends: Mapping[str, Any], p: Any) -> Any:
+        q, _ = walking.single_support_to_full(model, ends[SINGLE].xf)
+        c = model.contact(swing.contact)
+        from gaitopt.dynamics.kinematics import point_position
+
+        tip = as_scalars(point_position(model, q, c.link, model.link(c.link).local_point(*c.at)),
+                         2, "tip")
+        return vector([tip[0] - p[_L], tip[1]])
+
+    events.append(BoundaryConstraint("swing tip lands at (L, 0)", landing, 0.0, 0.0,
+                                     scale=0.1))
+
+    def strike(ends: Mapping[str, Any], p: Any) -> walking.Transition:
+        return walking.heel_strike(model, ends[SINGLE].xf, p[_L], double_support=two_phases)
+
+    if two_phases:
+        ds = _PointCache(
+            lambda x, u, p: walking.double_support_point(model, x, u, ds_controls, p[_L]))
+
+        def ds_dynamics(x: Any, u: Any, p: Any, t: Any) -> Any:
+            return ds(x, u, p).xdot
+
+        def ds_contact(x: Any, u: Any, p: Any, t: Any) -> Any:
+            fx1, fy1, fx2, fy2 = as_scalars(ds(x, u, p).solution.forces, 4, "forces")
+            rows = [fy1, fy2]
+            if mu is not None:
+                rows += [mu * fy1 - fx1, mu * fy1 + fx1, mu * fy2 - fx2, mu * fy2 + fx2]
+            return vector(rows)
+
+        def ds_geometry(x: Any, u: Any, p: Any, t: Any) -> Any:
+            qs = as_scalars(ds(x, u, p).solution.q, model.nq, "q")
+            return vector([walking.front_leg_reach(x, p[_L]), qs[stance.hip_index],
+                           qs[swing.hip_index]])
+
+        sw_lo, sw_hi = _limits(model, swing.hip)
+        ds_path = [
+            PathConstraint("double support contact forces", ds_contact, lower=-relax.force,
+                           upper=ca.inf, scale=model.total_mass * 9.81),
+            PathConstraint("front leg reach and hip limits", ds_geometry,
+                           lower=[r_min, hip_lo, sw_lo], upper=[r_max, hip_hi, sw_hi]),
+        ]
+        phase2 = Phase(
+            name=DOUBLE, states=ds_states, controls=ds_controls, dynamics=ds_dynamics,
+            duration=Duration.of_parameters(lambda p: (1.0 - f) * p[_L] / p[_V]),
+            state_bounds=state_bounds(ds_states), control_bounds=control_bounds(ds_controls),
+            path_constraints=ds_path, lagrange=lambda x, u, p, t: usq(u),
+            intervals=options.knots[1] - 1)
+        phases.append(phase2)
+
+        linkages.append(Linkage(
+            SINGLE, DOUBLE, name="heel strike (impact, tip 1 held)",
+            jump=lambda xf, uf, p: walking.heel_strike(model, xf, p[_L],
+                                                       double_support=True).x_next))
+
+        def strike_impulses(ends: Mapping[str, Any], p: Any) -> Any:
+            imp = strike(ends, p).impulses
+            return vector([as_scalars(imp[stance.contact], 2, "i")[1],
+                           as_scalars(imp[swing.contact], 2, "i")[1]])
+
+        events.append(BoundaryConstraint("heel strike normal impulses", strike_impulses,
+                                         lower=-relax.impulse, upper=ca.inf, scale=1.0))
+
+        def lift(ends: Mapping[str, Any], p: Any) -> walking.Transition:
+            return walking.liftoff(model, ends[DOUBLE].xf, p[_L], p[_P])
+
+        linkages.append(Linkage(
+            DOUBLE, SINGLE, name="liftoff impulse and periodicity (legs relabelled)",
+            jump=lambda xf, uf, p: walking.liftoff(model, xf, p[_L], p[_P]).x_next))
+
+        def liftoff_conditions(ends: Mapping[str, Any], p: Any) -> Any:
+            tr = lift(ends, p)
+            held = as_scalars(tr.impulses[swing.contact], 2, "i")[1]
+            v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
+            return vector([held, v_up])
+
+        events.append(BoundaryConstraint("liftoff: held normal impulse, lifting tip rises",
+                                         liftoff_conditions, lower=[-relax.impulse, 0.0],
+                                         upper=ca.inf, scale=[1.0, 0.1]))
+        # Controls: continuous across the heel strike, periodic with legs relabelled.
+        shared = [n for n in ss_controls if n in ds_controls]
+        linkages.append(ControlLinkage(SINGLE, DOUBLE, controls=shared,
+                                       name="controls continuous at heel strike"))
+        if options.periodic_controls:
+            linkages.append(_periodic_controls(model, DOUBLE, ds_controls, ss_controls))
+    else:
+        linkages.append(Linkage(
+            SINGLE, SINGLE, name="heel strike (tip 2 alone) and periodicity",
+            jump=lambda xf, uf, p: walking.heel_strike(model, xf, p[_L],
+                                                       double_support=False).x_next))
+
+        def strike_conditions(ends: Mapping[str, Any], p: Any) -> Any:
+            tr = strike(ends, p)
+            normal = as_scalars(tr.impulses[swing.contact], 2, "i")[1]
+            v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
+            return vector([normal, v_up])
+
+        events.append(BoundaryConstraint("heel strike: normal impulse, trailing tip rises",
+                                         strike_conditions, lower=[-relax.impulse, 0.0],
+                                         upper=ca.inf, scale=[1.0, 0.1]))
+        if options.periodic_controls:
+            linkages.append(_periodic_controls(model, SINGLE, ss_controls, ss_controls))
+
+    bounds = parameter_bounds(options)
+    parameters = [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH], scale=0.5),
+                  Parameter(SPEED, *bounds[SPEED], scale=1.0),
+                  Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
+    return Problem(
+        phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
+        parameter_cost=lambda p: p[_P] ** 2,
+        cost_denominator=lambda ends, p: p[_L],
+        objective_scale=1000.0)
+
+
+def relabel_actuator(model: RobotModel, name: str) -> str | None:
+    """The actuator of the other leg in the same role (hip_1 <-> hip_2, ...), or None."""
+    legs = checked_biped(model).legs
+    for i, leg in enumerate(legs):
+        other = legs[1 - i]
+        for mine, theirs in ((leg.hip_actuator, other.hip_actuator),
+                             (leg.knee_actuator, other.knee_actuator),
+                             (leg.ankle_actuator, other.ankle_actuator)):
+            if mine == name:
+                return theirs
+    return None
+
+
+def _periodic_controls(model: RobotModel, from_phase: str, from_controls: Sequence[str],
+                       to_controls: Sequence[str]) -> ControlLinkage:
+    """``u_first(0)[a] = u_last(T)[relabel(a)]`` for every control ``a`` whose relabelled
+    counterpart acts at the end of the step."""
+    targets = [a for a in to_controls if relabel_actuator(model, a) in from_controls]
+    sources = [from_controls.index(relabel_actuator(model, a) or "") for a in targets]
+
+    def fn(u_from: Any, p: Any) -> Any:
+        us = as_scalars(u_from, len(from_controls), "u")
+        return vector([us[i] for i in sources])
+
+    return ControlLinkage(from_phase, SINGLE, fn=fn, controls=targets,
+                          name="controls periodic (legs relabelled)")
