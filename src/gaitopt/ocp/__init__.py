@@ -1,1 +1,49 @@
-"""gaitopt.ocp"""
+"""gaitopt.ocp: generic multi-phase optimal control by direct collocation.
+
+State a :class:`Problem` of :class:`Phase` objects, then ``tr = transcribe(problem, ...)`` and
+``result = tr.solve(guess)``. See docs/ocp.md. Knows nothing of bipeds.
+"""
+
+from gaitopt.ocp.bounds import Bounds
+from gaitopt.ocp.guess import Guess, PhaseGuess
+from gaitopt.ocp.layout import ConstraintLayout, Layout, PhaseLayout
+from gaitopt.ocp.problem import (
+    BoundaryConstraint,
+    ControlLinkage,
+    Duration,
+    Linkage,
+    Parameter,
+    PathConstraint,
+    Phase,
+    PhaseEnds,
+    Problem,
+    named,
+)
+from gaitopt.ocp.result import NlpSize, PhaseTrajectory, Result
+from gaitopt.ocp.transcription import Transcription, transcribe
+from gaitopt.ocp.validate import ProblemError
+
+__all__ = [
+    "BoundaryConstraint",
+    "Bounds",
+    "ConstraintLayout",
+    "ControlLinkage",
+    "Duration",
+    "Guess",
+    "Layout",
+    "Linkage",
+    "NlpSize",
+    "Parameter",
+    "PathConstraint",
+    "Phase",
+    "PhaseEnds",
+    "PhaseGuess",
+    "PhaseLayout",
+    "Problem",
+    "ProblemError",
+    "Result",
+    "PhaseTrajectory",
+    "Transcription",
+    "named",
+    "transcribe",
+]

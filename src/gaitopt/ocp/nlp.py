@@ -1,0 +1,175 @@
+"""Assembly of the sparse NLP of a transcription (symbolic, built once).
+
+With w the unscaled decision vector (see :mod:`gaitopt.ocp.layout`), phase i of duration
+``T_i`` starting at ``t0_i = t0 + sum_{j<i} T_j`` has knots ``t_k = t0_i + T_i tau_k``. The
+phase's point function is mapped over the K knots (and, when needed, over the N midpoints
+``t_k + h_k/2`` with the method's midpoint state and the averaged control), giving the defects,
+the path constraints and the quadrature of the Lagrange integrand. The ends function adds the
+linkages, boundary constraints and the end/parameter costs::
+
+    J = (sum_i quad_i(L_i) + M(ends, p) + P(p)) / D(ends, p)
+
+The NLP handed to the solver is ``min J / objective_scale`` over ``w_hat = w / d_w`` subject to
+``lbg / d_g <= g / d_g <= ubg / d_g``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from gaitopt.ocp.functions import EndsFunction, PhaseFunction
+from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout
+from gaitopt.ocp.mesh import Mesh
+from gaitopt.ocp.method import Method, midpoint_control
+from gaitopt.ocp.problem import Problem
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Nlp:
+    """The symbolic NLP and everything needed to scale and name it.
+
+    ``w_hat`` (layout.size, 1) MX symbol; ``f`` scaled objective; ``g`` scaled constraints;
+    ``evaluate`` maps unscaled w to ``(g unscaled, numerator, denominator, phase durations)``.
+    """
+
+    w_hat: ca.MX
+    f: ca.MX
+    g: ca.MX
+    layout: Layout
+    constraints: ConstraintLayout
+    d_w: Array
+    d_g: Array
+    lbg: Array
+    ubg: Array
+    objective_scale: float
+    evaluate: ca.Function
+
+
+class _Rows:
+    """Accumulates constraint rows with names, bounds and scales."""
+
+    def __init__(self) -> None:
+        self.exprs: list[ca.MX] = []
+        self.blocks: list[ConstraintBlock] = []
+        self.lower: list[Array] = []
+        self.upper: list[Array] = []
+        self.scale: list[Array] = []
+        self.size = 0
+
+    def add(self, name: str, phase: str | None, kind: str, expr: ca.MX,
+            shape: tuple[int, ...], lower: Array, upper: Array, scale: Array) -> None:
+        rows = int(np.prod(shape))
+        if rows == 0:
+            return
+        assert expr.shape == (rows, 1), (name, expr.shape, rows)
+        assert lower.shape == upper.shape == scale.shape == (rows,), name
+        self.exprs.append(expr)
+        self.blocks.append(ConstraintBlock(name, phase, kind,
+                                           slice(self.size, self.size + rows), shape))
+        self.lower.append(lower)
+        self.upper.append(upper)
+        self.scale.append(scale)
+        self.size += rows
+
+    def cat(self, arrs: list[Array]) -> Array:
+        return np.concatenate(arrs) if arrs else np.zeros(0)
+
+
+def flat(m: ca.MX) -> ca.MX:
+    """Column-major flattening of an (a, b) matrix to (a*b, 1): entry (i, j) -> row j*a + i."""
+    return ca.reshape(m, m.numel(), 1)
+
+
+def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
+             phase_fns: tuple[PhaseFunction, ...], ends_fn: EndsFunction, d_w: Array,
+             state_scales: tuple[Array, ...]) -> Nlp:
+    """Build the symbolic NLP (see the module docstring)."""
+    w_hat = ca.MX.sym("w", layout.size)
+    w = w_hat * ca.DM(d_w)
+    p = w[layout.parameter_start:layout.size]
+    durations_expr = ends_fn.durations(p)
+    rows = _Rows()
+    numerator: ca.MX = ca.MX(0.0)
+    ends_parts: list[ca.MX] = []
+    durations: list[ca.MX] = []
+    t_start: ca.MX = ca.MX(problem.t0)
+    for i, (ph, pl, pf, tau) in enumerate(zip(problem.phases, layout.phases, phase_fns, mesh,
+                                              strict=True)):
+        spec = ph.duration_spec()
+        n, K, N = ph.n_states, pl.knots, pl.intervals
+        if spec.kind == "expression":
+            T = durations_expr[i]
+        elif pl.duration_index is not None:
+            T = w[pl.duration_index]
+        else:
+            T = ca.MX(spec.lower)
+        durations.append(T)
+        Z = ca.reshape(w[pl.start:pl.end], pl.stride, K)
+        X, U = Z[:n, :], Z[n:, :]
+        tk = t_start + T * ca.DM(tau).T
+        dtau = ca.DM(np.diff(tau)).T
+        h = T * dtau
+        Hn = ca.repmat(h, n, 1)
+        XD, C, L = pf.point.map(K)(X, U, p, tk)
+        x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
+        need_mid = method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0
+        f_m = L_m = None
+        if need_mid:
+            Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
+            Um = midpoint_control(U[:, :-1], U[:, 1:])
+            tm = t_start + T * ca.DM(0.5 * (tau[:-1] + tau[1:])).T
+            f_m, Cm, L_m = pf.point.map(N)(Xm, Um, p, tm)
+        defects = method.defects(x_k, x_k1, f_k, f_k1, f_m, Hn)
+        dx = state_scales[i]
+        rows.add(f"{ph.name}/defects", ph.name, "defects", flat(defects), (N, n),
+                 np.zeros(N * n), np.zeros(N * n), np.tile(dx, N))
+        r = pf.n_path
+        rows.add(f"{ph.name}/path@knots", ph.name, "path", flat(C), (K, r),
+                 np.tile(pf.path_lower, K), np.tile(pf.path_upper, K), np.tile(pf.path_scale, K))
+        if pf.midpoint_rows.size:
+            mr = pf.midpoint_rows
+            rm = int(mr.size)
+            rows.add(f"{ph.name}/path@midpoints", ph.name, "path", flat(Cm[list(mr), :]),
+                     (N, rm), np.tile(pf.path_lower[mr], N), np.tile(pf.path_upper[mr], N),
+                     np.tile(pf.path_scale[mr], N))
+        if spec.kind == "expression" and (math.isfinite(spec.lower) or
+                                          math.isfinite(spec.upper)):
+            sc = max(abs(v) for v in (spec.lower, spec.upper) if math.isfinite(v)) or 1.0
+            rows.add(f"{ph.name}/duration", ph.name, "duration", ca.reshape(T, 1, 1), (1,),
+                     np.array([spec.lower]), np.array([spec.upper]), np.array([sc]))
+        numerator = numerator + ca.sum2(method.quadrature(L[:, :-1], L[:, 1:], L_m, h))
+        t_end = t_start + T
+        ends_parts += [t_start, t_end, X[:, 0], X[:, -1], U[:, 0], U[:, -1]]
+        t_start = t_end
+    E = ca.vertcat(*ends_parts)
+    link, bnd, mayer, pcost, den = ends_fn.fn(E, p)
+    for name, sl in ends_fn.linkage_rows:
+        r = sl.stop - sl.start
+        rows.add(name, None, "linkage", link[sl.start:sl.stop], (r,), np.zeros(r), np.zeros(r),
+                 ends_fn.linkage_scale[sl])
+    for name, sl in ends_fn.boundary_rows:
+        r = sl.stop - sl.start
+        rows.add(name, None, "boundary", bnd[sl.start:sl.stop], (r,),
+                 ends_fn.boundary_lower[sl], ends_fn.boundary_upper[sl],
+                 ends_fn.boundary_scale[sl])
+    numerator = numerator + mayer + pcost
+    J = numerator / den if ends_fn.has_denominator else numerator
+    g = ca.vertcat(*rows.exprs) if rows.exprs else ca.MX(0, 1)
+    d_g = rows.cat(rows.scale)
+    f_scaled = J / problem.objective_scale
+    g_scaled = g / ca.DM(d_g) if rows.size else g
+    w_plain = ca.MX.sym("w_plain", layout.size)
+    evaluate = ca.Function("evaluate", [w_hat], [g, numerator, den, ca.vertcat(*durations)])
+    evaluate = ca.Function("evaluate_unscaled", [w_plain],
+                           evaluate.call([w_plain / ca.DM(d_w)]),
+                           ["w"], ["g", "numerator", "denominator", "durations"])
+    return Nlp(w_hat, f_scaled, g_scaled, layout, ConstraintLayout(tuple(rows.blocks), rows.size),
+               d_w, d_g, rows.cat(rows.lower), rows.cat(rows.upper), problem.objective_scale,
+               evaluate)

@@ -1,0 +1,152 @@
+"""Creating the IPOPT solver of an NLP (plain SX, MX, CasADi jit, or compiled C) and calling it.
+
+Modes (``compiled``):
+
+* ``None``: CasADi's virtual machine evaluates the functions (SX after ``expand`` by default).
+* ``"codegen"``: the solver's five functions (``nlp_f, nlp_g, nlp_grad_f, nlp_jac_g,
+  nlp_hess_l``) are generated as C, compiled with :mod:`gaitopt.codegen` into the on-disk
+  cache, loaded back as external functions and passed to ``nlpsol`` through its
+  Function-valued options ``grad_f``, ``jac_g``, ``hess_lag``. The library is keyed by a hash of
+  the expanded NLP, so a second build of the same NLP skips deriving and compiling.
+* ``"jit"``: CasADi's own just-in-time compilation (``jit=True``, shell compiler); compiled at
+  every build, nothing cached.
+
+A solve never raises: :func:`call_solver` returns the solution or an error message.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from gaitopt import codegen
+
+DEFAULT_OPTIONS: dict[str, Any] = {
+    "print_time": False,
+    "record_time": True,
+    "error_on_fail": False,
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-8,
+    "ipopt.max_iter": 3000,
+    "ipopt.linear_solver": "mumps",
+}
+
+COMPILED_MODES = (None, "codegen", "jit")
+EVAL_KINDS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l")
+
+
+def merge_options(*layers: Mapping[str, Any] | None) -> dict[str, Any]:
+    """Flatten nested ``{"ipopt": {...}}`` to ``"ipopt.key"`` and merge, later layers win."""
+    out: dict[str, Any] = {}
+    for layer in layers:
+        for key, value in (layer or {}).items():
+            if key == "ipopt" and isinstance(value, Mapping):
+                for k, v in value.items():
+                    out[f"ipopt.{k}"] = v
+            else:
+                out[key] = value
+    return out
+
+
+def options_key(options: Mapping[str, Any]) -> str:
+    """A hashable key of an options dict (for caching solvers)."""
+    return repr(sorted((k, repr(v)) for k, v in options.items()))
+
+
+@dataclass(frozen=True)
+class NlpFunctions:
+    """The expanded (or MX) NLP as symbols ready for ``nlpsol``."""
+
+    x: Any
+    f: Any
+    g: Any
+
+
+def nlp_symbols(w_hat: ca.MX, f: ca.MX, g: ca.MX, expand: bool) -> NlpFunctions:
+    """The NLP in SX (``expand``: faster evaluation) or left as MX."""
+    if not expand:
+        return NlpFunctions(w_hat, f, g)
+    fn = ca.Function("nlp", [w_hat], [f, g]).expand()
+    x = ca.SX.sym("w", w_hat.shape[0])
+    f_sx, g_sx = fn(x)
+    return NlpFunctions(x, f_sx, g_sx)
+
+
+def _nlp_hash(nlp: NlpFunctions) -> str:
+    fn = ca.Function("nlp", [nlp.x], [nlp.f, nlp.g])
+    return hashlib.sha256(fn.serialize().encode()).hexdigest()[:16]
+
+
+def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any]) -> ca.Function:
+    lib_name = f"ocp_{_nlp_hash(nlp)}"
+    cached = sorted(codegen.cache_dir().glob(f"{lib_name}-*.so"))
+    if cached:
+        path = cached[-1]
+    else:
+        base = ca.nlpsol(f"{name}_base", "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g},
+                         options)
+        fns = [base.get_function(k) for k in EVAL_KINDS]
+        path = codegen.compile_library(codegen.generate_source(fns, lib_name), lib_name)
+    ext = {k: ca.external(k, str(path)) for k in EVAL_KINDS}
+    X = ca.MX.sym("w", nlp.x.shape[0])
+    P = ca.MX.sym("p", 0)
+    opts = dict(options)
+    opts.update(grad_f=ext["nlp_grad_f"], jac_g=ext["nlp_jac_g"], hess_lag=ext["nlp_hess_l"],
+                no_nlp_grad=True, calc_lam_p=False)
+    return ca.nlpsol(name, "ipopt", {"x": X, "f": ext["nlp_f"](X, P), "g": ext["nlp_g"](X, P)},
+                     opts)
+
+
+def make_solver(name: str, nlp: NlpFunctions, options: Mapping[str, Any],
+                compiled: str | None) -> ca.Function:
+    """An IPOPT ``nlpsol`` for ``nlp`` in the requested evaluation mode."""
+    opts = dict(options)
+    if compiled is None:
+        return ca.nlpsol(name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
+    if compiled == "jit":
+        opts.update(jit=True, compiler="shell", jit_cleanup=True,
+                    jit_options={"flags": ["-O1"], "verbose": False})
+        return ca.nlpsol(name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
+    if compiled == "codegen":
+        return _codegen_solver(name, nlp, opts)
+    raise ValueError(f"compiled must be one of {COMPILED_MODES}, got {compiled!r}")
+
+
+@dataclass(frozen=True)
+class SolverOutput:
+    """What came back from one solver call (scaled vectors, as the solver saw them)."""
+
+    x: np.ndarray
+    lam_x: np.ndarray
+    lam_g: np.ndarray
+    f: float
+    stats: dict[str, Any]
+    error: str | None
+
+
+def call_solver(solver: ca.Function, args: dict[str, Any]) -> SolverOutput:
+    """Run ``solver(**args)``; any exception becomes ``error`` (with x = x0)."""
+    try:
+        sol = solver(**args)
+        error = None
+    except Exception as exc:  # noqa: BLE001 - the solver may raise anything; report it
+        sol = None
+        error = f"{type(exc).__name__}: {str(exc).strip().splitlines()[-1] if str(exc) else ''}"
+    try:
+        stats = dict(solver.stats())
+    except Exception:  # noqa: BLE001
+        stats = {}
+    if sol is None:
+        x0 = np.asarray(args["x0"], dtype=float).ravel()
+        ng = np.asarray(args["lbg"]).size
+        return SolverOutput(x0, np.zeros_like(x0), np.zeros(ng), float("nan"), stats, error)
+    return SolverOutput(np.asarray(sol["x"], dtype=float).ravel(),
+                        np.asarray(sol["lam_x"], dtype=float).ravel(),
+                        np.asarray(sol["lam_g"], dtype=float).ravel(),
+                        float(sol["f"]), stats, None)

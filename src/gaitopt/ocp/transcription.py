@@ -1,0 +1,243 @@
+"""A transcription owns the NLP of a problem on a mesh and its solvers; solving returns a Result.
+
+``transcribe(problem, method=..., intervals=...)`` validates the statement and builds the NLP
+and the IPOPT solver once. ``tr.solve(guess, bounds=..., parameters=..., options=...)`` can be
+called many times with other initial guesses and bounds without rebuilding anything (the
+counters in ``tr.builds`` show it); only new solver options build (and cache) a new solver.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Mapping
+from typing import Any
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from gaitopt.ocp.bounds import Bounds, variable_bounds
+from gaitopt.ocp.estimate import interval_errors
+from gaitopt.ocp.functions import PhaseFunction, build_ends_function, build_phase_function
+from gaitopt.ocp.guess import Guess, guess_vector
+from gaitopt.ocp.layout import Layout
+from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
+from gaitopt.ocp.nlp import Nlp, assemble
+from gaitopt.ocp.problem import Problem
+from gaitopt.ocp.result import METHODS, NlpSize, PhaseTrajectory, Result, point_values
+from gaitopt.ocp.scaling import state_scales, variable_scales
+from gaitopt.ocp.solver import (
+    COMPILED_MODES,
+    DEFAULT_OPTIONS,
+    EVAL_KINDS,
+    SolverOutput,
+    call_solver,
+    make_solver,
+    merge_options,
+    nlp_symbols,
+    options_key,
+)
+from gaitopt.ocp.validate import ProblemError, check_problem
+
+Array = NDArray[np.float64]
+
+ParameterBounds = Mapping[str, float | tuple[float, float]]
+
+
+class Transcription:
+    """The NLP of ``problem`` transcribed by ``method`` on ``mesh``, with cached solvers.
+
+    Attributes:
+        problem, method (name), mesh (normalised knots per phase), layout (w), nlp
+        (symbolic NLP with constraint layout and scales), builds (Counter: ``nlp``,
+        ``solver``), options (the default solver options).
+    """
+
+    def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool = True,
+                 compiled: str | None = None, options: Mapping[str, Any] | None = None,
+                 scaling: bool = True, cse: bool = True) -> None:
+        check_problem(problem)
+        if method not in METHODS:
+            raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
+        if compiled not in COMPILED_MODES:
+            raise ProblemError(f"compiled must be one of {COMPILED_MODES}, got {compiled!r}")
+        self.problem = problem
+        self.method = method
+        self.mesh = mesh
+        self.compiled = compiled
+        self.expand = expand or compiled is not None
+        self.options = merge_options(DEFAULT_OPTIONS, options)
+        self.builds: Counter[str] = Counter()
+        n_p = len(problem.parameters)
+        self.layout = Layout.build(
+            [(ph.name, ph.states, ph.controls, tau.size, ph.duration_spec().kind == "free")
+             for ph, tau in zip(problem.phases, mesh, strict=True)], problem.parameter_names)
+        self.phase_functions: tuple[PhaseFunction, ...] = tuple(
+            build_phase_function(ph, n_p, cse=cse) for ph in problem.phases)
+        sx = tuple(state_scales(ph, scaling) for ph in problem.phases)
+        ends = build_ends_function(problem, {ph.name: s for ph, s in zip(problem.phases, sx,
+                                                                          strict=True)}, cse=cse)
+        d_w = variable_scales(problem, self.layout, scaling)
+        self.nlp: Nlp = assemble(problem, METHODS[method], mesh, self.layout,
+                                 self.phase_functions, ends, d_w, sx)
+        lbw, ubw = variable_bounds(problem, self.layout)
+        self._bounds = Bounds(self.layout, self.nlp.constraints, lbw, ubw, self.nlp.lbg,
+                              self.nlp.ubg)
+        self._bounds.check()
+        self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
+        self.builds["nlp"] += 1
+        self._solvers: dict[str, ca.Function] = {}
+        self.solver(self.options)
+
+    # -- solvers ---------------------------------------------------------------------------
+    def solver(self, options: Mapping[str, Any]) -> ca.Function:
+        """The (cached) IPOPT solver for ``options`` (built on first use)."""
+        key = options_key(options)
+        if key not in self._solvers:
+            name = f"ocp_solver_{len(self._solvers)}"
+            self._solvers[key] = make_solver(name, self._symbols, dict(options), self.compiled)
+            self.builds["solver"] += 1
+        return self._solvers[key]
+
+    # -- bounds and guesses ----------------------------------------------------------------
+    def bounds(self) -> Bounds:
+        """The statement's bounds (modify with ``Bounds.with_*`` and pass to :meth:`solve`)."""
+        return self._bounds
+
+    def initial_guess(self, guess: Guess | Result | None = None) -> Array:
+        """The unscaled initial point w0 for ``guess``."""
+        return guess_vector(self.problem, self.layout, self.mesh, guess)
+
+    def nlp_size(self, bounds: Bounds | None = None) -> NlpSize:
+        """Variables and constraints counted in the paper's terms (see :class:`NlpSize`)."""
+        b = bounds or self._bounds
+        fixed = b.lbw == b.ubw
+        boxed = (~fixed) & (np.isfinite(b.lbw) | np.isfinite(b.ubw))
+        eq = b.lbg == b.ubg
+        ineq = (~eq) & (np.isfinite(b.lbg) | np.isfinite(b.ubg))
+        return NlpSize(self.layout.size, int(fixed.sum()), int(boxed.sum()), int(eq.sum()),
+                       int(ineq.sum()))
+
+    # -- solving ---------------------------------------------------------------------------
+    def solve(self, guess: Guess | Result | None = None, *, bounds: Bounds | None = None,
+              parameters: ParameterBounds | None = None,
+              options: Mapping[str, Any] | None = None,
+              warm_start_multipliers: bool = False) -> Result:
+        """Solve the NLP from ``guess``; never raises for solver failures.
+
+        ``bounds`` replaces the statement's bounds; ``parameters`` then bounds parameters by
+        name (a value fixes it, a pair bounds it). ``options`` are merged over the
+        transcription's solver options. ``warm_start_multipliers`` passes a Result's
+        multipliers to IPOPT (with ``warm_start_init_point``) when its layout matches.
+        """
+        b = bounds or self._bounds
+        if b.layout.signature() != self.layout.signature() or b.lbg.size != self.nlp.lbg.size:
+            raise ProblemError("bounds: made for another transcription (layout differs)")
+        for name, val in (parameters or {}).items():
+            lo, hi = val if isinstance(val, tuple) else (val, val)
+            try:
+                b = b.with_parameter(name, lo, hi)
+            except KeyError as exc:
+                raise ProblemError(str(exc.args[0])) from None
+        b.check()
+        opts = merge_options(self.options, options)
+        w0 = self.initial_guess(guess)
+        d_w, d_g, s_j = self.nlp.d_w, self.nlp.d_g, self.nlp.objective_scale
+        args: dict[str, Any] = dict(x0=w0 / d_w, lbx=b.lbw / d_w, ubx=b.ubw / d_w,
+                                    lbg=b.lbg / d_g, ubg=b.ubg / d_g)
+        if (warm_start_multipliers and isinstance(guess, Result)
+                and guess.layout_signature == self.layout.signature()
+                and guess.method == self.method and guess.lam_g.size == d_g.size):
+            args["lam_x0"] = guess.lam_x * d_w / s_j
+            args["lam_g0"] = guess.lam_g * d_g / s_j
+            opts = merge_options(opts, {"ipopt.warm_start_init_point": "yes",
+                                        "ipopt.warm_start_bound_push": 1e-9,
+                                        "ipopt.warm_start_mult_bound_push": 1e-9,
+                                        "ipopt.mu_init": 1e-6})
+        try:
+            solver = self.solver(opts)
+        except Exception as exc:  # noqa: BLE001 - bad options etc.: report, don't raise
+            out = SolverOutput(w0 / d_w, np.zeros_like(w0), np.zeros(d_g.size), math.nan, {},
+                               f"{type(exc).__name__}: {str(exc).strip()[-500:]}")
+        else:
+            out = call_solver(solver, args)
+        return self._result(out, b)
+
+    def _result(self, out: SolverOutput, b: Bounds) -> Result:
+        nlp = self.nlp
+        w = out.x * nlp.d_w
+        lam_x = out.lam_x * nlp.objective_scale / nlp.d_w
+        lam_g = out.lam_g * nlp.objective_scale / nlp.d_g
+        g, num, den, durs = (np.asarray(v, dtype=float).ravel() for v in nlp.evaluate(w))
+        objective = float(num[0] / den[0]) if self.nlp_has_ratio else float(num[0])
+        viol = 0.0
+        if g.size:
+            viol = max(viol, float(np.max(np.maximum(b.lbg - g, g - b.ubg), initial=0.0)))
+        viol = max(viol, float(np.max(np.maximum(b.lbw - w, w - b.ubw), initial=0.0)))
+        p = w[self.layout.parameter_slice()]
+        phases = []
+        t_start = self.problem.t0
+        method = METHODS[self.method]
+        for ph, pl, pf, tau, T in zip(self.problem.phases, self.layout.phases,
+                                      self.phase_functions, self.mesh, durs, strict=True):
+            t = t_start + T * tau
+            x = w[pl.state_indices()]
+            u = w[pl.control_indices()]
+            xdot, path, _ = point_values(pf.point, t, x, u, p)
+            if np.all(np.isfinite(x)) and np.all(np.isfinite(xdot)) and T > 0:
+                eta, err = interval_errors(method, pf.point, t, x, u, xdot, p)
+            else:
+                eta, err = np.full((tau.size - 1, ph.n_states), np.nan), np.full(tau.size - 1,
+                                                                                 np.nan)
+            phases.append(PhaseTrajectory(
+                ph.name, tuple(ph.states), tuple(ph.controls), self.method, t, x, u, xdot,
+                {pr.name: path[:, pr.rows] for pr in pf.path_rows}, err, eta))
+            t_start = t_start + T
+        st = out.stats
+        status = str(st.get("return_status", "unknown")) if out.error is None else \
+            "Solver_Exception"
+        evals = {k: int(st.get(f"n_call_{k}", 0)) for k in EVAL_KINDS}
+        times = {k: float(st.get(f"t_wall_{k}", 0.0)) for k in EVAL_KINDS}
+        times["evaluations"] = sum(times[k] for k in EVAL_KINDS)
+        times["total"] = float(st.get("t_wall_total", 0.0))
+        success = bool(st.get("success", False)) and out.error is None
+        return Result(
+            status=status, success=success, iterations=int(st.get("iter_count", 0)),
+            objective=objective, constraint_violation=viol, evaluations=evals, times=times,
+            nlp_size=self.nlp_size(b), phases=tuple(phases),
+            parameters={name: float(p[i]) for i, name in enumerate(self.layout.parameters)},
+            w=w, lam_x=lam_x, lam_g=lam_g, method=self.method, mesh=self.mesh,
+            layout_signature=self.layout.signature(), message=out.error or status,
+            stats={k: v for k, v in st.items() if not isinstance(v, dict | list)})
+
+    @property
+    def nlp_has_ratio(self) -> bool:
+        """Whether the objective is a ratio (a cost denominator is given)."""
+        return self.problem.cost_denominator is not None
+
+
+def transcribe(problem: Problem, *, method: str = "hermite-simpson",
+               intervals: IntervalsSpec | Mapping[str, IntervalsSpec] | None = None,
+               expand: bool = True, compiled: str | None = None,
+               options: Mapping[str, Any] | None = None, scaling: bool = True,
+               cse: bool = True) -> Transcription:
+    """Validate ``problem``, build its NLP and solver once, and return the transcription.
+
+    Args:
+        method: ``"hermite-simpson"`` (default) or ``"trapezoidal"``.
+        intervals: None (each phase's ``intervals``), an int for all phases, or by phase name
+            an int (uniform) or an array of normalised knots in [0, 1].
+        expand: evaluate in SX (faster) rather than MX.
+        compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk) or ``"jit"``.
+        options: solver options over the defaults (``{"ipopt.tol": 1e-10}`` or
+            ``{"ipopt": {"tol": 1e-10}}``).
+        scaling: scale variables and constraints from bounds or given scales.
+        cse: eliminate common subexpressions in the point and ends functions.
+    """
+    if method not in METHODS:
+        raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
+    check_problem(problem)
+    mesh = make_mesh(problem, intervals)
+    return Transcription(problem, method, mesh, expand=expand, compiled=compiled,
+                         options=options, scaling=scaling, cse=cse)
