@@ -97,12 +97,13 @@ def ellipsoid_inertia(mass: float, length: float, radius: float) -> float:
     """Inertia (kg m^2) about the axis through the centre normal to the plane of a uniform
     ellipsoid with semi-axes ``a = length/2`` (along the link), ``b = c = radius``:
     ``I = m (a^2 + b^2) / 5``."""
-    return mass * ((length / 2.0) ** 2 + radius**2) / 5.0
+    a = length / 2.0
+    return mass * (a * a + radius * radius) / 5.0  # products give inf, never OverflowError
 
 
 def rod_inertia(mass: float, length: float) -> float:
     """Inertia (kg m^2) of a thin uniform rod about its centre: ``I = m length^2 / 12``."""
-    return mass * length**2 / 12.0
+    return mass * (length * length) / 12.0
 
 
 def shape_inertia(shape: Shape, mass: float, length: float) -> float:
@@ -157,6 +158,13 @@ def model_from_dict(data: Any, *, source: str = "<dict>") -> RobotModel:
     return _Validator(source).model(data)
 
 
+def _field(path: str, key: Any) -> str:
+    """The path of ``key`` under ``path``: ``links[1].mass``, or ``links[1]['odd key']``."""
+    if isinstance(key, str) and key.isidentifier():
+        return f"{path}.{key}" if path else key
+    return f"{path}[{show_value(key, 30)}]"
+
+
 def _names(names: list[str] | set[str] | tuple[str, ...]) -> str:
     return ", ".join(sorted(names)) or "none defined"
 
@@ -177,7 +185,7 @@ class _Validator:
             raise self.fail(path, value, f"a mapping (key: value) describing {what}")
         for key in value:
             if key not in keys:
-                raise self.fail(f"{path}.{key}" if path else str(key), value[key],
+                raise self.fail(_field(path, key), value[key],
                                 f"the keys {', '.join(keys)}",
                                 problem=f"unknown key {show_value(key)}")
         for key in required:
@@ -206,11 +214,13 @@ class _Validator:
         return x
 
     def name(self, path: str, value: Any) -> str:
-        if not isinstance(value, str) or not value.strip() or value != value.strip():
+        """A name: non-empty printable text without leading or trailing spaces."""
+        if (not isinstance(value, str) or not value.strip() or value != value.strip()
+                or not value.isprintable()):
             hint = " (quote it in YAML: '1', 'yes')" if isinstance(value, bool | int | float) \
                 else ""
-            raise self.fail(path, value,
-                            f"a non-empty text without leading or trailing spaces{hint}")
+            raise self.fail(path, value, "a non-empty printable text without leading or "
+                            f"trailing spaces{hint}")
         return value
 
     def pair(self, path: str, value: Any, allowed: str) -> tuple[float, float]:
@@ -229,7 +239,8 @@ class _Validator:
 
     def unique(self, path: str, name: str, seen: set[str], what: str) -> None:
         if name in seen:
-            raise self.fail(path, name, f"a {what} name not used by another {what}",
+            article = "an" if what[0] in "aeiou" else "a"
+            raise self.fail(path, name, f"{article} {what} name not used by another {what}",
                             problem=f"duplicate {what} name {show_value(name)}")
         seen.add(name)
 
@@ -257,8 +268,10 @@ class _Validator:
         description = top.get("description")
         if description is None:
             description = ""
-        if not isinstance(description, str):
-            raise self.fail("description", description, "a text (or null)")
+        if not isinstance(description, str) or not all(
+                c.isprintable() or c in "\n\t" for c in description):
+            raise self.fail("description", description,
+                            "a text of printable characters, new lines and tabs (or null)")
         gravity = DEFAULT_GRAVITY
         if "gravity" in top:
             gravity = self.pair("gravity", top["gravity"], "[gx, gy] in m/s^2, world frame")
@@ -288,6 +301,10 @@ class _Validator:
             parents.append(parent)
         self.tree(names, [e["name"] for e in entries], parents)
         base_name = entries[0]["name"]
+        if base_name in ("x", "y"):
+            raise self.fail("links[0].name", base_name,
+                            "a name other than x and y (the base link's name names its angle "
+                            "in q = [x, y, <base>, ...])")
         joint_names: set[str] = set()
         return tuple(self.link(i, e, parents[i], joint_names, base_name)
                      for i, e in enumerate(entries))
@@ -362,6 +379,10 @@ class _Validator:
                                     "only one of 'inertia' and 'shape')")
         elif shape is not None:
             inertia = shape_inertia(shape, mass, length)
+            if not (math.isfinite(inertia) and inertia > 0.0):
+                raise self.fail(f"{path}.shape", e["shape"],
+                                "a shape whose inertia (with this mass and length) is a finite "
+                                f"number > 0 kg m^2, not {inertia!r}")
         else:
             raise self.fail(f"{path}.inertia", MISSING,
                             "an 'inertia' (kg m^2, > 0) or a 'shape' to compute it from")
