@@ -52,6 +52,19 @@ class Joint:
 
 
 @dataclass(frozen=True)
+class Shape:
+    """A uniform solid that a link's inertia was computed from (kept for the record).
+
+    ``type`` is ``"ellipsoid"`` (semi-axes ``length/2, radius, radius``: inertia about the axis
+    normal to the plane ``m ((length/2)^2 + radius^2) / 5``) or ``"rod"`` (a thin rod:
+    ``m length^2 / 12``, ``radius`` is ``None``). Lengths in m.
+    """
+
+    type: Literal["ellipsoid", "rod"]
+    radius: float | None = None
+
+
+@dataclass(frozen=True)
 class Link:
     """A rigid link of the planar tree.
 
@@ -64,7 +77,8 @@ class Link:
         mass: kilograms, > 0.
         com: centre of mass as ``(along, across)`` in metres.
         inertia: rotational inertia about the centre of mass, about z, kg m^2, > 0.
-        shape: the shape the inertia was computed from (for the record), or ``None``.
+        shape: the shape the inertia was computed from (for the record), or ``None`` when the
+            inertia was given directly.
     """
 
     name: str
@@ -75,7 +89,7 @@ class Link:
     mass: float
     com: tuple[float, float]
     inertia: float
-    shape: dict[str, Any] | None = None
+    shape: Shape | None = None
 
     @property
     def axis(self) -> tuple[float, float]:
@@ -135,6 +149,8 @@ class RobotModel:
     gravity: tuple[float, float] = (0.0, -9.81)
     description: str = ""
     _index: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
+    # ``_index`` is derived from ``links`` and excluded from ``==`` and ``hash``; models are
+    # hashable (usable as cache keys) because every field is immutable.
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_index", {link.name: i for i, link in enumerate(self.links)})
@@ -156,6 +172,7 @@ class RobotModel:
 
     @property
     def total_mass(self) -> float:
+        """Sum of the link masses (kg)."""
         return sum(link.mass for link in self.links)
 
     # -- names and indices -------------------------------------------------------------------
@@ -214,8 +231,8 @@ class RobotModel:
 
     # -- identity ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """The model as plain data in the model-file schema (see ``gaitopt.robot.loader``)."""
-        from gaitopt.robot.loader import model_to_dict
+        """The model as plain data in the model-file schema (see ``gaitopt.robot.schema``)."""
+        from gaitopt.robot.schema import model_to_dict
 
         return model_to_dict(self)
 

@@ -1,0 +1,472 @@
+"""The model-file schema (format ``gaitopt.model``, version 1): validation of plain data into a
+:class:`~gaitopt.robot.model.RobotModel`, and the model back to plain data.
+
+Plain data is what YAML or JSON parse into: mappings, lists, strings, numbers and null. Units:
+lengths in m, masses in kg, inertias in kg m^2 (about the centre of mass, about z), angles in
+rad, torques in N m, gravity in m/s^2. Points on a link are ``[along, across]`` (see
+:mod:`gaitopt.robot.model`). The full schema with every field and default is in
+``docs/conventions.md``; in short::
+
+    format: gaitopt.model     # optional; version: 1 (optional; other versions are rejected)
+    name: five-link
+    description: free text    # optional
+    gravity: [0.0, -9.81]     # optional
+    links:                    # the floating base first (parent: null), parents before children
+      - {name, parent, direction: up|down, length, mass, com (default [length/2, 0]),
+         inertia and/or shape: {type: ellipsoid, radius} | {type: rod},
+         joint: {name, at: [along, across] on the parent, limits: [lower, upper]}}  # not base
+    contacts:                 # optional
+      - {name, link, at (default [length, 0]: the link's far end)}
+    actuators:                # optional; the controls u, in this order
+      - {name, joint: NAME | contact: NAME, limits: [lower, upper]}
+
+Every problem raises :class:`ModelError`, which names the source (file), the field path, the
+bad value and what is allowed. Validation never raises any other exception, whatever the data.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Mapping
+from typing import Any
+
+from gaitopt.robot.model import Actuator, Contact, Direction, Joint, Link, RobotModel, Shape
+
+FORMAT = "gaitopt.model"
+VERSION = 1
+DEFAULT_GRAVITY: tuple[float, float] = (0.0, -9.81)
+
+TOP_KEYS = ("format", "version", "name", "description", "gravity", "links", "contacts",
+            "actuators")
+LINK_KEYS = ("name", "parent", "joint", "direction", "length", "mass", "com", "inertia", "shape")
+JOINT_KEYS = ("name", "at", "limits")
+CONTACT_KEYS = ("name", "link", "at")
+ACTUATOR_KEYS = ("name", "joint", "contact", "limits")
+SHAPE_TYPES = ("ellipsoid", "rod")
+DIRECTIONS = ("up", "down")
+
+#: Relative tolerance when a link gives both ``inertia`` and ``shape``.
+INERTIA_RTOL = 1e-9
+
+
+class _Missing:
+    def __repr__(self) -> str:
+        return "<missing>"
+
+
+#: Stands for the value of a required field that is absent.
+MISSING: Any = _Missing()
+
+
+def show_value(value: Any, limit: int = 60) -> str:
+    """A one-line, length-limited ``repr`` of a value for error messages."""
+    try:
+        text = repr(value)
+    except Exception:  # a repr that fails must not hide the real error
+        text = f"<{type(value).__name__}>"
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+class ModelError(ValueError):
+    """A model file or description is invalid.
+
+    The message is one line: ``SOURCE: PATH: got VALUE; allowed: ALLOWED`` (``missing`` instead
+    of ``got VALUE`` for an absent required field, or another ``problem`` text).
+
+    Attributes:
+        source: the file (or ``<builtin NAME>``, ``<dict>``, ``<string>``) the model came from.
+        path: the field path, e.g. ``links[2].mass``; ``""`` for the whole file.
+        value: the offending value (:data:`MISSING` for an absent field).
+        allowed: what would have been accepted.
+    """
+
+    def __init__(self, source: str, path: str, value: Any, allowed: str, *,
+                 problem: str | None = None) -> None:
+        self.source, self.path, self.value, self.allowed = source, path, value, allowed
+        if problem is None:
+            problem = "missing" if value is MISSING else f"got {show_value(value)}"
+        where = f"{path}: " if path else ""
+        super().__init__(f"{source}: {where}{problem}; allowed: {allowed}")
+
+
+# -- inertia of shapes -----------------------------------------------------------------------
+
+def ellipsoid_inertia(mass: float, length: float, radius: float) -> float:
+    """Inertia (kg m^2) about the axis through the centre normal to the plane of a uniform
+    ellipsoid with semi-axes ``a = length/2`` (along the link), ``b = c = radius``:
+    ``I = m (a^2 + b^2) / 5``."""
+    a = length / 2.0
+    return mass * (a * a + radius * radius) / 5.0  # products give inf, never OverflowError
+
+
+def rod_inertia(mass: float, length: float) -> float:
+    """Inertia (kg m^2) of a thin uniform rod about its centre: ``I = m length^2 / 12``."""
+    return mass * (length * length) / 12.0
+
+
+def shape_inertia(shape: Shape, mass: float, length: float) -> float:
+    """Inertia (kg m^2) about the centre of a link of ``mass`` kg and ``length`` m."""
+    if shape.type == "ellipsoid":
+        assert shape.radius is not None
+        return ellipsoid_inertia(mass, length, shape.radius)
+    return rod_inertia(mass, length)
+
+
+# -- model -> plain data ---------------------------------------------------------------------
+
+def model_to_dict(model: RobotModel) -> dict[str, Any]:
+    """The model as plain data in the model-file schema.
+
+    Every default is written out; a link keeps its ``shape`` (if any) next to the explicit
+    ``inertia``. ``model_from_dict(model_to_dict(m)) == m``.
+    """
+    links: list[dict[str, Any]] = []
+    for link in model.links:
+        entry: dict[str, Any] = {"name": link.name, "parent": link.parent}
+        if link.joint is not None:
+            entry["joint"] = {"name": link.joint.name, "at": list(link.joint.at),
+                              "limits": list(link.joint.limits)}
+        entry.update({"direction": link.direction, "length": link.length, "mass": link.mass,
+                      "com": list(link.com), "inertia": link.inertia})
+        if link.shape is not None:
+            entry["shape"] = ({"type": "ellipsoid", "radius": link.shape.radius}
+                              if link.shape.type == "ellipsoid" else {"type": "rod"})
+        links.append(entry)
+    actuators: list[dict[str, Any]] = []
+    for a in model.actuators:
+        target = {"joint": a.joint} if a.joint is not None else {"contact": a.contact}
+        actuators.append({"name": a.name, **target, "limits": list(a.limits)})
+    return {
+        "format": FORMAT, "version": VERSION, "name": model.name,
+        "description": model.description, "gravity": list(model.gravity), "links": links,
+        "contacts": [{"name": c.name, "link": c.link, "at": list(c.at)} for c in model.contacts],
+        "actuators": actuators,
+    }
+
+
+# -- plain data -> model ---------------------------------------------------------------------
+
+def model_from_dict(data: Any, *, source: str = "<dict>") -> RobotModel:
+    """Validate plain data in the model-file schema and build a :class:`RobotModel`.
+
+    Raises:
+        ModelError: for any problem, naming ``source``, the field path, the value and what is
+            allowed. No other exception escapes, whatever ``data`` is.
+    """
+    return _Validator(source).model(data)
+
+
+def _field(path: str, key: Any) -> str:
+    """The path of ``key`` under ``path``: ``links[1].mass``, or ``links[1]['odd key']``."""
+    if isinstance(key, str) and key.isidentifier():
+        return f"{path}.{key}" if path else key
+    return f"{path}[{show_value(key, 30)}]"
+
+
+def _names(names: list[str] | set[str] | tuple[str, ...]) -> str:
+    return ", ".join(sorted(names)) or "none defined"
+
+
+class _Validator:
+    """Checks one model description; ``source`` goes into every error."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, path: str, value: Any, allowed: str, problem: str | None = None) -> ModelError:
+        return ModelError(self.source, path, value, allowed, problem=problem)
+
+    # -- generic fields ----------------------------------------------------------------------
+    def mapping(self, path: str, value: Any, keys: tuple[str, ...], required: tuple[str, ...],
+                what: str) -> Mapping[str, Any]:
+        if not isinstance(value, Mapping):
+            raise self.fail(path, value, f"a mapping (key: value) describing {what}")
+        for key in value:
+            if key not in keys:
+                raise self.fail(_field(path, key), value[key],
+                                f"the keys {', '.join(keys)}",
+                                problem=f"unknown key {show_value(key)}")
+        for key in required:
+            if key not in value:
+                raise self.fail(f"{path}.{key}" if path else key, MISSING,
+                                f"'{key}' is required in {what}")
+        return value
+
+    def number(self, path: str, value: Any, allowed: str, *, positive: bool = False) -> float:
+        """A finite real number (> 0 if ``positive``); ``allowed`` describes it with units."""
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            hint = ""
+            if isinstance(value, str):
+                try:
+                    float(value)
+                    hint = " (YAML reads numbers like 1e3 as text: write 1.0e+3)"
+                except ValueError:
+                    pass
+            raise self.fail(path, value, allowed + hint)
+        try:
+            x = float(value)
+        except (OverflowError, ValueError, TypeError):
+            raise self.fail(path, value, allowed) from None
+        if not math.isfinite(x) or (positive and x <= 0.0):
+            raise self.fail(path, value, allowed)
+        return x
+
+    def name(self, path: str, value: Any) -> str:
+        """A name: non-empty printable text without leading or trailing spaces."""
+        if (not isinstance(value, str) or not value.strip() or value != value.strip()
+                or not value.isprintable()):
+            hint = " (quote it in YAML: '1', 'yes')" if isinstance(value, bool | int | float) \
+                else ""
+            raise self.fail(path, value, "a non-empty printable text without leading or "
+                            f"trailing spaces{hint}")
+        return value
+
+    def pair(self, path: str, value: Any, allowed: str) -> tuple[float, float]:
+        """Two finite numbers ``[a, b]``; ``allowed`` describes them with units."""
+        if not isinstance(value, list | tuple) or len(value) != 2:
+            raise self.fail(path, value, f"a list of two numbers {allowed}")
+        return (self.number(f"{path}[0]", value[0], f"a finite number; {allowed}"),
+                self.number(f"{path}[1]", value[1], f"a finite number; {allowed}"))
+
+    def bounds(self, path: str, value: Any, unit: str) -> tuple[float, float]:
+        lo, hi = self.pair(path, value, f"[lower, upper] in {unit}")
+        if lo > hi:
+            raise self.fail(path, [lo, hi], f"[lower, upper] in {unit} with lower <= upper",
+                            problem=f"lower bound above upper bound {show_value([lo, hi])}")
+        return (lo, hi)
+
+    def unique(self, path: str, name: str, seen: set[str], what: str) -> None:
+        if name in seen:
+            article = "an" if what[0] in "aeiou" else "a"
+            raise self.fail(path, name, f"{article} {what} name not used by another {what}",
+                            problem=f"duplicate {what} name {show_value(name)}")
+        seen.add(name)
+
+    def optional_list(self, path: str, value: Any, what: str) -> list[Any]:
+        if value is None:
+            return []
+        if not isinstance(value, list):
+            raise self.fail(path, value, f"a list of {what} (or null for none)")
+        return value
+
+    # -- the model ---------------------------------------------------------------------------
+    def model(self, data: Any) -> RobotModel:
+        if data is None:
+            raise self.fail("", None, "a model: a mapping with at least 'name' and 'links'",
+                            problem="empty model (no YAML content)")
+        top = self.mapping("", data, TOP_KEYS, ("name", "links"), "a model")
+        if "format" in top and (not isinstance(top["format"], str) or top["format"] != FORMAT):
+            raise self.fail("format", top["format"], f"{FORMAT!r}")
+        if "version" in top:
+            version = top["version"]
+            if isinstance(version, bool) or not isinstance(version, int) or version != VERSION:
+                raise self.fail("version", version,
+                                f"{VERSION} (this gaitopt reads {FORMAT} version {VERSION} only)")
+        name = self.name("name", top["name"])
+        description = top.get("description")
+        if description is None:
+            description = ""
+        if not isinstance(description, str) or not all(
+                c.isprintable() or c in "\n\t" for c in description):
+            raise self.fail("description", description,
+                            "a text of printable characters, new lines and tabs (or null)")
+        gravity = DEFAULT_GRAVITY
+        if "gravity" in top:
+            gravity = self.pair("gravity", top["gravity"], "[gx, gy] in m/s^2, world frame")
+        links = self.links(top["links"])
+        contacts = self.contacts(self.optional_list("contacts", top.get("contacts"),
+                                                    "contact points"), links)
+        actuators = self.actuators(self.optional_list("actuators", top.get("actuators"),
+                                                      "actuators"), links, contacts)
+        return RobotModel(name=name, links=links, contacts=contacts, actuators=actuators,
+                          gravity=gravity, description=description)
+
+    def links(self, raw: Any) -> tuple[Link, ...]:
+        if not isinstance(raw, list) or not raw:
+            raise self.fail("links", raw, "a non-empty list of links, the floating base first")
+        names: set[str] = set()
+        entries: list[Mapping[str, Any]] = []
+        parents: list[str | None] = []
+        for i, item in enumerate(raw):
+            path = f"links[{i}]"
+            e = self.mapping(path, item, LINK_KEYS,
+                             ("name", "parent", "direction", "length", "mass"), "a link")
+            self.unique(f"{path}.name", self.name(f"{path}.name", e["name"]), names, "link")
+            parent = e["parent"]
+            if parent is not None:
+                parent = self.name(f"{path}.parent", parent)
+            entries.append(e)
+            parents.append(parent)
+        self.tree(names, [e["name"] for e in entries], parents)
+        base_name = entries[0]["name"]
+        if base_name in ("x", "y"):
+            raise self.fail("links[0].name", base_name,
+                            "a name other than x and y (the base link's name names its angle "
+                            "in q = [x, y, <base>, ...])")
+        joint_names: set[str] = set()
+        return tuple(self.link(i, e, parents[i], joint_names, base_name)
+                     for i, e in enumerate(entries))
+
+    def tree(self, names: set[str], order: list[str], parents: list[str | None]) -> None:
+        """One base, first; every parent exists; no cycle; parents before their children."""
+        bases = [n for n, p in zip(order, parents, strict=True) if p is None]
+        if len(bases) != 1:
+            raise self.fail("links", bases, "exactly one floating base link (parent: null)",
+                            problem=f"{len(bases)} links with parent null {show_value(bases)}")
+        if parents[0] is not None:
+            i = order.index(bases[0])
+            raise self.fail(f"links[{i}].parent", None,
+                            "the floating base (parent: null) as the first link",
+                            problem=f"the floating base {bases[0]!r} is link {i}, not link 0")
+        for i, parent in enumerate(parents):
+            if parent is not None and parent not in names:
+                raise self.fail(f"links[{i}].parent", parent,
+                                f"the name of a link in this model ({_names(names)})")
+        parent_of = dict(zip(order, parents, strict=True))
+        for i, start in enumerate(order):
+            seen = [start]
+            node = parent_of[start]
+            while node is not None:
+                if node in seen:
+                    cycle = " -> ".join([*seen[seen.index(node):], node])
+                    raise self.fail(f"links[{i}].parent", parent_of[start],
+                                    "parents that lead to the floating base (a tree)",
+                                    problem=f"a cycle of parents {cycle} "
+                                            f"(parent {parent_of[start]!r})")
+                seen.append(node)
+                node = parent_of[node]
+        position = {n: i for i, n in enumerate(order)}
+        for i, parent in enumerate(parents):
+            if parent is not None and position[parent] > i:
+                raise self.fail(f"links[{i}].parent", parent,
+                                f"a link listed before links[{i}] (parents come first)")
+
+    def link(self, i: int, e: Mapping[str, Any], parent: str | None, joint_names: set[str],
+             base_name: str) -> Link:
+        path = f"links[{i}]"
+        direction: Direction
+        raw_direction = e["direction"] if isinstance(e["direction"], str) else None
+        if raw_direction == "up":
+            direction = "up"
+        elif raw_direction == "down":
+            direction = "down"
+        else:
+            raise self.fail(f"{path}.direction", e["direction"],
+                            "'up' or 'down' (the link axis in its own frame)")
+        length = self.number(f"{path}.length", e["length"], "a number > 0 (m)", positive=True)
+        mass = self.number(f"{path}.mass", e["mass"], "a number > 0 (kg)", positive=True)
+        com = (self.pair(f"{path}.com", e["com"], "[along, across] in m")
+               if "com" in e else (length / 2.0, 0.0))
+        joint = None
+        if parent is None:
+            if e.get("joint") is not None:
+                raise self.fail(f"{path}.joint", e["joint"],
+                                "no joint (or null) on the floating base (parent: null)")
+        else:
+            joint = self.joint(f"{path}.joint", e.get("joint", MISSING), joint_names, base_name)
+        shape = self.shape(f"{path}.shape", e["shape"]) if "shape" in e else None
+        if "inertia" in e:
+            inertia = self.number(f"{path}.inertia", e["inertia"],
+                                  "a number > 0 (kg m^2, about the centre of mass)",
+                                  positive=True)
+            if shape is not None:
+                expected = shape_inertia(shape, mass, length)
+                if abs(inertia - expected) > INERTIA_RTOL * expected:
+                    raise self.fail(f"{path}.inertia", e["inertia"],
+                                    f"the inertia of the shape, {expected!r} kg m^2 (or give "
+                                    "only one of 'inertia' and 'shape')")
+        elif shape is not None:
+            inertia = shape_inertia(shape, mass, length)
+            if not (math.isfinite(inertia) and inertia > 0.0):
+                raise self.fail(f"{path}.shape", e["shape"],
+                                "a shape whose inertia (with this mass and length) is a finite "
+                                f"number > 0 kg m^2, not {inertia!r}")
+        else:
+            raise self.fail(f"{path}.inertia", MISSING,
+                            "an 'inertia' (kg m^2, > 0) or a 'shape' to compute it from")
+        return Link(name=e["name"], parent=parent, joint=joint, direction=direction,
+                    length=length, mass=mass, com=com, inertia=inertia, shape=shape)
+
+    def joint(self, path: str, raw: Any, joint_names: set[str], base_name: str) -> Joint:
+        if raw is MISSING:
+            raise self.fail(path, MISSING, "a joint {name, at, limits} on every link but the "
+                            "floating base")
+        j = self.mapping(path, raw, JOINT_KEYS, JOINT_KEYS, "a joint")
+        name = self.name(f"{path}.name", j["name"])
+        reserved = {"x", "y", base_name}
+        if name in reserved:
+            raise self.fail(f"{path}.name", name,
+                            f"a name other than {_names(reserved)} (they name the base "
+                            "coordinates of q)")
+        self.unique(f"{path}.name", name, joint_names, "joint")
+        at = self.pair(f"{path}.at", j["at"], "[along, across] in m on the parent link")
+        return Joint(name=name, at=at, limits=self.bounds(f"{path}.limits", j["limits"], "rad"))
+
+    def shape(self, path: str, raw: Any) -> Shape:
+        if not isinstance(raw, Mapping) or "type" not in raw:
+            raise self.fail(path, raw, "{type: ellipsoid, radius: R} or {type: rod}")
+        kind = raw["type"] if isinstance(raw["type"], str) else None
+        if kind == "ellipsoid":
+            s = self.mapping(path, raw, ("type", "radius"), ("type", "radius"), "an ellipsoid")
+            radius = self.number(f"{path}.radius", s["radius"], "a number > 0 (m)",
+                                 positive=True)
+            return Shape(type="ellipsoid", radius=radius)
+        if kind == "rod":
+            self.mapping(path, raw, ("type",), ("type",), "a rod")
+            return Shape(type="rod")
+        raise self.fail(f"{path}.type", raw["type"],
+                        f"a shape type, one of {', '.join(SHAPE_TYPES)}")
+
+    def contacts(self, raw: list[Any], links: tuple[Link, ...]) -> tuple[Contact, ...]:
+        by_name = {link.name: link for link in links}
+        names: set[str] = set()
+        out = []
+        for i, item in enumerate(raw):
+            path = f"contacts[{i}]"
+            c = self.mapping(path, item, CONTACT_KEYS, ("name", "link"), "a contact point")
+            name = self.name(f"{path}.name", c["name"])
+            self.unique(f"{path}.name", name, names, "contact")
+            link = c["link"]
+            if not isinstance(link, str) or link not in by_name:
+                raise self.fail(f"{path}.link", link,
+                                f"the name of a link in this model ({_names(list(by_name))})")
+            at = (self.pair(f"{path}.at", c["at"], "[along, across] in m on the link")
+                  if "at" in c else (by_name[link].length, 0.0))
+            out.append(Contact(name=name, link=link, at=at))
+        return tuple(out)
+
+    def actuators(self, raw: list[Any], links: tuple[Link, ...],
+                  contacts: tuple[Contact, ...]) -> tuple[Actuator, ...]:
+        joints = [link.joint.name for link in links if link.joint is not None]
+        contact_names = [c.name for c in contacts]
+        names: set[str] = set()
+        driven: dict[str, str] = {}
+        out = []
+        for i, item in enumerate(raw):
+            path = f"actuators[{i}]"
+            a = self.mapping(path, item, ACTUATOR_KEYS, ("name", "limits"), "an actuator")
+            name = self.name(f"{path}.name", a["name"])
+            self.unique(f"{path}.name", name, names, "actuator")
+            if ("joint" in a) == ("contact" in a):
+                raise self.fail(path, {k: a[k] for k in ("joint", "contact") if k in a},
+                                "exactly one of 'joint' (a joint torque) or 'contact' "
+                                "(a torque between the ground and the link at a contact "
+                                "point, e.g. an ankle)")
+            kind, known = ("joint", joints) if "joint" in a else ("contact", contact_names)
+            target = a[kind]
+            if not isinstance(target, str) or target not in known:
+                raise self.fail(f"{path}.{kind}", target,
+                                f"the name of a {kind} in this model ({_names(known)})")
+            key = f"{kind} {target}"
+            if key in driven:
+                raise self.fail(f"{path}.{kind}", target,
+                                f"a {kind} that no other actuator drives",
+                                problem=f"{kind} {target!r} is already driven by actuator "
+                                        f"{driven[key]!r}")
+            driven[key] = name
+            limits = self.bounds(f"{path}.limits", a["limits"], "N m")
+            out.append(Actuator(name=name, limits=limits, joint=target if kind == "joint"
+                                else None, contact=target if kind == "contact" else None))
+        return tuple(out)
