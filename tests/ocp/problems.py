@@ -17,10 +17,12 @@ from gaitopt.ocp import (
     BoundaryConstraint,
     ControlLinkage,
     Duration,
+    Guess,
     Linkage,
     Parameter,
     PathConstraint,
     Phase,
+    PhaseGuess,
     Problem,
 )
 
@@ -37,7 +39,7 @@ def energy(x: ca.SX, u: ca.SX, p: ca.SX, t: ca.SX) -> ca.SX:
     return u[0] ** 2
 
 
-# --- 1. minimum-energy rest-to-rest double integrator --------------------------------------
+# --- 1. minimum-energy rest-to-rest double integrator ---
 # min int_0^1 a^2 dt, s(0)=0, s(1)=1, v(0)=v(1)=0. Optimum: a = 6 - 12 t, s = 3t^2 - 2t^3,
 # v = 6t - 6t^2, J = 12. The states are cubic and the control linear: Hermite-Simpson is exact.
 def double_integrator(intervals: int = 10) -> Problem:
@@ -48,7 +50,7 @@ def double_integrator(intervals: int = 10) -> Problem:
     return Problem([ph])
 
 
-# --- 2. brachistochrone ----------------------------------------------------------------------
+# --- 2. brachistochrone ---
 # x' = v cos(theta), y' = v sin(theta) (y downward), v' = g sin(theta), from rest at the origin
 # to (xf, yf) in minimum time. Optimum: the cycloid x = R (phi - sin phi), y = R (1 - cos phi)
 # with phi = t sqrt(g / R); phi_f solves (phi - sin phi) / (1 - cos phi) = xf / yf and
@@ -66,6 +68,14 @@ def brachistochrone(xf: float = 1.0, yf: float = 0.6, intervals: int = 30) -> Pr
     return Problem([ph], mayer=lambda ends, p: ends["slide"].tf)
 
 
+def brachistochrone_guess(xf: float = 1.0, yf: float = 0.6) -> Guess:
+    """A straight-line slide guess (v = 0 everywhere is a degenerate start)."""
+    tau = np.array([0.0, 1.0])
+    return Guess(phases={"slide": PhaseGuess(
+        x={"x": xf * tau, "y": yf * tau, "v": [1.0, 3.0]}, u={"theta": 0.5}, tau=tau,
+        duration=0.6)})
+
+
 def cycloid(xf: float, yf: float) -> tuple[float, float, float]:
     """``(R, phi_f, T)`` of the brachistochrone to (xf, yf)."""
     phi_f = brentq(lambda ph: (ph - math.sin(ph)) / (1 - math.cos(ph)) - xf / yf, 1e-6,
@@ -74,7 +84,7 @@ def cycloid(xf: float, yf: float) -> tuple[float, float, float]:
     return R, phi_f, phi_f * math.sqrt(R / G)
 
 
-# --- 3. free final time -----------------------------------------------------------------------
+# --- 3. free final time ---
 # min T + int_0^T a^2 dt for the rest-to-rest double integrator over distance 1. For fixed T
 # the energy is 12 / T^3, so J(T) = T + 12 / T^3, minimal at T^4 = 36: T* = sqrt(6),
 # J* = 8 / sqrt(6).
@@ -87,7 +97,7 @@ def free_time(intervals: int = 10) -> Problem:
     return Problem([ph], mayer=lambda ends, p: ends["move"].tf - ends["move"].t0)
 
 
-# --- 4. two phases joined by a jump ------------------------------------------------------------
+# --- 4. two phases joined by a jump ---
 # Phase "before" (T = 1): double integrator from rest at s = 0 to a free (s_m, v_m).
 # Jump: s+ = s-, v+ = -v-/2 (a bounce that halves and reverses the velocity).
 # Phase "after" (T = 1): from (s_m, -v_m/2) to rest at s = 1. Cost: int a^2 over both phases.
@@ -110,7 +120,7 @@ def two_phase_jump(intervals: int = 6) -> Problem:
     return Problem([before, after], linkages=[bounce])
 
 
-# --- 5. periodic motion with a ratio cost --------------------------------------------------------
+# --- 5. periodic motion with a ratio cost ---
 # A cart with drag, s' = v, v' = a - v, moves periodically: two phases of durations
 # T_i = D / (2 vbar) (expressions of the parameters: distance D and mean speed vbar), states
 # and controls continuous between them and cyclic from the end of the second to the start of
@@ -144,7 +154,7 @@ def periodic_ratio(c: float = 4.0, intervals: int = 8) -> Problem:
         cost_denominator=lambda ends, p: p[0])
 
 
-# --- 6. a smooth problem for the order of accuracy -------------------------------------------------
+# --- 6. a smooth problem for the order of accuracy ---
 # min int_0^2 (x^2 + u^2) dt, x' = u, x(0) = 1, x(2) = 0. Euler-Lagrange: x'' = x, so
 # x(t) = sinh(2 - t) / sinh(2), u = -cosh(2 - t) / sinh(2).
 def smooth_lq(intervals: int = 8) -> Problem:
@@ -160,7 +170,7 @@ def smooth_lq_state(t: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.sinh(2.0 - t) / np.sinh(2.0)
 
 
-# --- 7. a boundary layer for error estimates and mesh refinement ----------------------------------
+# --- 7. a boundary layer for error estimates and mesh refinement ---
 # min int_0^1 (x^2 + eps^2 u^2) dt, x' = -x + u, x(0) = 1, x(1) free: x decays like
 # exp(-t sqrt(1 + 1/eps^2)), steep near t = 0, so the largest errors are in the first intervals.
 def boundary_layer(eps: float = 0.05, intervals: int = 10) -> Problem:
@@ -172,7 +182,7 @@ def boundary_layer(eps: float = 0.05, intervals: int = 10) -> Problem:
     return Problem([ph])
 
 
-# --- 8. an infeasible problem -------------------------------------------------------------------
+# --- 8. an infeasible problem ---
 # |a| <= 1 for one second from rest cannot reach s = 10 (at most 0.25 with v(1) = 0... and at
 # most 0.5 with v free).
 def infeasible() -> Problem:
@@ -183,7 +193,7 @@ def infeasible() -> Problem:
     return Problem([ph])
 
 
-# --- 9. an active path constraint -----------------------------------------------------------------
+# --- 9. an active path constraint ---
 # The rest-to-rest double integrator peaks at v = 1.5; capping v <= 1.2 makes the cap active.
 def with_path_constraint(intervals: int = 20, limit: float = 1.2) -> Problem:
     """Rest-to-rest double integrator with the path constraint v <= limit (active)."""

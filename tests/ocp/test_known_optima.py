@@ -34,7 +34,7 @@ def test_double_integrator_min_energy_is_exact() -> None:
 
 def test_brachistochrone_time_and_path_match_the_cycloid() -> None:
     xf, yf = 1.0, 0.6
-    res = transcribe(P.brachistochrone(xf, yf, intervals=30)).solve()
+    res = transcribe(P.brachistochrone(xf, yf, intervals=30)).solve(P.brachistochrone_guess(xf, yf))
     assert res.success, res.summary()
     R, _, T = P.cycloid(xf, yf)
     assert res.objective == pytest.approx(T, rel=1e-6)
