@@ -54,3 +54,26 @@ def test_nlp_size_and_constraint_blocks() -> None:
     assert cons.size == 22 and len(cons.row_names()) == 22
     path = transcribe(P.with_path_constraint(10)).nlp_size()
     assert path.inequality_constraints == 11 + 10  # knots + midpoints
+
+
+def test_scales_from_bounds_and_given_scales_leave_the_answer_unchanged() -> None:
+    from dataclasses import replace
+
+    from gaitopt.ocp import Problem
+
+    base = P.free_time(8)
+    ph = replace(base.phases[0], state_bounds={"s": (-2.0, 1000.0)}, control_scales={"a": 20.0})
+    prob = Problem([ph], mayer=base.mayer)
+    tr = transcribe(prob)
+    pl = tr.layout.phase(0)
+    d = tr.nlp.d_w
+    np.testing.assert_allclose(d[pl.across_knots("state", "s")], 1000.0)  # largest bound
+    np.testing.assert_allclose(d[pl.across_knots("state", "v")], 1.0)  # unbounded
+    np.testing.assert_allclose(d[pl.across_knots("control", "a")], 20.0)  # given
+    assert d[pl.duration_index] == 10.0  # duration bounds (0.5, 10)
+    # Defects take their state's scale.
+    rows = tr.nlp.constraints.block("move/defects").rows
+    np.testing.assert_allclose(tr.nlp.d_g[rows].reshape(8, 2), [[1000.0, 1.0]] * 8)
+    scaled, plain = tr.solve(), transcribe(prob, scaling=False).solve()
+    assert scaled.objective == pytest.approx(plain.objective, rel=1e-8)
+    assert scaled.objective == pytest.approx(8.0 / 6.0**0.5, rel=1e-8)
