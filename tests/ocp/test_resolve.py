@@ -1,0 +1,104 @@
+"""Re-solving one transcription with other bounds and guesses, warm starts, compiled modes."""
+
+from __future__ import annotations
+
+import numpy as np
+import problems as P
+import pytest
+
+from gaitopt.ocp import Guess, PhaseGuess, transcribe
+
+
+def test_resolve_with_changed_parameter_bounds_does_not_rebuild() -> None:
+    tr = transcribe(P.periodic_ratio(c=4.0))
+    assert tr.builds == {"nlp": 1, "solver": 1}
+    free = tr.solve()
+    assert free.objective == pytest.approx(4.0, rel=1e-8)
+    # J(vbar) = vbar + c / vbar for a fixed mean speed (see problems.periodic_ratio).
+    for vbar in (1.0, 3.0, 0.5):
+        fixed = tr.solve(free, parameters={"vbar": vbar})
+        assert fixed.success, fixed.summary()
+        assert fixed.parameters["vbar"] == vbar
+        assert fixed.objective == pytest.approx(vbar + 4.0 / vbar, rel=1e-8)
+    # The same through a Bounds object.
+    b = tr.bounds().with_parameter("vbar", 1.0, 1.5)
+    ranged = tr.solve(bounds=b)
+    assert ranged.parameters["vbar"] == pytest.approx(1.5, rel=1e-6)
+    assert tr.builds == {"nlp": 1, "solver": 1}
+    # Statement bounds are untouched by the overrides.
+    assert tr.bounds().ubw[tr.layout.parameter("vbar")] == 10.0
+
+
+def test_state_and_constraint_bound_overrides() -> None:
+    tr = transcribe(P.double_integrator(6))
+    b = tr.bounds().with_state("move", "s", 2.0, knot=-1)
+    res = tr.solve(bounds=b)
+    assert res.objective == pytest.approx(48.0, rel=1e-9)  # J = 12 d^2 for distance d
+    tr2 = transcribe(P.periodic_ratio(c=4.0))
+    res2 = tr2.solve(bounds=tr2.bounds().with_parameter("D", 2.0).with_parameter("vbar", 2.0))
+    assert res2.objective == pytest.approx(4.0, rel=1e-8)
+    assert tr2.builds["nlp"] == 1
+
+
+def test_warm_start_from_a_result_on_another_mesh() -> None:
+    coarse = transcribe(P.brachistochrone(intervals=10)).solve(P.brachistochrone_guess())
+    tr = transcribe(P.brachistochrone(intervals=25))
+    cold = tr.solve(P.brachistochrone_guess())
+    warm = tr.solve(coarse)
+    assert cold.success and warm.success
+    assert warm.objective == pytest.approx(cold.objective, rel=1e-8)
+    assert warm.iterations < cold.iterations
+    # The initial guess is the coarse result's interpolant at the new knots.
+    w0 = tr.initial_guess(coarse)
+    pl = tr.layout.phase("slide")
+    t_new = coarse.phase(0).t0 + coarse.phase(0).duration * tr.mesh[0]
+    np.testing.assert_allclose(w0[pl.state_indices()], coarse.phase(0).x_at(t_new))
+    assert w0[pl.duration_index] == pytest.approx(coarse.phase(0).duration)
+
+
+def test_warm_start_multipliers_on_the_same_mesh() -> None:
+    tr = transcribe(P.brachistochrone(intervals=20))
+    res = tr.solve(P.brachistochrone_guess())
+    again = tr.solve(res, warm_start_multipliers=True)
+    assert again.success and again.iterations <= 2
+    assert again.objective == pytest.approx(res.objective, rel=1e-9)
+    assert tr.builds["nlp"] == 1
+
+
+def test_user_guess_on_normalised_times() -> None:
+    tr = transcribe(P.brachistochrone(intervals=15))
+    tau = np.linspace(0, 1, 5)
+    guess = Guess(phases={"slide": PhaseGuess(x={"x": tau, "y": 0.6 * tau, "v": 2.0},
+                                              u={"theta": 0.5}, tau=tau, duration=0.6)})
+    w0 = tr.initial_guess(guess)
+    pl = tr.layout.phase("slide")
+    np.testing.assert_allclose(w0[pl.across_knots("state", "y")], 0.6 * tr.mesh[0])
+    np.testing.assert_allclose(w0[pl.across_knots("state", "v")], 2.0)
+    assert w0[pl.duration_index] == 0.6
+    res = tr.solve(guess)
+    R, _, T = P.cycloid(1.0, 0.6)
+    assert res.objective == pytest.approx(T, rel=1e-5)
+
+
+@pytest.mark.parametrize("mode", ["codegen", "jit"])
+def test_compiled_modes_give_the_same_solution(mode: str, tmp_path: object,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    plain = transcribe(P.periodic_ratio(intervals=3)).solve(parameters={"vbar": 1.5})
+    tr = transcribe(P.periodic_ratio(intervals=3), compiled=mode)
+    res = tr.solve(parameters={"vbar": 1.5})
+    assert res.success, res.summary()
+    assert res.objective == pytest.approx(plain.objective, rel=1e-10)
+    assert res.evaluations["nlp_hess_l"] > 0
+    if mode == "codegen":
+        # A second build of the same NLP loads the cached library.
+        libs = list(tmp_path.glob("ocp_*.so"))  # type: ignore[attr-defined]
+        assert len(libs) == 1
+        tr2 = transcribe(P.periodic_ratio(intervals=3), compiled=mode)
+        assert list(tmp_path.glob("ocp_*.so")) == libs  # type: ignore[attr-defined]
+        assert tr2.solve(parameters={"vbar": 1.5}).objective == pytest.approx(res.objective)
+
+
+def test_mx_evaluation_without_expand() -> None:
+    res = transcribe(P.two_phase_jump(4), expand=False).solve()
+    assert res.objective == pytest.approx(60.0 / 13.0, rel=1e-9)
