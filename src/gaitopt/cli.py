@@ -181,6 +181,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+# Subcommands defined in their own modules register themselves on ``cli`` when imported.
+from gaitopt import cli_gait  # noqa: E402,F401,I001  (imported for its side effect)
+
 __all__ = ["USER_ERRORS", "UserError", "cli", "main", "make_console", "model_tables"]
 
 if __name__ == "__main__":  # pragma: no cover

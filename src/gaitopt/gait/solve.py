@@ -217,7 +217,8 @@ class _Run:
 
 
 def solve_walking(model: RobotModel, options: GaitOptions, *,
-                  warm_start: Result | None = None, progress: ProgressFn | None = None,
+                  warm_start: Guess | Result | None = None,
+                  progress: ProgressFn | None = None,
                   compiled: str | None = None) -> WalkingSolution:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed."""

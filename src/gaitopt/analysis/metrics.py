@@ -1,0 +1,64 @@
+"""Figures of merit of a gait, read off its record: what a user checks first.
+
+All quantities come from the gait file alone (knots, events and dense samples), so they are
+the same whether the gait was just solved or loaded from disk.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gaitopt.gait.gait_file import Gait
+
+#: Normal forces/impulses below this (N, N s) are treated as zero in friction ratios.
+NORMAL_FLOOR = 1e-6
+
+
+@dataclass(frozen=True)
+class GaitMetrics:
+    """Summary numbers of one gait.
+
+    Attributes:
+        peak_torques: by actuator, the largest |u| over the knots and samples (N m).
+        torque_bounds: by actuator, the larger |bound| (N m).
+        min_normal_force: smallest normal contact force over all knots of all phases (N).
+        min_normal_impulse: smallest normal impulse over the events' contacts (N s).
+        swing_clearance: largest height of the swing tip during single support (m).
+        swing_min_height: smallest height of the swing tip over the dense samples of single
+            support (m); negative values are penetration between collocation points.
+        friction_required: largest |tangential| / normal over forces and impulses.
+    """
+
+    peak_torques: dict[str, float]
+    torque_bounds: dict[str, float]
+    min_normal_force: float
+    min_normal_impulse: float
+    swing_clearance: float
+    swing_min_height: float
+    friction_required: float
+
+
+def gait_metrics(gait: Gait) -> GaitMetrics:
+    """The :class:`GaitMetrics` of ``gait``."""
+    model = gait.model
+    u_all = np.vstack([ph.u for ph in gait.phases] + [gait.samples.u])
+    peaks = {a.name: float(np.max(np.abs(u_all[:, i]))) for i, a in enumerate(model.actuators)}
+    bounds = {a.name: float(max(abs(a.limits[0]), abs(a.limits[1]))) for a in model.actuators}
+    forces = [f for ph in gait.phases for f in ph.contact_forces.values()]
+    min_force = float(min(np.min(f[:, 1]) for f in forces))
+    impulses = [i for e in gait.events for c, i in e.impulses.items()
+                if not (e.name == "liftoff" and c == e.leg)]
+    min_impulse = float(min((i[1] for i in impulses), default=0.0))
+    ratios = [np.abs(f[:, 0]) / np.maximum(f[:, 1], NORMAL_FLOOR) for f in forces]
+    ratios += [np.array([abs(i[0]) / max(i[1], NORMAL_FLOOR)]) for i in impulses
+               if abs(i[0]) > NORMAL_FLOOR or i[1] > NORMAL_FLOOR]
+    friction = float(max((np.max(r) for r in ratios), default=0.0))
+    t1 = gait.parameters["single_support_time"]
+    t0 = gait.samples.t[0]
+    swing = gait.samples.points["tip_2"][gait.samples.t <= t0 + t1 + 1e-12, 1]
+    return GaitMetrics(peak_torques=peaks, torque_bounds=bounds, min_normal_force=min_force,
+                       min_normal_impulse=min_impulse,
+                       swing_clearance=float(np.max(swing)),
+                       swing_min_height=float(np.min(swing)), friction_required=friction)

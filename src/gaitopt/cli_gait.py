@@ -1,0 +1,168 @@
+"""``gaitopt solve`` and ``gaitopt verify``: one gait, solved or checked."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+from rich.table import Table
+
+from gaitopt.cli import USER_ERRORS, UserError, cli, make_console
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.solve import StageReport
+from gaitopt.robot.biped import BipedStructureError
+from gaitopt.units import format_speed, parse_speed
+
+
+def _speed(text: str) -> float | None:
+    if text.strip().lower() == "free":
+        return None
+    try:
+        return parse_speed(text)
+    except ValueError as exc:
+        raise UserError(f"--speed: {exc}") from None
+
+
+def _step(text: str) -> float | None:
+    if text.strip().lower() == "free":
+        return None
+    try:
+        return float(text.removesuffix("m"))
+    except ValueError:
+        raise UserError(f"--step-length: {text!r} is not a length in m or 'free'") from None
+
+
+def _knots(text: str) -> tuple[int, int]:
+    parts = text.split(",")
+    try:
+        values = tuple(int(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) == 1:
+        values = (values[0], 5)
+    if len(values) != 2:
+        raise UserError(f"--knots: {text!r} must be two integers 'single,double', e.g. 8,5")
+    return (values[0], values[1])
+
+
+@cli.command("solve")
+@click.option("--model", "model_name", default="five-link", show_default=True,
+              help="Built-in model name or model file.")
+@click.option("--speed", default="12m/min", show_default=True,
+              help="Average speed with a unit (12m/min, 0.2m/s) or 'free' (the optimal walk).")
+@click.option("--step-length", default="free", show_default=True,
+              help="Step length in m, or 'free'.")
+@click.option("--ankle/--no-ankle", default=True, show_default=True,
+              help="Ankle torques at the tips on the ground.")
+@click.option("--impulse/--no-impulse", default=True, show_default=True,
+              help="Liftoff impulse along the lifting leg.")
+@click.option("--single-support", type=float, default=0.85, show_default=True,
+              help="Single-support fraction of the step time; 1 = no double support.")
+@click.option("--knots", default="8,5", show_default=True,
+              help="Grid points per phase: single support, double support.")
+@click.option("--transcription", type=click.Choice(["hermite-simpson", "trapezoidal"]),
+              default="hermite-simpson", show_default=True)
+@click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,
+              help="Controls periodic as well as states (the paper), or states only.")
+@click.option("--friction", type=float, default=None,
+              help="Friction coefficient of an optional friction-cone constraint.")
+@click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
+def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, impulse: bool,
+                  single_support: float, knots: str, transcription: str,
+                  periodic_controls: bool, friction: float | None, compiled: bool,
+                  output: Path) -> None:
+    """Solve the minimum-energy walking problem and write the gait file."""
+    from gaitopt.analysis.metrics import gait_metrics
+    from gaitopt.gait.api import as_model, solve_gait
+
+    console = make_console()
+    model = as_model(model_name)
+    options = GaitOptions(
+        speed=_speed(speed), step_length=_step(step_length), ankle=ankle, impulse=impulse,
+        single_support_fraction=single_support, knots=_knots(knots),
+        transcription=transcription,  # type: ignore[arg-type]
+        periodic_controls=periodic_controls, friction=friction)
+    console.print(f"solving {options.variant} on model {model.name}: speed "
+                  f"{'free' if options.speed is None else format_speed(options.speed)}, step "
+                  f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
+                  f", {options.knots[0]}+{options.knots[1]} knots")
+
+    def progress(stage: StageReport) -> None:
+        console.print("  stage " + stage.line())
+
+    try:
+        gait = solve_gait(model, options, progress=progress,
+                          compiled="codegen" if compiled else None)
+    except (GaitOptionsError, BipedStructureError) as exc:
+        raise UserError(str(exc)) from None
+    if not gait.success:
+        stages = gait.solver.get("stages", [])
+        failed = [s for s in stages if not s["success"]]
+        where = failed[-1]["name"] if failed else "solve"
+        console.print(f"FAILED at stage '{where}': {gait.status}; largest constraint "
+                      f"violation {gait.solver['max_violation']:.3g}. No gait file written.")
+        sys.exit(1)
+    metrics = gait_metrics(gait)
+    p = gait.parameters
+    table = Table(title="optimal gait", show_header=False)
+    table.add_column("quantity")
+    table.add_column("value")
+    table.add_row("speed", format_speed(p["speed"]))
+    table.add_row("step length", f"{p['step_length']:.4f} m")
+    table.add_row("step time", f"{p['step_time']:.4f} s (single support "
+                  f"{p['single_support_time']:.4f} s)")
+    table.add_row("liftoff impulse", f"{p['liftoff_impulse']:.4f} N s")
+    table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
+    for name, peak in metrics.peak_torques.items():
+        bound = metrics.torque_bounds[name]
+        table.add_row(f"peak torque {name}", f"{peak:8.2f} / {bound:g} N m "
+                      f"({100 * peak / bound:5.1f} %)")
+    table.add_row("smallest normal force", f"{metrics.min_normal_force:.3f} N")
+    table.add_row("smallest normal impulse", f"{metrics.min_normal_impulse:.4f} N s")
+    table.add_row("swing clearance", f"{metrics.swing_clearance * 1000:.1f} mm (lowest "
+                  f"{metrics.swing_min_height * 1000:.2f} mm)")
+    table.add_row("friction needed", f"{metrics.friction_required:.3f} (|tangential|/normal)")
+    s = gait.solver
+    table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
+                  f"equality, {s['inequality_constraints']} inequality constraints")
+    table.add_row("iterations (last stage)", str(s["iterations"]))
+    table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
+    console.print(table)
+    gait.save(output)
+    console.print(f"wrote {output}")
+
+
+@cli.command("verify")
+@click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--tolerance", type=float, default=None,
+              help="Scale every check's tolerance by this factor (default 1).")
+def verify_command(file: Path, tolerance: float | None) -> None:
+    """Check a saved gait independently of the solver (exit status 1 if a check fails)."""
+    from gaitopt.analysis.verify import verify_gait
+
+    console = make_console()
+    try:
+        gait = Gait.load(file)
+    except GaitFileError as exc:
+        raise UserError(str(exc)) from None
+    report = verify_gait(gait, tolerance_scale=tolerance or 1.0)
+    table = Table(title=f"verify {file}")
+    for col in ("check", "value", "limit", "result"):
+        table.add_column(col)
+    for c in report.checks:
+        table.add_row(c.name, f"{c.value:.3g}", c.limit_text, "ok" if c.passed else "FAIL")
+    console.print(table)
+    if report.passed:
+        console.print(f"all {len(report.checks)} checks passed")
+    else:
+        failed = [c.name for c in report.checks if not c.passed]
+        console.print(f"{len(failed)} check(s) FAILED: {', '.join(failed)}")
+        sys.exit(1)
+
+
+USER_ERRORS_HERE = (GaitOptionsError, BipedStructureError, GaitFileError)
+__all__ = ["USER_ERRORS", "USER_ERRORS_HERE", "solve_command", "verify_command"]

@@ -1,0 +1,75 @@
+"""The Python entry point: ``solve_gait(model, options) -> Gait``, usable from a notebook.
+
+>>> from gaitopt import GaitOptions, solve_gait
+>>> gait = solve_gait("five-link", GaitOptions(speed=0.2))   # doctest: +SKIP
+>>> gait.save("walk.gait.json")                              # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
+from gaitopt.ocp import Guess, PhaseGuess
+from gaitopt.robot import RobotModel, load_model
+
+
+def as_model(model: RobotModel | str | os.PathLike[str]) -> RobotModel:
+    """A model object from a model, a built-in name or a model file path."""
+    return model if isinstance(model, RobotModel) else load_model(model)
+
+
+def guess_from_gait(gait: Gait) -> Guess:
+    """An engine guess from a saved gait: its reduced states and phase controls at its knots
+    (normalised times), and its parameters."""
+    model = gait.model
+    phases = {}
+    for ph in gait.phases:
+        from gaitopt.gait import walking
+
+        controls = walking.control_names(model, ph.name, ankle=bool(gait.options.get("ankle")))
+        cols = [model.actuator_index(c) for c in controls]
+        tau = (ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0])
+        phases[ph.name] = PhaseGuess(x=np.asarray(ph.x), u=np.asarray(ph.u)[:, cols], tau=tau)
+    p = gait.parameters
+    return Guess(phases=phases, parameters={"step_length": p["step_length"],
+                                            "speed": p["speed"],
+                                            "impulse": p["liftoff_impulse"]})
+
+
+def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
+                        options: GaitOptions | None = None, *,
+                        warm_start: Gait | None = None, progress: ProgressFn | None = None,
+                        compiled: str | None = None) -> WalkingSolution:
+    """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`."""
+    robot = as_model(model)
+    opts = options or GaitOptions()
+    guess = None
+    if warm_start is not None and warm_start.options.get("ankle") == opts.ankle and \
+            bool(warm_start.options.get("single_support_fraction") ==
+                 opts.single_support_fraction):
+        guess = guess_from_gait(warm_start)
+    return solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+
+
+def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions | None = None,
+               *, warm_start: Gait | None = None, progress: ProgressFn | None = None,
+               compiled: str | None = None) -> Gait:
+    """Solve the minimum-energy walking problem and return the gait (converged or not:
+    ``gait.success`` says; :meth:`Gait.save` refuses to write a failed gait).
+
+    Args:
+        model: a :class:`RobotModel`, a built-in model name or a model file.
+        options: the variant, targets and bounds (default: the paper's problem at 12 m/min).
+        warm_start: a neighbouring gait to start from (the cold path is the fallback).
+        progress: called with a :class:`~gaitopt.gait.solve.StageReport` after every stage.
+        compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
+    """
+    solution = solve_gait_solution(model, options, warm_start=warm_start, progress=progress,
+                                   compiled=compiled)
+    return gait_from_solution(solution)

@@ -1,0 +1,171 @@
+"""Turning a solved walking problem into a :class:`~gaitopt.gait.gait_file.Gait` record.
+
+Everything in the record is evaluated from the reduced solution with the same physics the
+solver used (:mod:`gaitopt.gait.walking`), compiled once per model into small CasADi functions:
+the full ``q, qd, qdd`` and the contact forces at every knot, the two events with their impulses
+and velocities, and dense samples of the step on a uniform time grid with the transcription's
+own interpolation (cubic Hermite states, linear controls).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from gaitopt.dynamics.backend import as_scalars
+from gaitopt.dynamics.kinematics import point_position
+from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.gait import walking
+from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.solve import WalkingSolution
+from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.robot.model import RobotModel
+
+Array = NDArray[np.float64]
+
+COST_FORMULA = ("energy per metre (paper eq. 5): (integral over the step of u'u dt + "
+                "liftoff_impulse^2) / step_length, in N^2 m s (torques in N m, impulse in N s)")
+#: Samples per second of step time in the dense grid (at least 101 samples per step).
+SAMPLE_RATE = 200.0
+
+
+@functools.lru_cache(maxsize=32)
+def _phase_functions(model: RobotModel, phase: str, controls: tuple[str, ...]) -> ca.Function:
+    """``(x, u, L) -> (q, qd, qdd, forces, u_full)`` for a phase, as one SX function."""
+    n = len(walking.state_names(model, phase))
+    x = ca.SX.sym("x", n)
+    u = ca.SX.sym("u", len(controls))
+    step = ca.SX.sym("L")
+    if phase == SINGLE:
+        point = walking.single_support_point(model, x, u, controls)
+    else:
+        point = walking.double_support_point(model, x, u, controls, step)
+    sol = point.solution
+    u_full = ca.vertcat(*walking.full_controls(model, controls, u))
+    return ca.Function(f"record_{phase}", [x, u, step],
+                       [sol.q, sol.qd, sol.qdd, sol.forces, u_full, point.xdot],
+                       ["x", "u", "L"], ["q", "qd", "qdd", "forces", "u_full", "xdot"])
+
+
+@functools.lru_cache(maxsize=8)
+def _points_function(model: RobotModel) -> ca.Function:
+    """``q -> (hip, knee_1, knee_2, tip_1, tip_2, torso_top)`` world positions (2, 6)."""
+    legs = checked_biped(model).legs
+    q = ca.SX.sym("q", model.nq)
+    cols = [q[0:2]]
+    for leg in legs:
+        cols.append(point_position(model, q, leg.shank, (0.0, 0.0)))
+    for leg in legs:
+        c = model.contact(leg.contact)
+        cols.append(point_position(model, q, c.link, model.link(c.link).local_point(*c.at)))
+    torso = model.base
+    cols.append(point_position(model, q, torso.name, torso.local_point(torso.length)))
+    return ca.Function("record_points", [q], [ca.horzcat(*cols)])
+
+
+POINTS = ("hip", "knee_1", "knee_2", "tip_1", "tip_2", "torso_top")
+
+
+def _evaluate(fn: ca.Function, x: Array, u: Array, step: float) -> list[Array]:
+    out = fn.map(x.shape[0])(x.T, u.T, step)
+    return [np.asarray(o, dtype=float).T for o in out]
+
+
+def gait_from_solution(solution: WalkingSolution) -> Gait:
+    """The gait record of a walking solution (converged or not: ``solver.success`` says)."""
+    model, options, res = solution.model, solution.options, solution.result
+    legs = checked_biped(model).legs
+    step, speed, impulse = (res.parameters[k] for k in ("step_length", "speed", "impulse"))
+    # IPOPT may end a hair outside a bound (its bound_relax_factor): the impulse is >= 0.
+    impulse = max(impulse, 0.0)
+    phases: list[GaitPhase] = []
+    traj = {ph.name: ph for ph in res.phases}
+    for name in traj:
+        ph = traj[name]
+        contacts = (legs[0].contact,) if name == SINGLE else (legs[0].contact, legs[1].contact)
+        fn = _phase_functions(model, name, tuple(ph.controls))
+        q, qd, qdd, forces, u_full, _ = _evaluate(fn, ph.x, ph.u, step)
+        phases.append(GaitPhase(
+            name=name, contacts=contacts, t=ph.t, q=q, qd=qd, qdd=qdd, u=u_full,
+            contact_forces={c: forces[:, 2 * i:2 * i + 2] for i, c in enumerate(contacts)},
+            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot))
+    events = _events(model, options, traj, step, impulse)
+    samples = _samples(model, options, res, step)
+    t1 = traj[SINGLE].duration
+    solver = {
+        "status": res.status, "success": bool(res.success), "iterations": int(res.iterations),
+        "wall_time_s": float(solution.wall_time_s),
+        "variables": res.nlp_size.variables,
+        "equality_constraints": res.nlp_size.equality_constraints,
+        "inequality_constraints": res.nlp_size.inequality_constraints,
+        "evaluations": {k: int(v) for k, v in res.evaluations.items()},
+        "max_violation": float(res.constraint_violation),
+        "time_in_evaluations_s": float(res.times.get("evaluations", 0.0)),
+        "stages": [{"name": s.name, "knots": list(s.knots), "status": s.status,
+                    "success": s.success, "iterations": s.iterations,
+                    "objective": s.objective, "wall_time_s": s.wall_time_s}
+                   for s in solution.stages],
+    }
+    return Gait(
+        model_data=model.to_dict(), options=options.to_dict(),
+        parameters={"step_length": step, "speed": speed, "step_time": step / speed,
+                    "single_support_time": t1, "liftoff_impulse": impulse},
+        cost={"value": float(res.objective), "formula": COST_FORMULA},
+        solver=solver, phases=tuple(phases), events=events, samples=samples)
+
+
+def _vec(value: Any, n: int) -> Array:
+    return np.array([float(v) for v in as_scalars(value, n, "value")])
+
+
+def _events(model: RobotModel, options: GaitOptions, traj: dict[str, Any], step: float,
+            impulse: float) -> tuple[GaitEvent, ...]:
+    legs = checked_biped(model).legs
+    ss = traj[SINGLE]
+    strike = walking.heel_strike(model, ss.x[-1], step, double_support=options.double_support)
+    events = [GaitEvent(
+        name="heel_strike", t=ss.tf, leg=legs[1].contact,
+        impulses={c: _vec(v, 2) for c, v in strike.impulses.items()},
+        qd_before=_vec(strike.qd_before, model.nq), qd_after=_vec(strike.qd_after, model.nq))]
+    if options.double_support:
+        ds = traj[DOUBLE]
+        lift = walking.liftoff(model, ds.x[-1], step, impulse)
+        events.append(GaitEvent(
+            name="liftoff", t=ds.tf, leg=legs[0].contact,
+            impulses={c: _vec(v, 2) for c, v in lift.impulses.items()},
+            qd_before=_vec(lift.qd_before, model.nq), qd_after=_vec(lift.qd_after, model.nq)))
+    else:
+        after = _vec(strike.qd_after, model.nq)
+        events.append(GaitEvent(name="liftoff", t=ss.tf, leg=legs[0].contact,
+                                impulses={legs[0].contact: np.zeros(2)},
+                                qd_before=after, qd_after=after))
+    return tuple(events)
+
+
+def _samples(model: RobotModel, options: GaitOptions, res: Any, step: float) -> GaitSamples:
+    total = sum(ph.duration for ph in res.phases)
+    t0 = res.phases[0].t0
+    count = max(101, int(np.ceil(total * SAMPLE_RATE)) + 1)
+    t = t0 + np.linspace(0.0, total, count)
+    q = np.zeros((count, model.nq))
+    qd = np.zeros((count, model.nq))
+    u = np.zeros((count, model.nu))
+    t_split = res.phases[0].tf
+    for i, ph in enumerate(res.phases):
+        mask = t <= t_split if i == 0 else t > t_split
+        if not mask.any():
+            continue
+        x = ph.x_at(t[mask])
+        uc = ph.u_at(t[mask])
+        fn = _phase_functions(model, ph.name, tuple(ph.controls))
+        q_s, qd_s, _, _, u_s, _ = _evaluate(fn, np.atleast_2d(x), np.atleast_2d(uc), step)
+        q[mask], qd[mask], u[mask] = q_s, qd_s, u_s
+    pts = np.asarray(_points_function(model).map(count)(q.T), dtype=float)  # (2, 6 * count)
+    pts = pts.T.reshape(count, len(POINTS), 2)  # sample k, point j at row 6 k + j
+    points = {name: pts[:, j, :] for j, name in enumerate(POINTS)}
+    return GaitSamples(t=t, q=q, qd=qd, u=u, points=points)
