@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import assert_close, random_state, well_conditioned
+from dynamics_helpers import assert_close, random_state, well_conditioned
 from pinocchio_model import build
 
 from gaitopt.dynamics import (

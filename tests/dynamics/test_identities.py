@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from conftest import assert_close, random_state
+from dynamics_helpers import assert_close, random_state
 
 from gaitopt.dynamics import (
     aba,

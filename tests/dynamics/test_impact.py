@@ -6,7 +6,7 @@ import itertools
 
 import numpy as np
 import pytest
-from conftest import assert_close, random_state, well_conditioned
+from dynamics_helpers import assert_close, random_state, well_conditioned
 
 from gaitopt.dynamics import (
     angular_momentum,

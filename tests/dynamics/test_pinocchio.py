@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from conftest import assert_close, random_state
+from dynamics_helpers import assert_close, random_state
 from pinocchio_model import build
 
 from gaitopt.dynamics import (

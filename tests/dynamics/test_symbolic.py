@@ -9,7 +9,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 import pytest
-from conftest import assert_close, random_state
+from dynamics_helpers import assert_close, random_state
 
 import gaitopt.dynamics as dyn
 from gaitopt.dynamics import functions

@@ -50,12 +50,14 @@ from gaitopt.robot.model import RobotModel
 @dataclass(frozen=True)
 class ArticulatedInertias:
     """Configuration-only part of the ABA: per body ``U_k = IA_k S_k`` (3-vector), ``D_k``
-    (scalar) and the projected inertia ``Ia_k = IA_k - U_k U_k^T / D_k`` (3x3)."""
+    (scalar), ``1 / D_k`` and the projected inertia ``Ia_k = IA_k - U_k U_k^T / D_k``
+    (3x3, symmetric)."""
 
     tree: tuple[Body, ...]
     x: tuple[Transform, ...]
     u: tuple[Vec3, ...]
     d: tuple[Scalar, ...]
+    d_inv: tuple[Scalar, ...]
     projected: tuple[Mat3, ...]
 
 
@@ -68,17 +70,21 @@ def articulated_inertias(model: RobotModel, q: Scalars) -> ArticulatedInertias:
     u: list[Vec3] = [ZERO3] * n
     d: list[Scalar] = [0.0] * n
     projected: list[Mat3] = [ZERO_MAT3] * n
+    d_inv: list[Scalar] = [0.0] * n
     for k in reversed(range(n)):
         body = tree[k]
         col = ia[k][body.axis]  # IA is symmetric: column axis = row axis
         u[k] = col
         d[k] = col[body.axis]
+        d_inv[k] = 1.0 / d[k]
         if body.parent >= 0:
-            rows = [tuple(ia[k][i][j] - col[i] * col[j] / d[k] for j in range(3))
-                    for i in range(3)]
-            projected[k] = (rows[0], rows[1], rows[2])
+            w = scale3(d_inv[k], col)
+            upper = {(i, j): ia[k][i][j] - w[i] * col[j] for i in range(3) for j in range(i, 3)}
+            projected[k] = tuple(tuple(upper[min(i, j), max(i, j)] for j in range(3))
+                                 for i in range(3))  # type: ignore[assignment]
             ia[body.parent] = add_mat3(ia[body.parent], mat3_to_parent(x[k], projected[k]))
-    return ArticulatedInertias(tree, tuple(x), tuple(u), tuple(d), tuple(projected))
+    return ArticulatedInertias(tree, tuple(x), tuple(u), tuple(d), tuple(d_inv),
+                               tuple(projected))
 
 
 def aba_sweep(art: ArticulatedInertias, tau: Sequence[Scalar],
@@ -98,7 +104,7 @@ def aba_sweep(art: ArticulatedInertias, tau: Sequence[Scalar],
         body = tree[k]
         u_k[k] = tau[k] - p_a[k][body.axis]
         if body.parent >= 0:
-            pa = add3(p_a[k], scale3(u_k[k] / art.d[k], art.u[k]))
+            pa = add3(p_a[k], scale3(u_k[k] * art.d_inv[k], art.u[k]))
             if c is not None:
                 pa = add3(pa, mat3_times(art.projected[k], c[k]))
             p_a[body.parent] = add3(p_a[body.parent], force_to_parent(art.x[k], pa))
@@ -108,7 +114,7 @@ def aba_sweep(art: ArticulatedInertias, tau: Sequence[Scalar],
         a_prime = motion_to_child(art.x[k], a[body.parent] if body.parent >= 0 else a_root)
         if c is not None:
             a_prime = add3(a_prime, c[k])
-        qdd[k] = (u_k[k] - dot3(art.u[k], a_prime)) / art.d[k]
+        qdd[k] = (u_k[k] - dot3(art.u[k], a_prime)) * art.d_inv[k]
         a_list = list(a_prime)
         a_list[body.axis] = a_list[body.axis] + qdd[k]
         a[k] = (a_list[0], a_list[1], a_list[2])
