@@ -15,7 +15,8 @@ from gaitopt.robot import load_model
 
 @pytest.fixture
 def runner() -> CliRunner:
-    return CliRunner()
+    # pytest-xdist workers set COLUMNS=80; unset it to see what a plain pipe gets.
+    return CliRunner(env={"COLUMNS": None})
 
 
 def write_bad_model(folder: Path) -> Path:
@@ -56,6 +57,13 @@ def test_show_output_is_readable_when_piped(runner: CliRunner) -> None:
     assert "\x1b[" not in out
     assert max(len(line.rstrip()) for line in out.splitlines()) <= PIPE_WIDTH
     assert "…" not in out
+
+
+def test_show_fits_80_columns(runner: CliRunner) -> None:
+    narrow = CliRunner(env={"COLUMNS": "80"})
+    out = narrow.invoke(cli, ["model", "show"]).stdout
+    assert max(len(line.rstrip()) for line in out.splitlines()[:-2]) <= 80
+    assert out.splitlines()[:-2] == runner.invoke(cli, ["model", "show"]).stdout.splitlines()[:-2]
 
 
 def test_show_default_is_five_link(runner: CliRunner) -> None:
