@@ -44,8 +44,6 @@ def test_replaced_file_keeps_its_permissions(tmp_path: Path) -> None:
 def test_failed_write_keeps_old_file_and_leaves_no_debris(tmp_path: Path) -> None:
     target = tmp_path / "f"
     target.write_bytes(b"old")
-
-
     with pytest.raises(TypeError):
         write_bytes_atomic(target, "not bytes")  # type: ignore[arg-type]
     assert target.read_bytes() == b"old"
