@@ -95,26 +95,27 @@ def model_tables(m: RobotModel) -> list[Table]:
     points and actuators. Points are ``(along, across)`` in m on the link (see the docs)."""
     def table(title: str, *columns: str) -> Table:
         t = Table(title=Text(title, style="bold"), title_justify="left", box=box.SIMPLE_HEAD,
-                  pad_edge=False)
+                  pad_edge=False, collapse_padding=True)
         for col in columns:
             numeric = col.split(" [")[0] in ("mass", "length", "inertia")
             t.add_column(Text(col), justify="right" if numeric else "left")
         return t
 
     links = table(f"model {m.name}: {len(m.links)} links, {m.nq} coordinates, "
-                  f"{m.nu} actuators", "link", "parent", "mass [kg]", "length [m]",
-                  "com [m]", "inertia [kg m^2]", "shape")
+                  f"{m.nu} actuators", "link", "mass [kg]", "length [m]", "com [m]",
+                  "inertia [kg m^2]", "shape")
     for link in m.links:
         shape = "-"
         if link.shape is not None:
             shape = (f"ellipsoid r={_g(link.shape.radius)}" if link.shape.radius is not None
                      else link.shape.type)
-        links.add_row(link.name, link.parent or "(base)", _g(link.mass),
-                      _g(link.length), _pair(link.com), _g(link.inertia), shape)
+        links.add_row(link.name, _g(link.mass), _g(link.length), _pair(link.com),
+                      _g(link.inertia), shape)
     links.add_section()
-    links.add_row("total", "", _g(m.total_mass), "", "", "", "")
+    links.add_row("total", _g(m.total_mass), "", "", "", "")
 
-    joints = table("joints", "joint", "parent -> link", "at [m] on parent", "limits [rad]")
+    joints = table(f"joints (the floating base is {m.base.name})", "joint", "parent -> link",
+                   "at [m] on parent", "limits [rad]")
     for link in m.links:
         if link.joint is not None:
             joints.add_row(link.joint.name, f"{link.parent} -> {link.name}",

@@ -237,6 +237,7 @@ class RobotModel:
         return model_to_dict(self)
 
     def content_hash(self) -> str:
-        """A short hash of everything that affects dynamics (for on-disk caches)."""
+        """A short hash of the whole model description (every field of ``to_dict()``), e.g. as
+        a cache key: equal models have equal hashes."""
         text = json.dumps(self.to_dict(), sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
