@@ -43,9 +43,17 @@ def _event_lines(ax: Axes, curves: GaitCurves, n_steps: int) -> None:
             ax.axvline(k + f, **EVENT_LINE)
 
 
+def _legend(fig: Figure, ax: Axes) -> None:
+    """One legend for the figure, below the axes (gid 'gaits' for tests)."""
+    handles, labels = ax.get_legend_handles_labels()
+    legend = fig.legend(handles, labels, loc="outside lower center", fontsize=7,
+                        ncols=min(len(labels), 2), frameon=False)
+    legend.set_gid("gaits")
+
+
 def _finish(fig: Figure, axes: Sequence[Axes], title: str, xlabel: str) -> None:
     axes[-1].set_xlabel(xlabel)
-    axes[0].legend(fontsize=7, loc="best")
+    _legend(fig, axes[0])
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)
@@ -136,6 +144,6 @@ def torques_figure(curves: GaitCurves, *, title: str = "joint torques with their
         ax.set_visible(False)
     for ax in axes[-ncols:]:
         ax.set_xlabel("normalized time t / T")
-    axes[0].legend(fontsize=6.5, loc="lower left")
+    _legend(fig, axes[0])
     fig.suptitle(title, fontsize=10)
     return fig

@@ -88,9 +88,10 @@ class _Selected:
     style: dict[str, Any]
 
 
-def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str]
-                 ) -> ReportInfo:
-    """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring).
+def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
+                 svg: bool = True) -> ReportInfo:
+    """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
+    ``svg=False`` skips the SVG copies of the figures.
 
     Raises :class:`gaitopt.viz.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
@@ -127,8 +128,8 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         if fig is None:
             sections.append(f"<p class='missing'>{html.escape(caption)}: no gait to show.</p>")
             return
-        png, svg, data = save_figure(fig, out, stem)
-        figures.extend((png, svg))
+        paths, data = save_figure(fig, out, stem, svg=svg)
+        figures.extend(paths)
         sections.append(f"<figure><img alt='{html.escape(stem)}' src='{png_data_uri(data)}'>"
                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 

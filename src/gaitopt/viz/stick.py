@@ -65,7 +65,7 @@ def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None)
     times = np.linspace(s.t[0], s.t[-1], frames)
     reach = max(float(np.ptp(np.concatenate([s.points[n][:, 0] - s.points["hip"][:, 0]
                                              for n in ("tip_1", "tip_2")]))), 0.3)
-    spacing = reach + 0.25
+    spacing = max(reach + 0.25, 0.55)
     height = float(np.max(s.points["torso_top"][:, 1])) + 0.1
     fig = new_figure(min(1.1 * frames * spacing + 0.6, 16.0), 3.2)
     ax = fig.add_subplot()
@@ -76,14 +76,15 @@ def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None)
         ax.plot([i * spacing - spacing / 2.2, i * spacing + spacing / 2.2], [0.0, 0.0],
                 color="0.3", linewidth=1.0)
         draw_pose(ax, pose, offset=offset)
-        phase = "single support" if t < t1 - 1e-12 else "double support"
-        ax.text(i * spacing, -0.08, f"t/T={(t - s.t[0]) / gait.step_time:.2f}\n"
-                f"hip x={pose['hip'][0]:+.2f} m\n{phase}", ha="center", va="top", fontsize=6.5)
+        phase = "single" if t < t1 - 1e-12 else "double"
+        ax.text(i * spacing, -0.06, f"t/T={(t - s.t[0]) / gait.step_time:.2f}\n"
+                f"hip {pose['hip'][0]:+.2f} m\n{phase}", ha="center", va="top", fontsize=6.5)
     ax.set_aspect("equal")
     ax.set_xlim(-spacing / 2, (frames - 1) * spacing + spacing / 2)
     ax.set_ylim(-0.3, height)
     ax.axis("off")
     speed = gait.speed * 60.0
-    ax.set_title(title or f"one step at {speed:.1f} m/min, step length {gait.step_length:.3f} m "
-                 "(leg 1 blue stands, leg 2 orange swings)", fontsize=9)
+    ax.set_title((title or f"one step at {speed:.1f} m/min, step length "
+                  f"{gait.step_length:.3f} m") + "  (leg 1 blue stands, leg 2 orange swings; "
+                 "single/double support)", fontsize=9)
     return fig
