@@ -102,7 +102,9 @@ def curves() -> list[tuple[str, Gait]]:
 
 def test_hip_motion_figure_shows_a_double_step(curves: list[tuple[str, Gait]]) -> None:
     fig = hip_motion_figure(curves)
-    ax_x, ax_v = fig.axes
+    ax_s, ax_x, ax_v = fig.axes
+    assert ax_s.get_gid() == "sticks"
+    assert len([ln for ln in ax_s.get_lines() if ln.get_gid() == "leg_1"]) == 9  # t/T=0..2
     data = [ln for ln in ax_x.get_lines() if ln.get_label() in ("slow", "fast")]
     assert [ln.get_label() for ln in data] == ["slow", "fast"]
     for line, (_, gait) in zip(data, curves, strict=True):

@@ -93,3 +93,16 @@ def test_report_renders_in_headless_chromium(report: ReportInfo, tmp_path: Path)
     assert 0.01 < dark < 0.5  # text, tables and figures drawn; not blank, not black
     # the lower part of the window shows figures (many grey levels), not an empty page
     assert len(np.unique(pixels[1000:].astype(int))) > 50
+
+
+def test_gait_figures_of_a_few_gaits(tmp_path: Path) -> None:
+    from gaitopt.viz.report import write_gait_figures
+    from tests.viz.synthetic import synthetic_gait
+
+    curves = [("a", synthetic_gait(n_samples=21)), ("b", synthetic_gait(speed=0.3, n_samples=21))]
+    paths = write_gait_figures(curves, tmp_path, svg=False)
+    assert sorted(p.name for p in paths) == ["heights.png", "hip_motion.png", "stick_1.png",
+                                             "stick_2.png", "torques.png"]
+    assert all(p.stat().st_size > 5000 for p in paths)
+    with pytest.raises(ValueError, match="no gaits"):
+        write_gait_figures([], tmp_path)

@@ -242,7 +242,7 @@ class GaitSamples:
             {str(p): _array(f"points.{p}", v, (n, 2)) for p, v in points.items()}))
 
 
-@dataclass(frozen=True, kw_only=True, eq=False)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Gait:
     """One solved step of a symmetric periodic gait (see the module docstring).
 
@@ -294,6 +294,12 @@ class Gait:
         set_(self, "phases", tuple(self.phases))
         set_(self, "events", tuple(self.events))
         _check_consistency(self, model)
+
+    def __repr__(self) -> str:
+        phases = "+".join(f"{p.name}({p.t.size})" for p in self.phases)
+        return (f"Gait(model={self.model_data.get('name')!r}, speed={self.speed:.4g} m/s, "
+                f"step_length={self.step_length:.4g} m, cost={self.cost_value:.6g}, "
+                f"status={self.status!r}, phases={phases})")
 
     # -- convenience ------------------------------------------------------------------------
     @cached_property

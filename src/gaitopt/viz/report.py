@@ -149,7 +149,7 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
             row = table[variant]
             gait = load(row)
             if row is not None and gait is not None:
-                kind = "optimal" if table is optimal else "near 50 m/min"
+                kind = "optimal" if table is optimal else "fixed speed"
                 chosen.append(_Selected(f"{variant}, {row.speed_m_min:.1f} m/min ({kind})",
                                         gait, gait_style(k)))
         return chosen
@@ -193,6 +193,27 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     write_text_atomic(path, page)
     return ReportInfo(html=path, figures=tuple(figures), problems=tuple(problems),
                       findings=findings)
+
+
+def write_gait_figures(curves: Sequence[tuple[str, Gait]], out_dir: str | os.PathLike[str],
+                       *, svg: bool = True) -> list[Path]:
+    """Figures of a few gaits, overlaid: ``hip_motion``, ``heights``, ``torques`` and one
+    ``stick_<k>`` strip per gait (k = 1, 2, ...), as PNG (and SVG) in ``out_dir``.
+
+    ``curves`` pairs a legend label with each gait, e.g. ``[(path.name, Gait.load(path))]``.
+    """
+    if not curves:
+        raise ValueError("write_gait_figures: no gaits given")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    figures = [(hip_motion_figure(curves), "hip_motion"), (heights_figure(curves), "heights"),
+               (torques_figure(curves), "torques")]
+    figures += [(stick_strip_figure(g, title=label), f"stick_{k}")
+                for k, (label, g) in enumerate(curves, start=1)]
+    for fig, stem in figures:
+        paths += save_figure(fig, out, stem, svg=svg)[0]
+    return paths
 
 
 def _fmt(x: float, spec: str) -> str:

@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from numpy.typing import NDArray
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.gait_file import Gait, GaitSamples
 from gaitopt.viz.style import LEG_COLORS, new_figure
 
 Points = Mapping[str, NDArray[np.float64]]
@@ -45,11 +45,24 @@ def draw_pose(ax: Axes, points: Points, *, offset: float = 0.0, alpha: float = 1
     return lines
 
 
-def pose_at(gait: Gait, t: float) -> dict[str, NDArray[np.float64]]:
+def pose_at(samples: GaitSamples, t: float) -> dict[str, NDArray[np.float64]]:
     """The world points (2,) of a pose at time ``t`` (s), linear between samples."""
-    s = gait.samples
-    return {name: np.array([np.interp(t, s.t, p[:, 0]), np.interp(t, s.t, p[:, 1])])
-            for name, p in s.points.items()}
+    return {name: np.array([np.interp(t, samples.t, p[:, 0]), np.interp(t, samples.t, p[:, 1])])
+            for name, p in samples.points.items()}
+
+
+def draw_pose_row(ax: Axes, samples: GaitSamples, times: NDArray[np.float64],
+                  positions: NDArray[np.float64], *, scale: float,
+                  linewidth: float = 1.2) -> None:
+    """Small poses at ``times`` (s), each scaled by ``scale`` (axis units per metre) and
+    placed with its hip above x = ``positions`` on a ground line at y = 0."""
+    for t, x in zip(times, positions, strict=True):
+        pose = pose_at(samples, float(t))
+        hip_x = pose["hip"][0]
+        small = {n: np.array([(p[0] - hip_x) * scale + x, p[1] * scale])
+                 for n, p in pose.items()}
+        draw_pose(ax, small, linewidth=linewidth)
+    ax.axhline(0.0, color="0.3", linewidth=0.8)
 
 
 def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None) -> Figure:
@@ -71,7 +84,7 @@ def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None)
     ax = fig.add_subplot()
     t1 = gait.parameters["single_support_time"] + s.t[0]
     for i, t in enumerate(times):
-        pose = pose_at(gait, float(t))
+        pose = pose_at(s, float(t))
         offset = i * spacing - float(pose["hip"][0])
         ax.plot([i * spacing - spacing / 2.2, i * spacing + spacing / 2.2], [0.0, 0.0],
                 color="0.3", linewidth=1.0)
