@@ -109,7 +109,7 @@ def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
     arrows: dict[str, FancyArrow] = {}
     for leg, color in (("tip_1", LEG_COLORS[0]), ("tip_2", LEG_COLORS[1])):
         arrows[leg] = FancyArrow(0, 0, 0, 0, width=0.008, head_width=0.03, head_length=0.03,
-                                 length_includes_head=True, color=color, alpha=0.8)
+                                 length_includes_head=True, color=color, alpha=0.8, zorder=5)
         ax.add_patch(arrows[leg])
     label = ax.text(0.01, 0.98, "", transform=ax.transAxes, va="top", fontsize=9)
 

@@ -98,6 +98,6 @@ def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None)
     ax.axis("off")
     speed = gait.speed * 60.0
     ax.set_title((title or f"one step at {speed:.1f} m/min, step length "
-                  f"{gait.step_length:.3f} m") + "  (leg 1 blue stands, leg 2 orange swings; "
-                 "single/double support)", fontsize=9)
+                  f"{gait.step_length:.3f} m") + "\nleg 1 (blue) stands, leg 2 (orange) "
+                 "swings; single / double support", fontsize=9)
     return fig
