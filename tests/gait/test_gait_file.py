@@ -236,3 +236,18 @@ def test_controls_are_piecewise_linear_between_knots() -> None:
     u = phase_controls_at(phase, np.array([0.0, 0.25, 0.75, 1.0]))
     np.testing.assert_allclose(u[:, 0], [0.0, 0.25, 0.75, 1.0])
     np.testing.assert_allclose(u[:, 1], [0.0, 0.125, 0.625, 1.0])  # chords of t^2
+
+
+def test_repr_is_one_short_line(gait: Gait) -> None:
+    text = repr(gait)
+    assert "\n" not in text and len(text) < 200
+    assert "speed=0.5 m/s" in text and "single_support(8)+double_support(5)" in text
+
+
+def test_non_json_options_are_refused_at_construction(gait: Gait) -> None:
+    with pytest.raises(GaitFileError, match=r"options: must be plain JSON data"):
+        dataclasses.replace(gait, options={"knots": np.array([8, 5])})
+    with pytest.raises(GaitFileError, match=r"options: must be plain JSON data"):
+        dataclasses.replace(gait, options={"tol": float("nan")})
+    with pytest.raises(GaitFileError, match=r"solver: must be plain JSON data"):
+        dataclasses.replace(gait, solver={**gait.solver, "stages": [object()]})

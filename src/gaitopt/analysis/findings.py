@@ -247,7 +247,7 @@ def _linear(rows: Sequence[SummaryRow]) -> Finding:
         slope, intercept, r2 = fit_line([r.speed_m_min for r in fixed], lengths)
         verdicts.append(slope > 0 and r2 >= MIN_R2)
         numbers.update({f"slope.{v}": slope, f"intercept.{v}": intercept, f"r2.{v}": r2})
-        parts.append(f"{v}: L = {slope * 1000:.3g} mm per m/min x v + {intercept:.3g} m, "
+        parts.append(f"{v}: L = {intercept:.3g} m + {slope * 1000:.3g} mm per m/min × v, "
                      f"R² = {r2:.3f}")
     if not verdicts:
         return Finding("linear_step_length", claim, None,

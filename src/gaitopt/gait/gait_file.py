@@ -120,6 +120,16 @@ def _mapping(path: str, value: Any, required: Sequence[str] = ()) -> dict[str, A
     return dict(value)
 
 
+def _plain_json(path: str, value: dict[str, Any]) -> dict[str, Any]:
+    """``value`` if it is plain JSON data (no NaN, no numpy or other objects)."""
+    try:
+        json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise _fail(path, f"must be plain JSON data: strings, finite numbers, booleans, "
+                    f"null, lists and objects ({exc})") from None
+    return value
+
+
 def _frozen(value: Mapping[str, Any]) -> Mapping[str, Any]:
     return MappingProxyType(copy.deepcopy(dict(value)))
 
@@ -242,7 +252,7 @@ class GaitSamples:
             {str(p): _array(f"points.{p}", v, (n, 2)) for p, v in points.items()}))
 
 
-@dataclass(frozen=True, kw_only=True, eq=False)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Gait:
     """One solved step of a symmetric periodic gait (see the module docstring).
 
@@ -277,11 +287,7 @@ class Gait:
             raise _fail("version", f"expected {VERSION}, got {self.version!r}")
         set_ = object.__setattr__
         set_(self, "model_data", _frozen(self.model_data))
-        set_(self, "options", _frozen(_mapping("options", self.options)))
-        try:
-            json.dumps(dict(self.options))
-        except (TypeError, ValueError) as exc:
-            raise _fail("options", f"must be plain JSON data ({exc})") from None
+        set_(self, "options", _frozen(_plain_json("options", _mapping("options", self.options))))
         params = _mapping("parameters", self.parameters, required=PARAMETER_KEYS)
         set_(self, "parameters", MappingProxyType(
             {k: _number(f"parameters.{k}", v, minimum=0.0) for k, v in params.items()}))
@@ -289,11 +295,17 @@ class Gait:
         cost["value"] = _number("cost.value", cost["value"])
         if not isinstance(cost["formula"], str):
             raise _fail("cost.formula", "expected a string (the cost formula in words)")
-        set_(self, "cost", _frozen(cost))
-        set_(self, "solver", _frozen(_check_solver(self.solver)))
+        set_(self, "cost", _frozen(_plain_json("cost", cost)))
+        set_(self, "solver", _frozen(_plain_json("solver", _check_solver(self.solver))))
         set_(self, "phases", tuple(self.phases))
         set_(self, "events", tuple(self.events))
         _check_consistency(self, model)
+
+    def __repr__(self) -> str:
+        phases = "+".join(f"{p.name}({p.t.size})" for p in self.phases)
+        return (f"Gait(model={self.model_data.get('name')!r}, speed={self.speed:.4g} m/s, "
+                f"step_length={self.step_length:.4g} m, cost={self.cost_value:.6g}, "
+                f"status={self.status!r}, phases={phases})")
 
     # -- convenience ------------------------------------------------------------------------
     @cached_property
@@ -450,6 +462,8 @@ def _check_solver(value: Any) -> dict[str, Any]:
     solver = _mapping("solver", value, required=SOLVER_KEYS)
     if not isinstance(solver["status"], str):
         raise _fail("solver.status", "expected a string")
+    if isinstance(solver["success"], np.bool_):
+        solver["success"] = bool(solver["success"])
     if not isinstance(solver["success"], bool):
         raise _fail("solver.success", f"expected true or false, got {solver['success']!r}")
     for key in ("iterations", "variables", "equality_constraints", "inequality_constraints"):

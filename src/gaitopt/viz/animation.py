@@ -12,18 +12,20 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
 import numpy as np
 from matplotlib.animation import FFMpegWriter
+from matplotlib.figure import Figure
 from matplotlib.patches import FancyArrow
 from numpy.typing import NDArray
 from PIL import Image
 
-from gaitopt.gait.gait_file import Gait, GaitSamples, phase_forces_at, swap_leg_label
-from gaitopt.viz.stick import draw_pose, pose_segments
+from gaitopt.gait.gait_file import Gait, phase_forces_at, swap_leg_label
+from gaitopt.viz.stick import draw_pose, pose_at, pose_segments
 from gaitopt.viz.style import LEG_COLORS, new_figure
 
 SUFFIXES = (".gif", ".mp4")
@@ -58,11 +60,6 @@ def contact_forces_at(gait: Gait, t: float) -> dict[str, NDArray[np.float64]]:
         if phase.t[0] - 1e-12 <= t <= phase.t[-1] + 1e-12:
             return {c: f[0] for c, f in phase_forces_at(phase, np.array([t])).items()}
     return {}
-
-
-def _interp_points(s: GaitSamples, t: float) -> dict[str, NDArray[np.float64]]:
-    return {name: np.array([np.interp(t, s.t, p[:, 0]), np.interp(t, s.t, p[:, 1])])
-            for name, p in s.points.items()}
 
 
 def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
@@ -107,17 +104,17 @@ def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
     ax.axhline(0.0, color="0.25", linewidth=1.5)
     for x in np.arange(math.floor(x_lo * 10) / 10, x_hi, 0.1):
         ax.plot([x, x - 0.03], [0.0, -0.03], color="0.5", linewidth=0.8)
-    pose0 = _interp_points(stride, 0.0)
+    pose0 = pose_at(stride, 0.0)
     lines = draw_pose(ax, pose0, linewidth=3.0)
     arrows: dict[str, FancyArrow] = {}
     for leg, color in (("tip_1", LEG_COLORS[0]), ("tip_2", LEG_COLORS[1])):
         arrows[leg] = FancyArrow(0, 0, 0, 0, width=0.008, head_width=0.03, head_length=0.03,
-                                 length_includes_head=True, color=color, alpha=0.8)
+                                 length_includes_head=True, color=color, alpha=0.8, zorder=5)
         ax.add_patch(arrows[leg])
     label = ax.text(0.01, 0.98, "", transform=ax.transAxes, va="top", fontsize=9)
 
     def draw(t: float) -> None:
-        pose = _interp_points(stride, t)
+        pose = pose_at(stride, t)
         for part, xy in pose_segments(pose).items():
             lines[part].set_data(xy[:, 0], xy[:, 1])
         k = min(int(t // period), steps - 1)
@@ -134,30 +131,39 @@ def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
         label.set_text(f"t = {t:5.2f} s   step {k + 1}/{steps}   "
                        f"{gait.speed * 60:.1f} m/min, step {shift:.3f} m   (real time)")
 
-    if suffix == ".gif":
-        images = []
-        for t in times:
-            draw(float(t))
-            fig.canvas.draw()
-            rgba = np.asarray(fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
-            images.append(Image.fromarray(rgba[:, :, :3].copy()).quantize(colors=64))
-        target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = target.with_name(f".{target.name}.tmp.gif")
-        images[0].save(tmp, save_all=True, append_images=images[1:],
-                       duration=gif_delays_ms(len(images), fps), loop=0, optimize=False)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = target.with_name(f".{target.name}.tmp{suffix}")  # same suffix: same encoder
+    try:
+        if suffix == ".gif":
+            _write_gif(tmp, fig, draw, times, fps)
+        else:
+            _write_mp4(tmp, fig, draw, times, fps, dpi)
         os.replace(tmp, target)
-    else:
-        import imageio_ffmpeg
-
-        tmp = target.with_name(f".{target.name}.tmp.mp4")
-        target.parent.mkdir(parents=True, exist_ok=True)
-        with matplotlib.rc_context({"animation.ffmpeg_path": imageio_ffmpeg.get_ffmpeg_exe()}):
-            writer = FFMpegWriter(fps=fps, codec="libx264",
-                                  extra_args=["-pix_fmt", "yuv420p"])
-            with writer.saving(fig, str(tmp), dpi):
-                for t in times:
-                    draw(float(t))
-                    writer.grab_frame()
-        os.replace(tmp, target)
+    finally:
+        tmp.unlink(missing_ok=True)
     return AnimationInfo(path=target, frames=len(times), fps=float(fps),
                          duration_s=len(times) / fps)
+
+
+def _write_gif(path: Path, fig: Figure, draw: Callable[[float], None],
+               times: NDArray[np.float64], fps: int) -> None:
+    images = []
+    for t in times:
+        draw(float(t))
+        fig.canvas.draw()
+        rgba = np.asarray(fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
+        images.append(Image.fromarray(rgba[:, :, :3].copy()).quantize(colors=64))
+    images[0].save(path, save_all=True, append_images=images[1:],
+                   duration=gif_delays_ms(len(images), fps), loop=0, optimize=False)
+
+
+def _write_mp4(path: Path, fig: Figure, draw: Callable[[float], None],
+               times: NDArray[np.float64], fps: int, dpi: int) -> None:
+    import imageio_ffmpeg
+
+    with matplotlib.rc_context({"animation.ffmpeg_path": imageio_ffmpeg.get_ffmpeg_exe()}):
+        writer = FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+        with writer.saving(fig, str(path), dpi):
+            for t in times:
+                draw(float(t))
+                writer.grab_frame()

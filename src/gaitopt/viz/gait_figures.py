@@ -17,6 +17,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from gaitopt.gait.gait_file import Gait
+from gaitopt.viz.stick import draw_pose_row
 from gaitopt.viz.style import BOUND_LINE, EVENT_LINE, gait_style, new_figure
 
 GaitCurves = Sequence[tuple[str, Gait]]
@@ -43,9 +44,17 @@ def _event_lines(ax: Axes, curves: GaitCurves, n_steps: int) -> None:
             ax.axvline(k + f, **EVENT_LINE)
 
 
+def _legend(fig: Figure, ax: Axes) -> None:
+    """One legend for the figure, below the axes (gid 'gaits' for tests)."""
+    handles, labels = ax.get_legend_handles_labels()
+    legend = fig.legend(handles, labels, loc="outside lower center", fontsize=7,
+                        ncols=min(len(labels), 2), frameon=False)
+    legend.set_gid("gaits")
+
+
 def _finish(fig: Figure, axes: Sequence[Axes], title: str, xlabel: str) -> None:
     axes[-1].set_xlabel(xlabel)
-    axes[0].legend(fontsize=7, loc="best")
+    _legend(fig, axes[0])
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)
@@ -54,10 +63,19 @@ def _finish(fig: Figure, axes: Sequence[Axes], title: str, xlabel: str) -> None:
 def hip_motion_figure(curves: GaitCurves, *,
                       styles: Sequence[Mapping[str, Any]] | None = None) -> Figure:
     """Paper Fig. 5: hip horizontal position (relative to its start, m) and velocity (m/s)
-    over a double step (two steps, legs relabelled) against normalized time t/T."""
+    over a double step (two steps, legs relabelled) against normalized time t/T, below
+    small poses of the first gait at t/T = 0, 0.25, ..., 2 (as the paper's stick figures)."""
     sty = _styles(curves, styles)
-    fig = new_figure(7.5, 5.5)
-    ax_x, ax_v = fig.subplots(2, 1, sharex=True)
+    fig = new_figure(7.5, 6.5)
+    ax_s, ax_x, ax_v = fig.subplots(3, 1, sharex=True, height_ratios=(0.8, 2, 2))
+    first = curves[0][1]
+    taus = np.linspace(0.0, 2.0, 9)
+    draw_pose_row(ax_s, first.stride_samples(2), first.samples.t[0] + taus * first.step_time,
+                  taus, scale=0.12)
+    ax_s.set_aspect("equal", adjustable="box")
+    ax_s.set_gid("sticks")
+    ax_s.axis("off")
+    ax_s.set_title(f"poses of: {curves[0][0]}", fontsize=7, loc="left")
     for (label, gait), style in zip(curves, sty, strict=True):
         s = gait.stride_samples(2)
         ix = gait.model.coordinate_names.index("x")
@@ -136,6 +154,6 @@ def torques_figure(curves: GaitCurves, *, title: str = "joint torques with their
         ax.set_visible(False)
     for ax in axes[-ncols:]:
         ax.set_xlabel("normalized time t / T")
-    axes[0].legend(fontsize=6.5, loc="lower left")
+    _legend(fig, axes[0])
     fig.suptitle(title, fontsize=10)
     return fig

@@ -88,9 +88,10 @@ class _Selected:
     style: dict[str, Any]
 
 
-def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str]
-                 ) -> ReportInfo:
-    """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring).
+def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
+                 svg: bool = True) -> ReportInfo:
+    """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
+    ``svg=False`` skips the SVG copies of the figures.
 
     Raises :class:`gaitopt.viz.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
@@ -127,8 +128,8 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         if fig is None:
             sections.append(f"<p class='missing'>{html.escape(caption)}: no gait to show.</p>")
             return
-        png, svg, data = save_figure(fig, out, stem)
-        figures.extend((png, svg))
+        paths, data = save_figure(fig, out, stem, svg=svg)
+        figures.extend(paths)
         sections.append(f"<figure><img alt='{html.escape(stem)}' src='{png_data_uri(data)}'>"
                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 
@@ -148,7 +149,7 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
             row = table[variant]
             gait = load(row)
             if row is not None and gait is not None:
-                kind = "optimal" if table is optimal else "near 50 m/min"
+                kind = "optimal" if table is optimal else "fixed speed"
                 chosen.append(_Selected(f"{variant}, {row.speed_m_min:.1f} m/min ({kind})",
                                         gait, gait_style(k)))
         return chosen
@@ -192,6 +193,27 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     write_text_atomic(path, page)
     return ReportInfo(html=path, figures=tuple(figures), problems=tuple(problems),
                       findings=findings)
+
+
+def write_gait_figures(curves: Sequence[tuple[str, Gait]], out_dir: str | os.PathLike[str],
+                       *, svg: bool = True) -> list[Path]:
+    """Figures of a few gaits, overlaid: ``hip_motion``, ``heights``, ``torques`` and one
+    ``stick_<k>`` strip per gait (k = 1, 2, ...), as PNG (and SVG) in ``out_dir``.
+
+    ``curves`` pairs a legend label with each gait, e.g. ``[(path.name, Gait.load(path))]``.
+    """
+    if not curves:
+        raise ValueError("write_gait_figures: no gaits given")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    figures = [(hip_motion_figure(curves), "hip_motion"), (heights_figure(curves), "heights"),
+               (torques_figure(curves), "torques")]
+    figures += [(stick_strip_figure(g, title=label), f"stick_{k}")
+                for k, (label, g) in enumerate(curves, start=1)]
+    for fig, stem in figures:
+        paths += save_figure(fig, out, stem, svg=svg)[0]
+    return paths
 
 
 def _fmt(x: float, spec: str) -> str:

@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from numpy.typing import NDArray
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.gait_file import Gait, GaitSamples
 from gaitopt.viz.style import LEG_COLORS, new_figure
 
 Points = Mapping[str, NDArray[np.float64]]
@@ -45,11 +45,24 @@ def draw_pose(ax: Axes, points: Points, *, offset: float = 0.0, alpha: float = 1
     return lines
 
 
-def pose_at(gait: Gait, t: float) -> dict[str, NDArray[np.float64]]:
+def pose_at(samples: GaitSamples, t: float) -> dict[str, NDArray[np.float64]]:
     """The world points (2,) of a pose at time ``t`` (s), linear between samples."""
-    s = gait.samples
-    return {name: np.array([np.interp(t, s.t, p[:, 0]), np.interp(t, s.t, p[:, 1])])
-            for name, p in s.points.items()}
+    return {name: np.array([np.interp(t, samples.t, p[:, 0]), np.interp(t, samples.t, p[:, 1])])
+            for name, p in samples.points.items()}
+
+
+def draw_pose_row(ax: Axes, samples: GaitSamples, times: NDArray[np.float64],
+                  positions: NDArray[np.float64], *, scale: float,
+                  linewidth: float = 1.2) -> None:
+    """Small poses at ``times`` (s), each scaled by ``scale`` (axis units per metre) and
+    placed with its hip above x = ``positions`` on a ground line at y = 0."""
+    for t, x in zip(times, positions, strict=True):
+        pose = pose_at(samples, float(t))
+        hip_x = pose["hip"][0]
+        small = {n: np.array([(p[0] - hip_x) * scale + x, p[1] * scale])
+                 for n, p in pose.items()}
+        draw_pose(ax, small, linewidth=linewidth)
+    ax.axhline(0.0, color="0.3", linewidth=0.8)
 
 
 def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None) -> Figure:
@@ -65,25 +78,26 @@ def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None)
     times = np.linspace(s.t[0], s.t[-1], frames)
     reach = max(float(np.ptp(np.concatenate([s.points[n][:, 0] - s.points["hip"][:, 0]
                                              for n in ("tip_1", "tip_2")]))), 0.3)
-    spacing = reach + 0.25
+    spacing = max(reach + 0.25, 0.55)
     height = float(np.max(s.points["torso_top"][:, 1])) + 0.1
     fig = new_figure(min(1.1 * frames * spacing + 0.6, 16.0), 3.2)
     ax = fig.add_subplot()
     t1 = gait.parameters["single_support_time"] + s.t[0]
     for i, t in enumerate(times):
-        pose = pose_at(gait, float(t))
+        pose = pose_at(s, float(t))
         offset = i * spacing - float(pose["hip"][0])
         ax.plot([i * spacing - spacing / 2.2, i * spacing + spacing / 2.2], [0.0, 0.0],
                 color="0.3", linewidth=1.0)
         draw_pose(ax, pose, offset=offset)
-        phase = "single support" if t < t1 - 1e-12 else "double support"
-        ax.text(i * spacing, -0.08, f"t/T={(t - s.t[0]) / gait.step_time:.2f}\n"
-                f"hip x={pose['hip'][0]:+.2f} m\n{phase}", ha="center", va="top", fontsize=6.5)
+        phase = "single" if t < t1 - 1e-12 else "double"
+        ax.text(i * spacing, -0.06, f"t/T={(t - s.t[0]) / gait.step_time:.2f}\n"
+                f"hip {pose['hip'][0]:+.2f} m\n{phase}", ha="center", va="top", fontsize=6.5)
     ax.set_aspect("equal")
     ax.set_xlim(-spacing / 2, (frames - 1) * spacing + spacing / 2)
     ax.set_ylim(-0.3, height)
     ax.axis("off")
     speed = gait.speed * 60.0
-    ax.set_title(title or f"one step at {speed:.1f} m/min, step length {gait.step_length:.3f} m "
-                 "(leg 1 blue stands, leg 2 orange swings)", fontsize=9)
+    ax.set_title((title or f"one step at {speed:.1f} m/min, step length "
+                  f"{gait.step_length:.3f} m") + "\nleg 1 (blue) stands, leg 2 (orange) "
+                 "swings; single / double support", fontsize=9)
     return fig

@@ -78,10 +78,14 @@ def png_data_uri(png: bytes) -> str:
 
 
 def save_figure(fig: Figure, out_dir: str | os.PathLike[str], stem: str, *,
-                dpi: int = 110) -> tuple[Path, Path, bytes]:
-    """Write ``<stem>.png`` and ``<stem>.svg`` atomically; returns both paths and the PNG."""
+                dpi: int = 110, svg: bool = True) -> tuple[list[Path], bytes]:
+    """Write ``<stem>.png`` (and ``<stem>.svg``) atomically; returns the paths and the PNG."""
     folder = Path(out_dir)
     png = png_bytes(fig, dpi=dpi)
-    write_bytes_atomic(folder / f"{stem}.png", png)
-    write_bytes_atomic(folder / f"{stem}.svg", svg_text(fig).encode("utf-8"))
-    return folder / f"{stem}.png", folder / f"{stem}.svg", png
+    paths = [folder / f"{stem}.png"]
+    write_bytes_atomic(paths[0], png)
+    if svg:
+        fig.set_layout_engine("none")  # keep the layout the PNG was drawn with (faster)
+        paths.append(folder / f"{stem}.svg")
+        write_bytes_atomic(paths[1], svg_text(fig).encode("utf-8"))
+    return paths, png
