@@ -1,20 +1,24 @@
 """Solving the walking problem robustly from a naive start: staged continuation.
 
 The paper's authors climbed to the optimum by hand through sub-problems. gaitopt does it by
-itself, in stages that each warm-start the next:
+itself, in stages that each warm-start the next (primal values and multipliers):
 
-1. ``relaxed``: the coarse grid (at most the paper's 8 + 5 knots), the unilateral contact
+1. ``relaxed contact``: the coarse grid (at most the paper's 8 + 5 knots) at the target speed
+   (12 m/min when the speed is free) with no liftoff impulse, the unilateral contact
    conditions relaxed (normal forces and impulses may be negative), from the geometric guess
-   of :mod:`gaitopt.gait.guess` at the target speed;
-2. ``enforced``: the same grid with the contact conditions enforced (the paper's two-stage
+   of :mod:`gaitopt.gait.guess`;
+2. ``enforced contact``: the same with the contact conditions enforced (the paper's two-stage
    process);
-3. ``target grid``: the requested grid, if finer, from stage 2 interpolated onto it.
+3. ``liftoff impulse free`` (impulse variants) and ``speed free`` (the optimal walk): the
+   parameters held fixed so far are released one at a time; starting from the no-impulse gait
+   keeps the impulse variants from stopping in worse local minima than the no-impulse gait;
+4. ``target grid``: the requested grid, if finer, from the coarse solution interpolated.
 
-If stage 1 or 2 fails, the same is tried from other naive guesses (shorter and longer
-steps), then by continuation in speed from the reference speed (12 m/min). Given a warm start
-(a neighbouring gait), the target problem is solved from it directly and the cold path is the
-fallback. Every stage is reported through ``progress`` and kept in the solution, so a failure
-says which stage failed and why.
+If stage 1 or 2 fails, the same is tried from guesses with shorter and longer steps, then by
+continuation in speed from the reference speed (12 m/min). Given a warm start (a neighbouring
+gait), the target problem is solved from it directly and the cold path is the fallback.
+Every stage is reported through ``progress`` and kept in the solution, so a failure says which
+stage failed and why.
 
 Transcriptions (NLP and IPOPT solver) are built once per process for each problem structure
 and reused: speed, step length and impulse enter through parameter bounds only.
@@ -144,50 +148,63 @@ class _Run:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
         self.stages: list[StageReport] = []
-        self.last: tuple[Result, Transcription] | None = None
+        self.results: list[tuple[Result, Transcription]] = []
 
     def stage(self, name: str, knots: tuple[int, int], relax: Relaxation,
               guess: Guess | Result, bounds: dict[str, Any]) -> Result:
+        """Solve one stage; a Result guess also passes its multipliers to IPOPT."""
         tr = transcription_for(self.model, self.options, knots, relax, compiled=self.compiled)
         start = time.perf_counter()
-        result = tr.solve(guess, parameters=bounds)
+        result = tr.solve(guess, parameters=bounds,
+                          warm_start_multipliers=isinstance(guess, Result))
         report = StageReport(
             name=name, knots=tuple(knots), status=result.status, success=result.success,
             iterations=result.iterations, objective=result.objective,
             violation=result.constraint_violation, wall_time_s=time.perf_counter() - start,
             parameters=dict(result.parameters))
         self.stages.append(report)
-        self.last = (result, tr)
+        self.results.append((result, tr))
         if self.progress is not None:
             self.progress(report)
         return result
 
-    def cold(self, speed: float, step_length: float | None) -> Result | None:
-        """Stages 1-2 on the coarse grid at ``speed`` from naive guesses."""
+    def cold(self, speed: float) -> Result | None:
+        """Stages 1-2 on the coarse grid at ``speed`` without impulse, from naive guesses
+        (the requested step length, or a speed-based guess and two others)."""
         o, coarse = self.options, coarse_knots(self.options)
         legs = checked_biped(self.model).legs
         r_max = min(leg.reach(-o.min_stance_knee_flexion) for leg in legs)
-        bounds = parameter_bounds(o)
-        base = step_length if step_length is not None else default_step_length(speed)
-        target_speed = bounds["speed"]
-        for factor in (1.0, 0.7, 1.4):
-            step0 = base if step_length is not None else base * factor
-            if step_length is not None and factor != 1.0:
-                break
+        bounds = dict(parameter_bounds(o))
+        bounds["speed"] = (speed, speed)
+        bounds["impulse"] = (0.0, 0.0)
+        steps = [o.step_length] if o.step_length is not None else \
+            [default_step_length(speed) * f for f in (1.0, 0.7, 1.4)]
+        for step0 in steps:
             guess = naive_guess(self.model, speed=speed, step_length=step0,
                                 single_support_fraction=o.single_support_fraction,
                                 knots=coarse, ankle=o.ankle, r_max=r_max)
-            stage_bounds = dict(bounds)
-            stage_bounds["speed"] = (speed, speed) if o.speed is not None else target_speed
-            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess),
-                                 stage_bounds)
+            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds)
             if not relaxed.success:
                 continue
-            enforced = self.stage("enforced contact", coarse, Relaxation(), relaxed,
-                                  stage_bounds)
+            enforced = self.stage("enforced contact", coarse, Relaxation(), relaxed, bounds)
             if enforced.success:
                 return enforced
         return None
+
+    def release(self, result: Result) -> Result:
+        """Free what the cold stages held fixed: the impulse, then the speed."""
+        o, coarse = self.options, coarse_knots(self.options)
+        bounds = dict(parameter_bounds(o))
+        speed = result.parameters["speed"]
+        if o.impulse:
+            b = dict(bounds)
+            b["speed"] = (speed, speed)
+            result = self.stage("liftoff impulse free", coarse, Relaxation(), result, b)
+            if not result.success:
+                return result
+        if o.speed is None:
+            result = self.stage("speed free", coarse, Relaxation(), result, bounds)
+        return result
 
     def refine(self, result: Result) -> Result:
         """Stage 3: the requested grid, when finer than the coarse one."""
@@ -200,12 +217,13 @@ class _Run:
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
         o = self.options
-        current = self.cold(REFERENCE_SPEED, o.step_length)
+        current = self.cold(REFERENCE_SPEED)
         if current is None:
             return None
         speeds = np.linspace(REFERENCE_SPEED, target,
                              int(np.ceil(abs(target - REFERENCE_SPEED) / SPEED_STEP)) + 1)[1:]
-        bounds = parameter_bounds(o)
+        bounds = dict(parameter_bounds(o))
+        bounds["impulse"] = (0.0, 0.0)
         for v in speeds:
             b = dict(bounds)
             b["speed"] = (float(v), float(v))
@@ -214,6 +232,24 @@ class _Run:
             if not current.success:
                 return None
         return current
+
+    def final(self) -> tuple[Result, Transcription]:
+        """The last stage's outcome, or, if its values are not finite (a diverged solve),
+        the last stage whose values are."""
+        for result, tr in reversed(self.results):
+            if np.all(np.isfinite(result.w)):
+                if result is not self.results[-1][0]:
+                    return _as_failed(result, self.results[-1][0]), tr
+                return result, tr
+        return self.results[-1]
+
+
+def _as_failed(result: Result, failed: Result) -> Result:
+    """``result``'s values with the failed stage's status (never reported as converged)."""
+    import dataclasses
+
+    return dataclasses.replace(result, success=False, status=failed.status,
+                               message=f"{failed.message} (values of an earlier stage)")
 
 
 def solve_walking(model: RobotModel, options: GaitOptions, *,
@@ -233,17 +269,14 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
             result = None
     if result is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
-        coarse = run.cold(speed, options.step_length)
+        coarse = run.cold(speed)
         if coarse is None and options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9:
             coarse = run.speed_continuation(speed)
         if coarse is not None:
-            result = run.refine(coarse)
-    if result is None:
-        assert run.last is not None
-        result = run.last[0]
-    assert run.last is not None
-    tr = transcription_for(model, options, tuple(options.knots), Relaxation(),
-                           compiled=compiled) if result.success else run.last[1]
-    return WalkingSolution(model=model, options=options, result=result,
+            released = run.release(coarse)
+            if released.success:
+                run.refine(released)
+    final, tr = run.final()
+    return WalkingSolution(model=model, options=options, result=final,
                            stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
                            transcription=tr)
