@@ -7,7 +7,9 @@ Modes (``compiled``):
   nlp_hess_l``) are generated as C, compiled with :mod:`gaitopt.codegen` into the on-disk
   cache, loaded back as external functions and passed to ``nlpsol`` through its
   Function-valued options ``grad_f``, ``jac_g``, ``hess_lag``. The library is keyed by a hash of
-  the expanded NLP, so a second build of the same NLP skips deriving and compiling.
+  the serialized NLP, so a second build of the same NLP skips deriving and compiling. With an
+  MX NLP (the default when compiled) the C code loops over the mapped point functions, so its
+  size and compile time do not grow with the mesh.
 * ``"jit"``: CasADi's own just-in-time compilation (``jit=True``, shell compiler); compiled at
   every build, nothing cached.
 
@@ -111,7 +113,7 @@ def make_solver(name: str, nlp: NlpFunctions, options: Mapping[str, Any],
         return ca.nlpsol(name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
     if compiled == "jit":
         opts.update(jit=True, compiler="shell", jit_cleanup=True,
-                    jit_options={"flags": ["-O1"], "verbose": False})
+                    jit_options={"flags": ["-O1", "-w"], "verbose": False})
         return ca.nlpsol(name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
     if compiled == "codegen":
         return _codegen_solver(name, nlp, opts)

@@ -54,7 +54,7 @@ class Transcription:
         ``solver``), options (the default solver options).
     """
 
-    def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool = True,
+    def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool | None = None,
                  compiled: str | None = None, options: Mapping[str, Any] | None = None,
                  scaling: bool = True, cse: bool = True) -> None:
         check_problem(problem)
@@ -66,7 +66,10 @@ class Transcription:
         self.method = method
         self.mesh = mesh
         self.compiled = compiled
-        self.expand = expand or compiled is not None
+        # Default: SX (expanded) when interpreted; MX with mapped SX point functions when
+        # compiled, whose C code has loops over the grid and compiles in a time independent of
+        # the mesh size (see docs/ocp.md for measurements).
+        self.expand = (compiled is None) if expand is None else expand
         self.options = merge_options(DEFAULT_OPTIONS, options)
         self.builds: Counter[str] = Counter()
         n_p = len(problem.parameters)
@@ -219,7 +222,7 @@ class Transcription:
 
 def transcribe(problem: Problem, *, method: str = "hermite-simpson",
                intervals: IntervalsSpec | Mapping[str, IntervalsSpec] | None = None,
-               expand: bool = True, compiled: str | None = None,
+               expand: bool | None = None, compiled: str | None = None,
                options: Mapping[str, Any] | None = None, scaling: bool = True,
                cse: bool = True) -> Transcription:
     """Validate ``problem``, build its NLP and solver once, and return the transcription.
@@ -228,8 +231,11 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
         method: ``"hermite-simpson"`` (default) or ``"trapezoidal"``.
         intervals: None (each phase's ``intervals``), an int for all phases, or by phase name
             an int (uniform) or an array of normalised knots in [0, 1].
-        expand: evaluate in SX (faster) rather than MX.
-        compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk) or ``"jit"``.
+        expand: evaluate the NLP as one SX graph rather than MX with mapped point functions.
+            Default: True when not compiled (fastest interpreted), False when compiled (the
+            generated C loops over the grid, so compiling takes seconds at any mesh size).
+        compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk; recommended for
+            repeated solves of one problem) or ``"jit"`` (CasADi's jit, not cached).
         options: solver options over the defaults (``{"ipopt.tol": 1e-10}`` or
             ``{"ipopt": {"tol": 1e-10}}``).
         scaling: scale variables and constraints from bounds or given scales.
