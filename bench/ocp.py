@@ -7,7 +7,8 @@ evaluation counts by kind, the error of the objective against the analytic optim
 ratio of solve and evaluation time to the interpreted SX mode measured in the same run.
 
 Modes: ``sx`` (expand=True, CasADi VM), ``mx`` (expand=False, mapped point functions),
-``codegen`` (MX compiled to C via gaitopt.codegen, cached), ``codegen-sx`` (the expanded SX
+``codegen`` (MX compiled to C via gaitopt.codegen with -O2, cached; ``codegen-O1`` with -O1),
+``codegen-sx`` (the expanded SX
 NLP compiled: fast to evaluate, slow to compile), ``jit`` (CasADi jit of the SX NLP).
 
 Run: ``python bench/ocp.py [--sizes 10 40 160] [--modes sx mx codegen] [--repeat 3]``
@@ -35,6 +36,8 @@ MODES: dict[str, dict[str, Any]] = {
     "sx": {"expand": True, "compiled": None},
     "mx": {"expand": False, "compiled": None},
     "codegen": {"expand": False, "compiled": "codegen"},
+    "codegen-O1": {"expand": False, "compiled": "codegen",
+                   "compile_flags": ("-O1", "-fPIC", "-shared")},
     "codegen-sx": {"expand": True, "compiled": "codegen"},
     "jit": {"expand": True, "compiled": "jit"},
 }
@@ -120,7 +123,7 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     if "GAITOPT_CACHE" not in os.environ:
         os.environ["GAITOPT_CACHE"] = tempfile.mkdtemp(prefix="gaitopt-bench-")
     print(f"compiled-code cache: {os.environ['GAITOPT_CACHE']} (cold on first build)")
-    header = (f"{'problem':18s} {'N':>4s} {'mode':10s} {'vars':>5s} {'build s':>8s} "
+    header = (f"{'problem':18s} {'N':>4s} {'mode':11s} {'vars':>5s} {'build s':>8s} "
               f"{'rebuild':>8s} {'solve s':>8s} {'eval s':>8s} {'iter':>4s} "
               f"{'f/g/gf/jg/h calls':>20s} {'rel.err J':>9s} {'solve/sx':>8s} {'eval/sx':>8s}")
     print(header)
@@ -140,7 +143,7 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
                 ratio = (f"{r['solve'] / ref['solve']:8.2f} {r['eval'] / ref['eval']:8.2f}"
                          if ref and ref["eval"] > 0 else f"{'-':>8s} {'-':>8s}")
                 rebuild = "" if math.isnan(r["rebuild"]) else f"{r['rebuild']:8.3f}"
-                print(f"{name:18s} {n:4d} {mode:10s} {r['size'].variables:5d} "
+                print(f"{name:18s} {n:4d} {mode:11s} {r['size'].variables:5d} "
                       f"{r['build']:8.3f} {rebuild:>8s} {r['solve']:8.4f} {r['eval']:8.4f} "
                       f"{r['iters']:4d} {calls:>20s} {r['err']:9.1e} {ratio}".replace("nan", "  -")
                       + ("" if r["status"] == "Solve_Succeeded" else f"  {r['status']}"))
