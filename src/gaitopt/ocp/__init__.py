@@ -19,6 +19,7 @@ from gaitopt.ocp.problem import (
     Problem,
     named,
 )
+from gaitopt.ocp.refine import Refinement, refine, refined_mesh
 from gaitopt.ocp.result import NlpSize, PhaseTrajectory, Result
 from gaitopt.ocp.transcription import Transcription, transcribe
 from gaitopt.ocp.validate import ProblemError
@@ -41,9 +42,12 @@ __all__ = [
     "PhaseLayout",
     "Problem",
     "ProblemError",
-    "Result",
     "PhaseTrajectory",
+    "Refinement",
+    "Result",
     "Transcription",
     "named",
+    "refine",
+    "refined_mesh",
     "transcribe",
 ]

@@ -7,7 +7,9 @@ Modes (``compiled``):
   nlp_hess_l``) are generated as C, compiled with :mod:`gaitopt.codegen` into the on-disk
   cache, loaded back as external functions and passed to ``nlpsol`` through its
   Function-valued options ``grad_f``, ``jac_g``, ``hess_lag``. The library is keyed by a hash of
-  the expanded NLP, so a second build of the same NLP skips deriving and compiling.
+  the serialized NLP, so a second build of the same NLP skips deriving and compiling. With an
+  MX NLP (the default when compiled) the C code loops over the mapped point functions, so its
+  size and compile time do not grow with the mesh.
 * ``"jit"``: CasADi's own just-in-time compilation (``jit=True``, shell compiler); compiled at
   every build, nothing cached.
 
@@ -83,8 +85,10 @@ def _nlp_hash(nlp: NlpFunctions) -> str:
     return hashlib.sha256(fn.serialize().encode()).hexdigest()[:16]
 
 
-def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any]) -> ca.Function:
-    lib_name = f"ocp_{_nlp_hash(nlp)}"
+def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any],
+                    flags: tuple[str, ...]) -> ca.Function:
+    digest = hashlib.sha256((_nlp_hash(nlp) + " ".join(flags)).encode()).hexdigest()[:16]
+    lib_name = f"ocp_{digest}"
     cached = sorted(codegen.cache_dir().glob(f"{lib_name}-*.so"))
     if cached:
         path = cached[-1]
@@ -92,7 +96,8 @@ def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any]) -> ca
         base = ca.nlpsol(f"{name}_base", "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g},
                          options)
         fns = [base.get_function(k) for k in EVAL_KINDS]
-        path = codegen.compile_library(codegen.generate_source(fns, lib_name), lib_name)
+        path = codegen.compile_library(codegen.generate_source(fns, lib_name), lib_name,
+                                       flags=flags)
     ext = {k: ca.external(k, str(path)) for k in EVAL_KINDS}
     X = ca.MX.sym("w", nlp.x.shape[0])
     P = ca.MX.sym("p", 0)
@@ -104,17 +109,22 @@ def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any]) -> ca
 
 
 def make_solver(name: str, nlp: NlpFunctions, options: Mapping[str, Any],
-                compiled: str | None) -> ca.Function:
-    """An IPOPT ``nlpsol`` for ``nlp`` in the requested evaluation mode."""
+                compiled: str | None,
+                compile_flags: tuple[str, ...] = codegen.DEFAULT_FLAGS) -> ca.Function:
+    """An IPOPT ``nlpsol`` for ``nlp`` in the requested evaluation mode.
+
+    ``compile_flags`` are the C compiler flags of the ``"codegen"`` mode (they must produce a
+    shared library: keep ``-fPIC -shared``).
+    """
     opts = dict(options)
     if compiled is None:
         return ca.nlpsol(name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
     if compiled == "jit":
         opts.update(jit=True, compiler="shell", jit_cleanup=True,
-                    jit_options={"flags": ["-O1"], "verbose": False})
+                    jit_options={"flags": ["-O1", "-w"], "verbose": False})
         return ca.nlpsol(name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
     if compiled == "codegen":
-        return _codegen_solver(name, nlp, opts)
+        return _codegen_solver(name, nlp, opts, tuple(compile_flags))
     raise ValueError(f"compiled must be one of {COMPILED_MODES}, got {compiled!r}")
 
 

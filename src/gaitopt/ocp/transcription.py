@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from gaitopt import codegen
 from gaitopt.ocp.bounds import Bounds, variable_bounds
 from gaitopt.ocp.estimate import interval_errors
 from gaitopt.ocp.functions import PhaseFunction, build_ends_function, build_phase_function
@@ -54,9 +55,10 @@ class Transcription:
         ``solver``), options (the default solver options).
     """
 
-    def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool = True,
+    def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool | None = None,
                  compiled: str | None = None, options: Mapping[str, Any] | None = None,
-                 scaling: bool = True, cse: bool = True) -> None:
+                 scaling: bool = True, cse: bool = True,
+                 compile_flags: Sequence[str] | None = None) -> None:
         check_problem(problem)
         if method not in METHODS:
             raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -66,7 +68,11 @@ class Transcription:
         self.method = method
         self.mesh = mesh
         self.compiled = compiled
-        self.expand = expand or compiled is not None
+        self.compile_flags = tuple(compile_flags) if compile_flags else codegen.DEFAULT_FLAGS
+        # Default: SX (expanded) when interpreted; MX with mapped SX point functions when
+        # compiled, whose C code has loops over the grid and compiles in a time independent of
+        # the mesh size (see docs/ocp.md for measurements).
+        self.expand = (compiled is None) if expand is None else expand
         self.options = merge_options(DEFAULT_OPTIONS, options)
         self.builds: Counter[str] = Counter()
         n_p = len(problem.parameters)
@@ -96,7 +102,8 @@ class Transcription:
         key = options_key(options)
         if key not in self._solvers:
             name = f"ocp_solver_{len(self._solvers)}"
-            self._solvers[key] = make_solver(name, self._symbols, dict(options), self.compiled)
+            self._solvers[key] = make_solver(name, self._symbols, dict(options), self.compiled,
+                                              self.compile_flags)
             self.builds["solver"] += 1
         return self._solvers[key]
 
@@ -219,25 +226,31 @@ class Transcription:
 
 def transcribe(problem: Problem, *, method: str = "hermite-simpson",
                intervals: IntervalsSpec | Mapping[str, IntervalsSpec] | None = None,
-               expand: bool = True, compiled: str | None = None,
+               expand: bool | None = None, compiled: str | None = None,
                options: Mapping[str, Any] | None = None, scaling: bool = True,
-               cse: bool = True) -> Transcription:
+               cse: bool = True, compile_flags: Sequence[str] | None = None) -> Transcription:
     """Validate ``problem``, build its NLP and solver once, and return the transcription.
 
     Args:
         method: ``"hermite-simpson"`` (default) or ``"trapezoidal"``.
         intervals: None (each phase's ``intervals``), an int for all phases, or by phase name
             an int (uniform) or an array of normalised knots in [0, 1].
-        expand: evaluate in SX (faster) rather than MX.
-        compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk) or ``"jit"``.
+        expand: evaluate the NLP as one SX graph rather than MX with mapped point functions.
+            Default: True when not compiled (fastest interpreted), False when compiled (the
+            generated C loops over the grid, so compiling takes seconds at any mesh size).
+        compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk; recommended for
+            repeated solves of one problem) or ``"jit"`` (CasADi's jit, not cached).
         options: solver options over the defaults (``{"ipopt.tol": 1e-10}`` or
             ``{"ipopt": {"tol": 1e-10}}``).
         scaling: scale variables and constraints from bounds or given scales.
         cse: eliminate common subexpressions in the point and ends functions.
+        compile_flags: C compiler flags for ``compiled="codegen"`` (default
+            ``gaitopt.codegen.DEFAULT_FLAGS``, ``-O2``; ``("-O1", "-fPIC", "-shared")``
+            compiles faster).
     """
     if method not in METHODS:
         raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
     check_problem(problem)
     mesh = make_mesh(problem, intervals)
     return Transcription(problem, method, mesh, expand=expand, compiled=compiled,
-                         options=options, scaling=scaling, cse=cse)
+                         options=options, scaling=scaling, cse=cse, compile_flags=compile_flags)
