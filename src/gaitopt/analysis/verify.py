@@ -162,7 +162,6 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
 def _event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
     model = gait.model
     legs = biped_structure(model).legs
-    nq = model.nq
     events = {e.name: e for e in gait.events}
     strike, lift = events["heel_strike"], events["liftoff"]
     first, last = gait.phases[0], gait.phases[-1]

@@ -38,8 +38,17 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from gaitopt.dynamics.backend import Scalar, Scalars, as_scalars, atan2, cos, is_symbolic, sin, \
-    sqrt, vector
+from gaitopt.dynamics.backend import (
+    Scalar,
+    Scalars,
+    as_scalars,
+    atan2,
+    cos,
+    is_symbolic,
+    sin,
+    sqrt,
+    vector,
+)
 from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.robot.biped import BipedStructure, BipedStructureError, Leg, biped_structure

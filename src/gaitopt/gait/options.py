@@ -100,7 +100,8 @@ class GaitOptions:
         if unknown:
             raise GaitOptionsError(f"unknown gait option(s) {', '.join(unknown)}; known: "
                                    f"{', '.join(sorted(fields))}")
-        clean = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
+        clean: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v
+                                 for k, v in data.items()}
         return GaitOptions(**clean)
 
 

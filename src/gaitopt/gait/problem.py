@@ -8,7 +8,7 @@ support), ``f`` the single-support fraction. The objective is the paper's eq. 5:
 
 Constraints (``docs/walking.md`` lists each with its reason): torque bounds, joint limits, the
 polar box ``r_min <= r <= r_max`` on the stance leg, the swing tip above the ground, normal
-contact forces ``>= -relax`` at knots and midpoints, normal impulses ``>= -relax`` at the heel
+contact forces ``>= 0`` at knots and midpoints, normal impulses ``>= 0`` at the heel
 strike and the liftoff, the lifting tip moving up after liftoff, tip 2 landing at ``(L, 0)``,
 the front leg's reach in double support, optional friction cones, continuity of controls
 between the phases and periodicity of states (through the liftoff map) and controls with the
@@ -28,6 +28,7 @@ from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import walking
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
     BoundaryConstraint,
     ControlLinkage,
@@ -38,6 +39,7 @@ from gaitopt.ocp.problem import (
     Phase,
     Problem,
 )
+from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
@@ -47,15 +49,45 @@ _L, _V, _P = range(3)
 #: Largest forward lean of the virtual stance leg considered (rad), a generous box on alpha.
 ALPHA_BOUND = 1.3
 
+# Names of the unilateral contact conditions (relaxed by the first continuation stage).
+SS_FORCE = "stance contact force"
+DS_FORCES = "double support contact forces"
+STRIKE_IMPULSES = "heel strike normal impulses"
+LIFTOFF_CONDITIONS = "liftoff: held normal impulse, lifting tip rises"
+STRIKE_ALONE = "heel strike: normal impulse, trailing tip rises"
+
 
 @dataclass(frozen=True)
 class Relaxation:
     """How far the unilateral contact conditions may be violated (N, N s): 0 enforces them.
 
-    The continuation solves a relaxed problem first (the paper's two-stage process)."""
+    The continuation solves a relaxed problem first (the paper's two-stage process). The
+    relaxation is applied through the bounds of those rows (:func:`relaxed_bounds`), so
+    the relaxed and the enforced problem share one NLP."""
 
     force: float = 0.0
     impulse: float = 0.0
+
+
+def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
+    """The transcription's bounds with the unilateral contact conditions relaxed by
+    ``relax`` (lower bounds ``-relax.force`` on normal forces and friction rows,
+    ``-relax.impulse`` on normal impulses)."""
+    bounds = tr.bounds()
+    if relax == Relaxation():
+        return bounds
+    names = {ph.name for ph in tr.problem.phases}
+    if SINGLE in names:
+        bounds = bounds.with_rows(tr.path_rows(SINGLE, SS_FORCE), -relax.force, ca.inf)
+    if DOUBLE in names:
+        bounds = bounds.with_rows(tr.path_rows(DOUBLE, DS_FORCES), -relax.force, ca.inf)
+        bounds = bounds.with_constraint(STRIKE_IMPULSES, -relax.impulse, ca.inf)
+        first = tr.nlp.constraints.block(LIFTOFF_CONDITIONS).rows.start
+        bounds = bounds.with_rows(slice(first, first + 1), -relax.impulse, ca.inf)
+    else:
+        first = tr.nlp.constraints.block(STRIKE_ALONE).rows.start
+        bounds = bounds.with_rows(slice(first, first + 1), -relax.impulse, ca.inf)
+    return bounds
 
 
 class _PointCache:
@@ -95,8 +127,7 @@ def _limits(model: RobotModel, joint: str) -> tuple[float, float]:
     raise KeyError(joint)
 
 
-def walking_problem(model: RobotModel, options: GaitOptions,
-                    relax: Relaxation = Relaxation()) -> Problem:
+def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     """The OCP of one periodic step for ``model`` with ``options`` (see the module docstring).
 
     Call :func:`gaitopt.gait.options.validate_options` first.
@@ -153,7 +184,7 @@ def walking_problem(model: RobotModel, options: GaitOptions,
 
     hip_lo, hip_hi = _limits(model, stance.hip)
     ss_path = [
-        PathConstraint("stance contact force", ss_contact, lower=-relax.force, upper=ca.inf,
+        PathConstraint(SS_FORCE, ss_contact, lower=0.0, upper=ca.inf,
                        scale=model.total_mass * 9.81),
         PathConstraint("swing clearance and stance hip limit", ss_geometry,
                        lower=[0.0, hip_lo], upper=[ca.inf, hip_hi], scale=[0.1, 1.0]),
@@ -205,7 +236,7 @@ def walking_problem(model: RobotModel, options: GaitOptions,
 
         sw_lo, sw_hi = _limits(model, swing.hip)
         ds_path = [
-            PathConstraint("double support contact forces", ds_contact, lower=-relax.force,
+            PathConstraint(DS_FORCES, ds_contact, lower=0.0,
                            upper=ca.inf, scale=model.total_mass * 9.81),
             PathConstraint("front leg reach and hip limits", ds_geometry,
                            lower=[r_min, hip_lo, sw_lo], upper=[r_max, hip_hi, sw_hi]),
@@ -228,8 +259,8 @@ def walking_problem(model: RobotModel, options: GaitOptions,
             return vector([as_scalars(imp[stance.contact], 2, "i")[1],
                            as_scalars(imp[swing.contact], 2, "i")[1]])
 
-        events.append(BoundaryConstraint("heel strike normal impulses", strike_impulses,
-                                         lower=-relax.impulse, upper=ca.inf, scale=1.0))
+        events.append(BoundaryConstraint(STRIKE_IMPULSES, strike_impulses,
+                                         lower=0.0, upper=ca.inf, scale=1.0))
 
         def lift(ends: Mapping[str, Any], p: Any) -> walking.Transition:
             return walking.liftoff(model, ends[DOUBLE].xf, p[_L], p[_P])
@@ -244,8 +275,8 @@ def walking_problem(model: RobotModel, options: GaitOptions,
             v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
             return vector([held, v_up])
 
-        events.append(BoundaryConstraint("liftoff: held normal impulse, lifting tip rises",
-                                         liftoff_conditions, lower=[-relax.impulse, 0.0],
+        events.append(BoundaryConstraint(LIFTOFF_CONDITIONS,
+                                         liftoff_conditions, lower=[0.0, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
         # Controls: continuous across the heel strike, periodic with legs relabelled.
         shared = [n for n in ss_controls if n in ds_controls]
@@ -265,8 +296,8 @@ def walking_problem(model: RobotModel, options: GaitOptions,
             v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
             return vector([normal, v_up])
 
-        events.append(BoundaryConstraint("heel strike: normal impulse, trailing tip rises",
-                                         strike_conditions, lower=[-relax.impulse, 0.0],
+        events.append(BoundaryConstraint(STRIKE_ALONE,
+                                         strike_conditions, lower=[0.0, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
         if options.periodic_controls:
             linkages.append(_periodic_controls(model, SINGLE, ss_controls, ss_controls))

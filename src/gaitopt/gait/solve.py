@@ -36,8 +36,8 @@ import numpy as np
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait.guess import WalkingGuess, default_step_length, naive_guess
 from gaitopt.gait.options import GaitOptions, validate_options
-from gaitopt.gait.problem import Relaxation, parameter_bounds, walking_problem
-from gaitopt.ocp import Guess, PhaseGuess, Result, Transcription, transcribe
+from gaitopt.gait.problem import Relaxation, parameter_bounds, relaxed_bounds, walking_problem
+from gaitopt.ocp import Bounds, Guess, PhaseGuess, Result, Transcription, transcribe
 from gaitopt.robot.model import RobotModel
 
 #: Reference speed (m/s) for the continuation fallback: the paper's optimal 12 m/min.
@@ -102,21 +102,20 @@ _CACHE: dict[tuple[Any, ...], Transcription] = {}
 
 
 def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, int],
-                   relax: Relaxation, compiled: str | None) -> tuple[Any, ...]:
+                   compiled: str | None) -> tuple[Any, ...]:
     o = options
     return (model.content_hash(), o.ankle, o.single_support_fraction, tuple(knots),
             o.transcription, o.periodic_controls, o.friction, o.min_stance_knee_flexion,
             tuple(o.torso_bounds), o.rate_bound, o.max_impulse, o.tol, o.max_iter,
-            tuple(o.speed_bounds), tuple(o.step_length_bounds), relax, compiled)
+            tuple(o.speed_bounds), tuple(o.step_length_bounds), compiled)
 
 
-def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int, int],
-                      relax: Relaxation = Relaxation(), *, compiled: str | None = None
-                      ) -> Transcription:
+def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int, int], *,
+                      compiled: str | None = None) -> Transcription:
     """The (process-wide cached) transcription of the walking problem on ``knots``."""
-    key = _structure_key(model, options, knots, relax, compiled)
+    key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
-        problem = walking_problem(model, options.replace(knots=tuple(knots)), relax)
+        problem = walking_problem(model, options.replace(knots=tuple(knots)))
         intervals = {problem.phases[i].name: knots[i] - 1 for i in range(len(problem.phases))}
         _CACHE[key] = transcribe(
             problem, method=options.transcription, intervals=intervals, compiled=compiled,
@@ -124,6 +123,16 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int,
                      "ipopt.acceptable_tol": max(options.tol * 100, 1e-6),
                      "show_eval_warnings": False})
     return _CACHE[key]
+
+
+def held_ankles(model: RobotModel, tr: Transcription, bounds: Bounds) -> Bounds:
+    """``bounds`` with every ankle torque of every phase bounded to zero."""
+    ankles = {leg.ankle_actuator for leg in checked_biped(model).legs}
+    for ph in tr.problem.phases:
+        for name in ph.controls:
+            if name in ankles:
+                bounds = bounds.with_control(ph.name, name, 0.0, 0.0)
+    return bounds
 
 
 def ocp_guess(guess: WalkingGuess) -> Guess:
@@ -151,14 +160,19 @@ class _Run:
         self.results: list[tuple[Result, Transcription]] = []
 
     def stage(self, name: str, knots: tuple[int, int], relax: Relaxation,
-              guess: Guess | Result, bounds: dict[str, Any]) -> Result:
-        """Solve one stage; a Result guess also passes its multipliers to IPOPT."""
-        tr = transcription_for(self.model, self.options, knots, relax, compiled=self.compiled)
+              guess: Guess | Result, bounds: dict[str, Any], *,
+              hold_ankles: bool = False) -> Result:
+        """Solve one stage; a Result guess also passes its multipliers to IPOPT.
+        ``hold_ankles`` bounds the ankle torques to zero (the no-ankle gait)."""
+        tr = transcription_for(self.model, self.options, knots, compiled=self.compiled)
         start = time.perf_counter()
-        result = tr.solve(guess, parameters=bounds,
+        nlp_bounds = relaxed_bounds(tr, relax)
+        if hold_ankles:
+            nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
+        result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds,
                           warm_start_multipliers=isinstance(guess, Result))
         report = StageReport(
-            name=name, knots=tuple(knots), status=result.status, success=result.success,
+            name=name, knots=(knots[0], knots[1]), status=result.status, success=result.success,
             iterations=result.iterations, objective=result.objective,
             violation=result.constraint_violation, wall_time_s=time.perf_counter() - start,
             parameters=dict(result.parameters))
@@ -183,19 +197,28 @@ class _Run:
             guess = naive_guess(self.model, speed=speed, step_length=step0,
                                 single_support_fraction=o.single_support_fraction,
                                 knots=coarse, ankle=o.ankle, r_max=r_max)
-            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds)
+            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
+                                 hold_ankles=o.ankle)
             if not relaxed.success:
                 continue
-            enforced = self.stage("enforced contact", coarse, Relaxation(), relaxed, bounds)
+            enforced = self.stage("enforced contact", coarse, Relaxation(), relaxed, bounds,
+                                  hold_ankles=o.ankle)
             if enforced.success:
                 return enforced
         return None
 
     def release(self, result: Result) -> Result:
-        """Free what the cold stages held fixed: the impulse, then the speed."""
+        """Free what the cold stages held fixed: the ankle torques, the impulse, the speed."""
         o, coarse = self.options, coarse_knots(self.options)
         bounds = dict(parameter_bounds(o))
         speed = result.parameters["speed"]
+        if o.ankle:
+            b = dict(bounds)
+            b["speed"] = (speed, speed)
+            b["impulse"] = (0.0, 0.0)
+            result = self.stage("ankle torques free", coarse, Relaxation(), result, b)
+            if not result.success:
+                return result
         if o.impulse:
             b = dict(bounds)
             b["speed"] = (speed, speed)
@@ -211,7 +234,7 @@ class _Run:
         o = self.options
         if tuple(o.knots) == coarse_knots(o):
             return result
-        return self.stage("target grid", tuple(o.knots), Relaxation(), result,
+        return self.stage("target grid", o.knots, Relaxation(), result,
                           parameter_bounds(o))
 
     def speed_continuation(self, target: float) -> Result | None:
@@ -228,7 +251,7 @@ class _Run:
             b = dict(bounds)
             b["speed"] = (float(v), float(v))
             current = self.stage(f"continuation {v * 60:.1f} m/min", coarse_knots(o),
-                                 Relaxation(), current, b)
+                                 Relaxation(), current, b, hold_ankles=o.ankle)
             if not current.success:
                 return None
         return current
@@ -263,7 +286,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
     if warm_start is not None:
-        result = run.stage("warm start", tuple(options.knots), Relaxation(), warm_start,
+        result = run.stage("warm start", options.knots, Relaxation(), warm_start,
                            parameter_bounds(options))
         if not result.success:
             result = None

@@ -52,6 +52,7 @@ ORIGIN = (0.0, 0.0)
 def state_names(model: RobotModel, phase: str) -> tuple[str, ...]:
     """Names of the phase's states ``x = [z, zd]`` (rates end in ``_rate``)."""
     legs = checked_biped(model).legs
+    z: tuple[str, ...]
     if phase == SINGLE:
         z = ("r", "alpha", "torso", legs[1].hip, legs[1].knee)
     elif phase == DOUBLE:

@@ -75,6 +75,13 @@ class Bounds:
         lbg[rows], ubg[rows] = lo, hi
         return replace(self, lbg=lbg, ubg=ubg)
 
+    def with_rows(self, rows: NDArray[np.int64] | slice, lower: float | NDArray[np.float64],
+                  upper: float | NDArray[np.float64]) -> Bounds:
+        """Bound the constraint rows ``rows`` of g (see ``Transcription.path_rows``)."""
+        lbg, ubg = self.lbg.copy(), self.ubg.copy()
+        lbg[rows], ubg[rows] = lower, upper
+        return replace(self, lbg=lbg, ubg=ubg)
+
     def check(self) -> None:
         """Raise :class:`ProblemError` naming the first variable/row with lower > upper."""
         bad = np.flatnonzero(self.lbw > self.ubw)

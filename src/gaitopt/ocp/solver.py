@@ -128,6 +128,25 @@ def make_solver(name: str, nlp: NlpFunctions, options: Mapping[str, Any],
     raise ValueError(f"compiled must be one of {COMPILED_MODES}, got {compiled!r}")
 
 
+def solver_sharing_derivatives(name: str, base: ca.Function, n_w: int,
+                               options: Mapping[str, Any]) -> ca.Function:
+    """Another IPOPT solver of the same NLP as ``base`` with other ``options``.
+
+    It takes ``base``'s objective, constraint, gradient, Jacobian and Hessian functions
+    (``nlp_f``, ``nlp_g``, ``nlp_grad_f``, ``nlp_jac_g``, ``nlp_hess_l``) instead of deriving
+    them again, which for a large expanded NLP costs seconds at the first call of every new
+    solver.
+    """
+    fns = {k: base.get_function(k) for k in EVAL_KINDS}
+    x = ca.MX.sym("w", n_w)
+    p = ca.MX.sym("p", 0)
+    opts = dict(options)
+    opts.update(grad_f=fns["nlp_grad_f"], jac_g=fns["nlp_jac_g"], hess_lag=fns["nlp_hess_l"],
+                no_nlp_grad=True, calc_lam_p=False)
+    return ca.nlpsol(name, "ipopt", {"x": x, "f": fns["nlp_f"](x, p), "g": fns["nlp_g"](x, p)},
+                     opts)
+
+
 @dataclass(frozen=True)
 class SolverOutput:
     """What came back from one solver call (scaled vectors, as the solver saw them)."""

@@ -38,6 +38,7 @@ from gaitopt.ocp.solver import (
     merge_options,
     nlp_symbols,
     options_key,
+    solver_sharing_derivatives,
 )
 from gaitopt.ocp.validate import ProblemError, check_problem
 
@@ -102,12 +103,41 @@ class Transcription:
         key = options_key(options)
         if key not in self._solvers:
             name = f"ocp_solver_{len(self._solvers)}"
-            self._solvers[key] = make_solver(name, self._symbols, dict(options), self.compiled,
-                                              self.compile_flags)
+            if self._solvers:
+                # Same NLP, other options: reuse the first solver's derivative functions.
+                base = next(iter(self._solvers.values()))
+                self._solvers[key] = solver_sharing_derivatives(name, base, self.layout.size,
+                                                                dict(options))
+            else:
+                self._solvers[key] = make_solver(name, self._symbols, dict(options),
+                                                  self.compiled, self.compile_flags)
             self.builds["solver"] += 1
         return self._solvers[key]
 
     # -- bounds and guesses ----------------------------------------------------------------
+    def path_rows(self, phase: str, name: str) -> NDArray[np.int64]:
+        """Rows of g holding path constraint ``name`` of ``phase`` at every knot (and
+        midpoint, if it is imposed there), e.g. to relax it with ``Bounds.with_rows``."""
+        i = self.problem.phase_index(phase)
+        pf = self.phase_functions[i]
+        match = [pr for pr in pf.path_rows if pr.name == name]
+        if not match:
+            raise ProblemError(f"phase {phase!r} has no path constraint {name!r} (it has "
+                               f"{[pr.name for pr in pf.path_rows]})")
+        within = np.arange(pf.n_path)[match[0].rows]
+        out = []
+        knots = self.nlp.constraints.block(f"{phase}/path@knots")
+        n_knots = knots.shape[0]
+        for k in range(n_knots):
+            out.extend(knots.rows.start + k * pf.n_path + within)
+        mids = [b for b in self.nlp.constraints.blocks if b.name == f"{phase}/path@midpoints"]
+        if mids:
+            mr = list(pf.midpoint_rows)
+            within_mid = [mr.index(j) for j in within if j in mr]
+            for k in range(mids[0].shape[0]):
+                out.extend(mids[0].rows.start + k * len(mr) + np.asarray(within_mid, dtype=int))
+        return np.asarray(out, dtype=np.int64)
+
     def bounds(self) -> Bounds:
         """The statement's bounds (modify with ``Bounds.with_*`` and pass to :meth:`solve`)."""
         return self._bounds
