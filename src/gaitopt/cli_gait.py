@@ -68,13 +68,16 @@ def _knots(text: str) -> tuple[int, int]:
               help="Controls periodic as well as states (the paper), or states only.")
 @click.option("--friction", type=float, default=None,
               help="Friction coefficient of an optional friction-cone constraint.")
+@click.option("--unilateral-impulses/--paper-impulse-maps", default=True, show_default=True,
+              help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
+                   "the paper's maps as they are (the ground may pull a held tip).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, impulse: bool,
                   single_support: float, knots: str, transcription: str,
-                  periodic_controls: bool, friction: float | None, compiled: bool,
-                  output: Path) -> None:
+                  periodic_controls: bool, friction: float | None,
+                  unilateral_impulses: bool, compiled: bool, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
     from gaitopt.gait.api import as_model, solve_gait
@@ -85,7 +88,8 @@ def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, im
         speed=_speed(speed), step_length=_step(step_length), ankle=ankle, impulse=impulse,
         single_support_fraction=single_support, knots=_knots(knots),
         transcription=transcription,  # type: ignore[arg-type]
-        periodic_controls=periodic_controls, friction=friction)
+        periodic_controls=periodic_controls, friction=friction,
+        unilateral_impulses=unilateral_impulses)
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"

@@ -92,8 +92,8 @@ def test_coordinate_and_control_order_follow_design(five_link: RobotModel) -> No
 def test_default_torque_bounds_ankles_half_of_hips_and_knees(five_link: RobotModel) -> None:
     bounds = {a.name: a.limits for a in five_link.actuators}
     for leg in ("1", "2"):
-        assert bounds[f"hip_{leg}"] == bounds[f"knee_{leg}"] == (-150.0, 150.0)
-        assert bounds[f"ankle_{leg}"] == (-75.0, 75.0)
+        assert bounds[f"hip_{leg}"] == bounds[f"knee_{leg}"] == (-50.0, 50.0)
+        assert bounds[f"ankle_{leg}"] == (-25.0, 25.0)
         ankle = five_link.actuators[five_link.actuator_index(f"ankle_{leg}")]
         assert ankle.kind == "contact" and ankle.contact == f"tip_{leg}"
 

@@ -44,7 +44,7 @@ def test_show_five_link_prints_links_total_mass_and_inertias(runner: CliRunner) 
     for header in ("mass [kg]", "length [m]", "com [m]", "inertia [kg m^2]", "limits [rad]",
                    "limits [N m]"):
         assert header in out  # units are printed, not eaten as markup
-    for name in ("hip_1", "knee_2", "tip_1", "ankle_2", "[-150, 150]", "[-75, 75]",
+    for name in ("hip_1", "knee_2", "tip_1", "ankle_2", "[-50, 50]", "[-25, 25]",
                  "[-2.5, 0]"):
         assert name in out
     assert "[x, y, torso, hip_1, knee_1, hip_2, knee_2]" in out

@@ -138,10 +138,10 @@ def _gaits_for(rows: list[SummaryRow], amplitude: Callable[[bool], float]) -> di
 
 def test_saturation_finding_both_ways() -> None:
     rows = _sweep()
-    holds = assess_findings(rows, _gaits_for(rows, lambda imp: 60.0 if imp else 250.0))
+    holds = assess_findings(rows, _gaits_for(rows, lambda imp: 20.0 if imp else 80.0))
     assert holds["impulse_reduces_saturation"].holds is True
     assert holds["impulse_reduces_saturation"].numbers["saturation.impulse"] == 0.0
-    fails = assess_findings(rows, _gaits_for(rows, lambda imp: 300.0 if imp else 200.0))
+    fails = assess_findings(rows, _gaits_for(rows, lambda imp: 100.0 if imp else 70.0))
     assert fails["impulse_reduces_saturation"].holds is False
 
 

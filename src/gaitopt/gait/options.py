@@ -40,6 +40,10 @@ class GaitOptions:
         transcription: ``"hermite-simpson"`` (DIRCOL's) or ``"trapezoidal"``.
         periodic_controls: controls periodic (paper) as well as the states.
         friction: a friction coefficient for an optional friction-cone constraint, or None.
+        unilateral_impulses: the ground only pushes at the heel strike and the liftoff (normal
+            impulses >= 0 on every held tip). ``False`` uses the paper's maps as they are, in
+            which the held tip may be pulled (the liftoff impulse along the trailing leg lifts
+            the front tip unless the ground pulls it down; see docs/walking.md).
         min_stance_knee_flexion: smallest knee bend (rad, > 0) of a leg on the ground; it sets
             the largest hip-to-tip distance, the polar box ``r <= r_max`` (paper section 3.5),
             and keeps the leg inverse kinematics away from its singularity at a straight knee.
@@ -61,6 +65,7 @@ class GaitOptions:
     transcription: Transcription = "hermite-simpson"
     periodic_controls: bool = True
     friction: float | None = None
+    unilateral_impulses: bool = True
     min_stance_knee_flexion: float = 0.1
     torso_bounds: tuple[float, float] = (-0.8, 0.8)
     rate_bound: float = 15.0

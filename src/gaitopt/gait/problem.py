@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
+import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.reduced import checked_biped
@@ -76,17 +77,24 @@ def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
     bounds = tr.bounds()
     if relax == Relaxation():
         return bounds
+
+    def lower(b: Bounds, rows: Any, by: float) -> Bounds:
+        # Only ever loosen: a row without a lower bound keeps none.
+        return b.with_rows(rows, np.minimum(b.lbg[rows], -by), ca.inf)
+
+    def block_rows(name: str, count: int | None = None) -> slice:
+        rows = tr.nlp.constraints.block(name).rows
+        return rows if count is None else slice(rows.start, rows.start + count)
+
     names = {ph.name for ph in tr.problem.phases}
     if SINGLE in names:
-        bounds = bounds.with_rows(tr.path_rows(SINGLE, SS_FORCE), -relax.force, ca.inf)
+        bounds = lower(bounds, tr.path_rows(SINGLE, SS_FORCE), relax.force)
     if DOUBLE in names:
-        bounds = bounds.with_rows(tr.path_rows(DOUBLE, DS_FORCES), -relax.force, ca.inf)
-        bounds = bounds.with_constraint(STRIKE_IMPULSES, -relax.impulse, ca.inf)
-        first = tr.nlp.constraints.block(LIFTOFF_CONDITIONS).rows.start
-        bounds = bounds.with_rows(slice(first, first + 1), -relax.impulse, ca.inf)
+        bounds = lower(bounds, tr.path_rows(DOUBLE, DS_FORCES), relax.force)
+        bounds = lower(bounds, block_rows(STRIKE_IMPULSES), relax.impulse)
+        bounds = lower(bounds, block_rows(LIFTOFF_CONDITIONS, 1), relax.impulse)
     else:
-        first = tr.nlp.constraints.block(STRIKE_ALONE).rows.start
-        bounds = bounds.with_rows(slice(first, first + 1), -relax.impulse, ca.inf)
+        bounds = lower(bounds, block_rows(STRIKE_ALONE, 1), relax.impulse)
     return bounds
 
 
@@ -140,6 +148,8 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     r_min = max(leg.reach(_limits(model, leg.knee)[0]) for leg in legs)
     rate = options.rate_bound
     mu = options.friction
+    # Lower bound of the normal impulses on held tips at the events (the paper's maps: none).
+    impulse_floor = 0.0 if options.unilateral_impulses else -ca.inf
 
     ss_states = walking.state_names(model, SINGLE)
     ss_controls = walking.control_names(model, SINGLE, ankle=options.ankle)
@@ -260,7 +270,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
                            as_scalars(imp[swing.contact], 2, "i")[1]])
 
         events.append(BoundaryConstraint(STRIKE_IMPULSES, strike_impulses,
-                                         lower=0.0, upper=ca.inf, scale=1.0))
+                                         lower=impulse_floor, upper=ca.inf, scale=1.0))
 
         def lift(ends: Mapping[str, Any], p: Any) -> walking.Transition:
             return walking.liftoff(model, ends[DOUBLE].xf, p[_L], p[_P])
@@ -276,7 +286,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             return vector([held, v_up])
 
         events.append(BoundaryConstraint(LIFTOFF_CONDITIONS,
-                                         liftoff_conditions, lower=[0.0, 0.0],
+                                         liftoff_conditions, lower=[impulse_floor, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
         # Controls: continuous across the heel strike, periodic with legs relabelled.
         shared = [n for n in ss_controls if n in ds_controls]
@@ -297,7 +307,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             return vector([normal, v_up])
 
         events.append(BoundaryConstraint(STRIKE_ALONE,
-                                         strike_conditions, lower=[0.0, 0.0],
+                                         strike_conditions, lower=[impulse_floor, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
         if options.periodic_controls:
             linkages.append(_periodic_controls(model, SINGLE, ss_controls, ss_controls))

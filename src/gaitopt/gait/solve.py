@@ -105,7 +105,8 @@ def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, in
                    compiled: str | None) -> tuple[Any, ...]:
     o = options
     return (model.content_hash(), o.ankle, o.single_support_fraction, tuple(knots),
-            o.transcription, o.periodic_controls, o.friction, o.min_stance_knee_flexion,
+            o.transcription, o.periodic_controls, o.friction, o.unilateral_impulses,
+            o.min_stance_knee_flexion,
             tuple(o.torso_bounds), o.rate_bound, o.max_impulse, o.tol, o.max_iter,
             tuple(o.speed_bounds), tuple(o.step_length_bounds), compiled)
 
