@@ -158,6 +158,18 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
         Check("normal contact force (negative part)", max(0.0, -min_force), lim["force"], "N"),
         Check("held tips on the ground", tip_err, lim["tips"], "m"),
     ]
+    mu = gait.options.get("friction")
+    if mu is not None:
+        excess = 0.0
+        for ph in gait.phases:
+            for f in ph.contact_forces.values():
+                excess = max(excess, float(np.max(np.abs(f[:, 0]) - mu * f[:, 1])))
+        for e in gait.events:
+            for c, imp in e.impulses.items():
+                if not (e.name == "liftoff" and c == e.leg):
+                    excess = max(excess, abs(float(imp[0])) - mu * float(imp[1]))
+        checks.append(Check(f"friction cone mu = {mu:g} (excess at knots and events)",
+                            max(0.0, excess), lim["force"], "N|N s"))
     checks += _event_checks(gait, lim)
     checks += _sample_checks(gait, lim)
     checks.append(_cost_check(gait, lim))

@@ -56,6 +56,7 @@ DS_FORCES = "double support contact forces"
 STRIKE_IMPULSES = "heel strike normal impulses"
 LIFTOFF_CONDITIONS = "liftoff: held normal impulse, lifting tip rises"
 STRIKE_ALONE = "heel strike: normal impulse, trailing tip rises"
+EVENT_FRICTION = "friction cones of the event impulses"
 
 
 @dataclass(frozen=True)
@@ -95,6 +96,8 @@ def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
         bounds = lower(bounds, block_rows(LIFTOFF_CONDITIONS, 1), relax.impulse)
     else:
         bounds = lower(bounds, block_rows(STRIKE_ALONE, 1), relax.impulse)
+    if any(b.name == EVENT_FRICTION for b in tr.nlp.constraints.blocks):
+        bounds = lower(bounds, block_rows(EVENT_FRICTION), relax.impulse)
     return bounds
 
 
@@ -225,6 +228,24 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     def strike(ends: Mapping[str, Any], p: Any) -> walking.Transition:
         return walking.heel_strike(model, ends[SINGLE].xf, p[_L], double_support=two_phases)
 
+    def lift(ends: Mapping[str, Any], p: Any) -> walking.Transition:
+        return walking.liftoff(model, ends[DOUBLE].xf, p[_L], p[_P])
+
+    if mu is not None:
+        def event_friction(ends: Mapping[str, Any], p: Any) -> Any:
+            """``mu n -+ t >= 0`` for every impulse of the ground on a held tip."""
+            held = list(strike(ends, p).impulses.values())
+            if two_phases:
+                held.append(lift(ends, p).impulses[swing.contact])
+            rows = []
+            for impulse in held:
+                t_imp, n_imp = as_scalars(impulse, 2, "impulse")
+                rows += [mu * n_imp - t_imp, mu * n_imp + t_imp]
+            return vector(rows)
+
+        events.append(BoundaryConstraint(EVENT_FRICTION, event_friction, lower=0.0,
+                                         upper=ca.inf, scale=1.0))
+
     if two_phases:
         ds = _PointCache(
             lambda x, u, p: walking.double_support_point(model, x, u, ds_controls, p[_L]))
@@ -271,9 +292,6 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
 
         events.append(BoundaryConstraint(STRIKE_IMPULSES, strike_impulses,
                                          lower=impulse_floor, upper=ca.inf, scale=1.0))
-
-        def lift(ends: Mapping[str, Any], p: Any) -> walking.Transition:
-            return walking.liftoff(model, ends[DOUBLE].xf, p[_L], p[_P])
 
         linkages.append(Linkage(
             DOUBLE, SINGLE, name="liftoff impulse and periodicity (legs relabelled)",
