@@ -127,7 +127,9 @@ def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
     else:
         step = (options.step_length, options.step_length)
     speed = options.speed_bounds if options.speed is None else (options.speed, options.speed)
-    impulse = (0.0, options.max_impulse) if options.impulse else (0.0, 0.0)
+    # Without double support the trailing leg leaves at the heel strike with no impulse.
+    with_impulse = options.impulse and options.double_support
+    impulse = (0.0, options.max_impulse) if with_impulse else (0.0, 0.0)
     return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
 
 
@@ -231,6 +233,13 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     def lift(ends: Mapping[str, Any], p: Any) -> walking.Transition:
         return walking.liftoff(model, ends[DOUBLE].xf, p[_L], p[_P])
 
+    def departure(tr: walking.Transition) -> Any:
+        """At the event where tip 1 leaves the ground: the normal impulse on tip 2 (which
+        stays) and the vertical velocity of tip 1 afterwards (it must rise)."""
+        normal = as_scalars(tr.impulses[swing.contact], 2, "i")[1]
+        v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
+        return vector([normal, v_up])
+
     if mu is not None:
         def event_friction(ends: Mapping[str, Any], p: Any) -> Any:
             """``mu n -+ t >= 0`` for every impulse of the ground on a held tip."""
@@ -297,14 +306,9 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             DOUBLE, SINGLE, name="liftoff impulse and periodicity (legs relabelled)",
             jump=lambda xf, uf, p: walking.liftoff(model, xf, p[_L], p[_P]).x_next))
 
-        def liftoff_conditions(ends: Mapping[str, Any], p: Any) -> Any:
-            tr = lift(ends, p)
-            held = as_scalars(tr.impulses[swing.contact], 2, "i")[1]
-            v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
-            return vector([held, v_up])
-
         events.append(BoundaryConstraint(LIFTOFF_CONDITIONS,
-                                         liftoff_conditions, lower=[impulse_floor, 0.0],
+                                         lambda ends, p: departure(lift(ends, p)),
+                                         lower=[impulse_floor, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
         # Controls: continuous across the heel strike, periodic with legs relabelled.
         shared = [n for n in ss_controls if n in ds_controls]
@@ -318,14 +322,9 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             jump=lambda xf, uf, p: walking.heel_strike(model, xf, p[_L],
                                                        double_support=False).x_next))
 
-        def strike_conditions(ends: Mapping[str, Any], p: Any) -> Any:
-            tr = strike(ends, p)
-            normal = as_scalars(tr.impulses[swing.contact], 2, "i")[1]
-            v_up = walking.tip_vertical_velocity(model, tr.q, tr.qd_after, stance)
-            return vector([normal, v_up])
-
         events.append(BoundaryConstraint(STRIKE_ALONE,
-                                         strike_conditions, lower=[impulse_floor, 0.0],
+                                         lambda ends, p: departure(strike(ends, p)),
+                                         lower=[impulse_floor, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
         if options.periodic_controls:
             linkages.append(_periodic_controls(model, SINGLE, ss_controls, ss_controls))

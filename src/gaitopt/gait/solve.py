@@ -220,7 +220,7 @@ class _Run:
             result = self.stage("ankle torques free", coarse, Relaxation(), result, b)
             if not result.success:
                 return result
-        if o.impulse:
+        if o.impulse and o.double_support:
             b = dict(bounds)
             b["speed"] = (speed, speed)
             result = self.stage("liftoff impulse free", coarse, Relaxation(), result, b)
