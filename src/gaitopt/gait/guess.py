@@ -80,8 +80,14 @@ def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple
 
 def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                 single_support_fraction: float, knots: tuple[int, int], ankle: bool,
-                r_max: float, clearance: float | None = None) -> WalkingGuess:
-    """The geometric guess described in the module docstring (knot values per phase)."""
+                r_max: float, clearance: float | None = None,
+                ankle_torques: bool | None = None) -> WalkingGuess:
+    """The geometric guess described in the module docstring (knot values per phase).
+
+    ``ankle`` says whether the controls include the ankle torques; ``ankle_torques`` (default:
+    ``ankle``) whether the least-squares torques may use them (``False``: they are zero, the
+    guess of a stage that holds the ankles at zero)."""
+    use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
     legs = checked_biped(model).legs
     v, step, f = speed, step_length, single_support_fraction
     total = step / v
@@ -108,7 +114,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
             q_fine[k, leg.hip_index] = float(joints.hip)
             q_fine[k, leg.knee_index] = float(joints.knee)
     phases.append(_phase_guess(model, SINGLE, t_fine, q_fine, _knots(0.0, t1, knots[0]),
-                               ankle, [legs[0].contact], step))
+                               ankle, use_ankles, [legs[0].contact]))
     if f < 1.0:
         t_fine = np.linspace(t1, t1 + t2, _FINE)
         p_hip = hip(t_fine)
@@ -121,17 +127,19 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                 q_fine[k, leg.hip_index] = float(joints.hip)
                 q_fine[k, leg.knee_index] = float(joints.knee)
         phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
-                                   _knots(t1, t2, knots[1]), ankle,
-                                   [legs[0].contact, legs[1].contact], step))
+                                   _knots(t1, t2, knots[1]), ankle, use_ankles,
+                                   [legs[0].contact, legs[1].contact]))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
 
 def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_knots: Array,
-                 ankle: bool, held: list[str], step: float) -> PhaseGuess:
+                 ankle: bool, use_ankles: bool, held: list[str]) -> PhaseGuess:
     qd_fine = np.gradient(q_fine, t_fine, axis=0)
     qdd_fine = np.gradient(qd_fine, t_fine, axis=0)
     controls = walking.control_names(model, phase, ankle=ankle)
+    acting = walking.control_names(model, phase, ankle=use_ankles)
+    columns = [controls.index(name) for name in acting]
     xs, us = [], []
     for t in t_knots:
         q = np.array([np.interp(t, t_fine, q_fine[:, i]) for i in range(model.nq)])
@@ -142,5 +150,7 @@ def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_
         else:
             x = walking.full_to_double_support(model, q, qd)
         xs.append(np.asarray(x, dtype=float).reshape(-1))
-        us.append(_torques(model, q, qd, qdd, controls, held))
+        u = np.zeros(len(controls))
+        u[columns] = _torques(model, q, qd, qdd, acting, held)
+        us.append(u)
     return PhaseGuess(name=phase, t=np.asarray(t_knots), x=np.array(xs), u=np.array(us))

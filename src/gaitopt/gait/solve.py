@@ -197,7 +197,8 @@ class _Run:
         for step0 in steps:
             guess = naive_guess(self.model, speed=speed, step_length=step0,
                                 single_support_fraction=o.single_support_fraction,
-                                knots=coarse, ankle=o.ankle, r_max=r_max)
+                                knots=coarse, ankle=o.ankle, r_max=r_max,
+                                ankle_torques=False)
             relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
                                  hold_ankles=o.ankle)
             if not relaxed.success:
@@ -231,11 +232,19 @@ class _Run:
         return result
 
     def refine(self, result: Result) -> Result:
-        """Stage 3: the requested grid, when finer than the coarse one."""
+        """The requested grid, when finer than the coarse one: first with the step length and
+        speed held at the coarse solution's (a fine grid started from a coarse solution with
+        them free can wander to a far worse local optimum), then released."""
         o = self.options
         if tuple(o.knots) == coarse_knots(o):
             return result
-        return self.stage("target grid", o.knots, Relaxation(), result,
+        held = dict(parameter_bounds(o))
+        for name in ("step_length", "speed"):
+            held[name] = (result.parameters[name], result.parameters[name])
+        fine = self.stage("target grid", o.knots, Relaxation(), result, held)
+        if not fine.success or (o.step_length is not None and o.speed is not None):
+            return fine
+        return self.stage("target grid, all free", o.knots, Relaxation(), fine,
                           parameter_bounds(o))
 
     def speed_continuation(self, target: float) -> Result | None:
