@@ -273,3 +273,18 @@ def contact_forces(ref: Reference, q: Array, qd: Array, u: Array,
     rhs = np.concatenate([ref.actuation(q, held) @ u - ref.bias(q, qd), -jdot_qd])
     sol = np.linalg.solve(kkt, rhs)
     return sol[nq:].reshape(len(held), 2)
+
+
+def lowest_sample_normal_force(ref: Reference, gait: Gait) -> float:
+    """The smallest normal force (N) over the dense samples, each sample evaluated with the
+    contacts of its own phase: single support up to and including the heel strike (that
+    sample holds the pre-impact velocity), double support after it."""
+    s = gait.samples
+    strike = next(e for e in gait.events if e.name == "heel_strike")
+    lowest = np.inf
+    for i, ph in enumerate(gait.phases):
+        inside = (s.t <= strike.t) if i == 0 else (s.t > strike.t)
+        for k in np.flatnonzero(inside):
+            f = contact_forces(ref, s.q[k], s.qd[k], s.u[k], ph.contacts)
+            lowest = min(lowest, float(np.min(f[:, 1])))
+    return lowest

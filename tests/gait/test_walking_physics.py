@@ -19,8 +19,10 @@ from tests.gait.conftest import (
     Reference,
     Solved,
     assert_physics,
+    contact_forces,
     eom_residuals,
     held_tip_errors,
+    lowest_sample_normal_force,
     periodicity_errors,
     recomputed_cost,
 )
@@ -179,3 +181,17 @@ def test_cost_recomputed_from_the_file_equals_the_reported_one(default_gait: Gai
 def test_assert_physics_helper_accepts_the_default_gait(
         default_gait: Gait, reference: RefFn) -> None:
     assert_physics(reference(default_gait.model), default_gait)
+
+
+def test_saved_forces_are_pinocchios_contact_forces(default_gait: Gait,
+                                                    reference: RefFn) -> None:
+    """Forward contact dynamics from the saved (q, qd, u) with Pinocchio's M, h, J gives the
+    saved contact forces at every knot (and the dense samples have no negative normal
+    force)."""
+    ref = reference(default_gait.model)
+    for ph in default_gait.phases:
+        for k in range(ph.t.size):
+            f = contact_forces(ref, ph.q[k], ph.qd[k], ph.u[k], ph.contacts)
+            saved = np.array([ph.contact_forces[c][k] for c in ph.contacts])
+            np.testing.assert_allclose(f, saved, atol=1e-7 * default_gait.model.total_mass)
+    assert lowest_sample_normal_force(ref, default_gait) >= -1e-3
