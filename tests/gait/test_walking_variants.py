@@ -165,3 +165,18 @@ def test_friction_cone_holds_at_every_knot(solved: SolveFn, default_gait: Gait,
 def test_friction_cone_gait_needs_no_more_friction_than_mu(solved: SolveFn) -> None:
     gait = solved(GaitOptions(friction=MU)).gait
     assert gait_metrics(gait).friction_required <= MU * (1 + 1e-3)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the ankle problem contains the no-ankle problem (ankle torques 0), yet at 6 m/min the "
+    "default solve of the ankle variants stops at J 1060 (L 0.143 m; verify fails: interval "
+    "error 0.41, knee limit exceeded by 0.22 rad between knots) while the no-ankle variants "
+    "reach J 755.6 (L 0.063 m). The split happens in the first stage: 'relaxed contact' "
+    "with the ankles held at 0 (solve.py _Run.cold, hold_ankles) ends at J 916, L 0.158 m "
+    "in the ankle transcription but at J 586, L 0.094 m in the no-ankle one, from the same "
+    "naive guess (the same problem, other fixed variables in the NLP)"))
+def test_ankle_optimum_is_no_worse_than_without_ankles_at_6_m_min(solved: SolveFn) -> None:
+    ankle = solved(GaitOptions(speed=0.1)).gait
+    plain = solved(GaitOptions(speed=0.1, ankle=False)).gait
+    assert ankle.success and plain.success
+    assert ankle.cost_value <= plain.cost_value * (1 + REL)
