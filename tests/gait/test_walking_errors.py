@@ -12,7 +12,7 @@ from gaitopt.gait.api import solve_gait, solve_gait_solution
 from gaitopt.gait.gait_file import FAILED_WARNING, Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.record import gait_from_solution
-from gaitopt.robot import load_model
+from gaitopt.robot import ModelError, load_model
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.robot.loader import builtin_text
 
@@ -95,3 +95,8 @@ def test_a_forced_failure_is_reported_as_failed(tmp_path: Path) -> None:
     gait.save(target, allow_failed=True)
     assert FAILED_WARNING in target.read_text()
     assert not Gait.load(target).success
+
+
+def test_missing_model_file_raises_model_error(no_solve: None, tmp_path: Path) -> None:
+    with pytest.raises(ModelError, match="no-such.yaml"):
+        solve_gait(tmp_path / "no-such.yaml", GaitOptions())
