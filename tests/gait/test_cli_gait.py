@@ -1,0 +1,125 @@
+"""``gaitopt solve``: writes a verified gait file; refuses bad requests with one line (exit 2)
+before solving; reports a failed solve (exit 1, no file, the failed stage named)."""
+
+from __future__ import annotations
+
+import functools
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+from click.testing import CliRunner, Result
+
+from gaitopt.cli import cli
+from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.options import GaitOptions
+from tests.gait.test_walking_errors import one_legged_model_file
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def solve(*args: str) -> Result:
+    return CliRunner().invoke(cli, ["solve", *args])
+
+
+def test_solve_prints_a_summary_and_writes_a_gait_that_verifies(
+        tmp_path: Path, default_gait: Gait) -> None:
+    out = tmp_path / "walk.gait.json"
+    result = solve("-o", str(out))
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    for stage in ("relaxed contact", "enforced contact", "ankle torques free"):
+        assert f"stage {stage}" in text
+    for item in ("0.2000 m/s (12.00 m/min)", "step length", "step time", "cost (energy per "
+                 "metre)", "peak torque hip_1", "smallest normal force", "swing clearance",
+                 "NLP size", "iterations", "wall time"):
+        assert item in text, item
+    assert f"wrote{out}" in "".join(result.output.split())  # rich may wrap a long path
+    gait = Gait.load(out)
+    assert gait.success and gait.options == default_gait.options
+    # The same problem as the API's default solve, with the same optimum.
+    assert gait.cost_value == pytest.approx(default_gait.cost_value, rel=1e-6)
+    assert gait.step_length == pytest.approx(default_gait.step_length, rel=1e-5)
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]  # atomic: no temporary left
+    verified = CliRunner().invoke(cli, ["verify", str(out)])
+    assert verified.exit_code == 0, verified.output
+
+
+@pytest.fixture
+def no_solve(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("a solve was started for a request that should be refused")
+
+    monkeypatch.setattr("gaitopt.gait.solve.transcription_for", refuse)
+
+
+BAD_REQUESTS: dict[str, tuple[list[str], tuple[str, ...]]] = {
+    "negative speed": (["--speed", "-3m/min"], ("speed", "> 0")),
+    "zero speed": (["--speed", "0m/min"], ("speed", "> 0")),
+    "speed without a number": (["--speed", "fast"], ("--speed",)),
+    "speed with an unknown unit": (["--speed", "3mph"], ("--speed", "unit")),
+    "three knot counts": (["--knots", "8,5,3"], ("--knots",)),
+    "knots not numbers": (["--knots", "a,b"], ("--knots",)),
+    "too few knots": (["--knots", "2,5"], ("knots",)),
+    "too many knots": (["--knots", "8,999"], ("knots",)),
+    "step longer than the legs reach": (["--step-length", "2.5"], ("step_length", "reach")),
+    "step length not a number": (["--step-length", "long"], ("--step-length",)),
+    "single support fraction zero": (["--single-support", "0"], ("single_support_fraction",)),
+    "negative friction": (["--friction", "-0.5"], ("friction",)),
+    "unknown model": (["--model", "no-such-model"], ("no-such-model",)),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_REQUESTS))
+def test_bad_request_exits_2_with_one_line_before_solving(no_solve: None, tmp_path: Path,
+                                                          case: str) -> None:
+    args, words = BAD_REQUESTS[case]
+    out = tmp_path / "g.gait.json"
+    result = solve(*args, "-o", str(out))
+    assert result.exit_code == 2, (result.output, result.exception)
+    assert isinstance(result.exception, SystemExit)  # a handled error, not a crash
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert "stage" not in result.stdout and not out.exists()
+
+
+def test_model_without_two_legs_exits_2(no_solve: None, tmp_path: Path) -> None:
+    result = solve("--model", str(one_legged_model_file(tmp_path)), "-o",
+                   str(tmp_path / "g.gait.json"))
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "two contact points" in lines[0]
+
+
+def test_negative_speed_in_a_real_process_prints_no_traceback(tmp_path: Path) -> None:
+    """The installed entry point (``python -m gaitopt``): one line on stderr, exit 2."""
+    out = tmp_path / "g.gait.json"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    proc = subprocess.run([sys.executable, "-m", "gaitopt", "solve", "--speed", "-3m/min",
+                           "-o", str(out)], capture_output=True, text=True, env=env,
+                          timeout=120, check=False)
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr + proc.stdout
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: ") and "speed" in lines[0]
+    assert not out.exists()
+
+
+def test_failed_solve_exits_1_names_the_stage_and_writes_nothing(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Forced failure: 3 IPOPT iterations per stage, no continuation (the CLI has no option
+    for that, so the options it builds are patched)."""
+    monkeypatch.setattr("gaitopt.cli_gait.GaitOptions",
+                        functools.partial(GaitOptions, max_iter=3, continuation=False))
+    out = tmp_path / "g.gait.json"
+    result = solve("-o", str(out))
+    assert result.exit_code == 1, result.output
+    text = " ".join(result.output.split())
+    assert "FAILED at stage 'relaxed contact': Maximum_Iterations_Exceeded" in text
+    assert "No gait file written" in text
+    assert not out.exists() and list(tmp_path.iterdir()) == []
