@@ -40,8 +40,6 @@ def _knots(text: str) -> tuple[int, int]:
         values = tuple(int(p) for p in parts)
     except ValueError:
         values = ()
-    if len(values) == 1:
-        values = (values[0], 5)
     if len(values) != 2:
         raise UserError(f"--knots: {text!r} must be two integers 'single,double', e.g. 8,5")
     return (values[0], values[1])

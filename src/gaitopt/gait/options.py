@@ -135,7 +135,7 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
     if o.speed is not None:
         speed = _finite("speed", o.speed)
         if speed <= 0.0:
-            raise GaitOptionsError(f"speed = {speed:g} m/s: must be > 0 (or free)")
+            raise GaitOptionsError(f"speed = {format_speed(speed)}: must be > 0 (or free)")
         if not v_lo <= speed <= v_hi:
             raise GaitOptionsError(f"speed = {format_speed(speed)}: must lie in speed_bounds "
                                    f"[{format_speed(v_lo)}, {format_speed(v_hi)}]")
@@ -175,7 +175,7 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         raise GaitOptionsError(f"transcription = {o.transcription!r}: must be "
                                "'hermite-simpson' or 'trapezoidal'")
     if o.friction is not None and not _finite("friction", o.friction) > 0.0:
-        raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 (or None for no cone)")
+        raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 (leave it unset for no friction cone)")
     t_lo, t_hi = _bounds("torso_bounds", o.torso_bounds)
     if not t_lo <= 0.0 <= t_hi:
         raise GaitOptionsError(f"torso_bounds = ({t_lo:g}, {t_hi:g}) rad: must contain 0 "
