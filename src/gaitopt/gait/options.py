@@ -175,7 +175,8 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         raise GaitOptionsError(f"transcription = {o.transcription!r}: must be "
                                "'hermite-simpson' or 'trapezoidal'")
     if o.friction is not None and not _finite("friction", o.friction) > 0.0:
-        raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 (leave it unset for no friction cone)")
+        raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 "
+                               "(leave it unset for no friction cone)")
     t_lo, t_hi = _bounds("torso_bounds", o.torso_bounds)
     if not t_lo <= 0.0 <= t_hi:
         raise GaitOptionsError(f"torso_bounds = ({t_lo:g}, {t_hi:g}) rad: must contain 0 "
