@@ -194,16 +194,16 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
         nonlocal task_id
         c = start.counts
         console.print(f"sweep {start.directory}: {c.total} points, {c.kept} kept from an "
-                      f"earlier run, {c.to_solve} to solve on {start.backend}")
+                      f"earlier run, {c.to_solve} to solve on {start.backend}", soft_wrap=True)
         for note in start.notes:
-            console.print(f"  note: {note}")
+            console.print(f"  note: {note}", soft_wrap=True)
         if c.to_solve:
             progress.start()
             task_id = progress.add_task("solving", total=c.to_solve, failed=0,
                                         remaining=c.to_solve)
 
     def on_point(point: SweepPoint, outcome: PointOutcome, counts: Counts) -> None:
-        progress.console.print(point_line(point, outcome))
+        progress.console.print(point_line(point, outcome), soft_wrap=True)
         progress.update(task_id, completed=counts.finished, failed=counts.failed,
                         remaining=counts.remaining)
 
@@ -218,14 +218,14 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
     c = report.counts
     if report.interrupted:
         console.print(f"interrupted after {c.finished} of {c.to_solve} points; every finished "
-                      "point is saved: rerun the same command to resume")
+                      "point is saved: rerun the same command to resume", soft_wrap=True)
         sys.exit(130)
     console.print(f"done in {report.wall_time_s:.1f} s: {c.succeeded} solved, {c.failed} "
                   f"failed, {c.kept} kept ({c.total} points); summary: "
-                  + ", ".join(str(p) for p in report.summaries))
+                  + ", ".join(str(p) for p in report.summaries), soft_wrap=True)
     if c.failed:
         console.print("failed points are listed in the summary as failed; rerun the same "
-                      "command to try them again")
+                      "command to try them again", soft_wrap=True)
     return report
 
 
@@ -299,10 +299,11 @@ def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
             info = write_report(sweep, target)
         except SummaryError as exc:
             raise UserError(str(exc)) from None
-        console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)")
+        console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)",
+                      soft_wrap=True)
         for problem in info.problems:
-            console.print(f"  problem: {problem}")
-        console.print(findings_text(info.findings))
+            console.print(f"  problem: {problem}", soft_wrap=True)
+        console.print(findings_text(info.findings), soft_wrap=True)
         pages.append(info.html)
     return pages
 
@@ -332,7 +333,7 @@ def animate_file(console: Console, file: Path, output: Path, *, steps: int, fps:
         raise UserError(str(exc)) from None
     console.print(f"animation: {info.path} ({info.frames} frames, {info.duration_s:.2f} s at "
                   f"{info.fps:g} fps, {steps} steps of {gait.speed * 60:.1f} m/min; written "
-                  f"in {time.perf_counter() - start:.1f} s)")
+                  f"in {time.perf_counter() - start:.1f} s)", soft_wrap=True)
 
 
 @cli.command("animate")
@@ -380,10 +381,12 @@ def study_command(directory: Path, model_name: str, speeds: str, workers: int | 
         animate_file(console, directory / best.file, out / "optimal-walk.gif", steps=4,
                      fps=30)
         console.print(f"(the animated gait is the {best.variant} optimum, "
-                      f"{best.speed_m_min:.1f} m/min, step {best.step_length:.3f} m)")
+                      f"{best.speed_m_min:.1f} m/min, step {best.step_length:.3f} m)",
+                      soft_wrap=True)
     else:
-        console.print("no point converged: no animation")
-    console.print(f"study done in {time.perf_counter() - start:.0f} s. Open {pages[0]}")
+        console.print("no point converged: no animation", soft_wrap=True)
+    console.print(f"study done in {time.perf_counter() - start:.0f} s. Open {pages[0]}",
+                  soft_wrap=True)
 
 
 __all__ = ["animate_command", "parse_speeds", "parse_variants", "report_command",

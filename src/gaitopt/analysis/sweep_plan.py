@@ -127,7 +127,8 @@ def start_index(speeds: Sequence[float]) -> int:
     """Index of the speed nearest :data:`START_SPEED` (the lower one on a tie)."""
     if not speeds:
         return 0
-    return min(range(len(speeds)), key=lambda i: (abs(speeds[i] - START_SPEED), speeds[i]))
+    return min(range(len(speeds)),  # distances compared in m/min to 1e-6: ties are ties
+               key=lambda i: (round(abs(speeds[i] - START_SPEED) * 60.0, 6), speeds[i]))
 
 
 def axis_tag(single_support: float, step_length: float | None) -> str:
