@@ -20,7 +20,7 @@ import threading
 import time
 import traceback
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions
@@ -68,7 +68,10 @@ class PointOutcome:
     the final engine result when the point succeeded (for its neighbours), else None;
     ``warm`` how it started (``result``, ``file``, ``none``, or ``file unreadable``);
     ``fell_back`` whether a warm start failed and the cold path was taken;
-    ``iterations`` the IPOPT iterations over all stages; ``worker`` host:pid.
+    ``iterations`` the IPOPT iterations over all stages; ``worker`` host:pid; ``timings``
+    where the time went (s): ``warm_start_s`` (reading a gait file), ``build_and_setup_s``
+    (transcription build on a process's first point of a structure, guesses), ``ipopt_s``
+    (the stages' solves), ``record_s`` (the gait record), ``write_s`` (the atomic save).
     """
 
     key: str
@@ -82,6 +85,7 @@ class PointOutcome:
     worker: str
     structures: frozenset[str]
     error: str = ""
+    timings: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
@@ -123,8 +127,10 @@ def _failure_status(solution: WalkingSolution) -> str:
 def solve_point(task: PointTask) -> PointOutcome:
     """Solve one point (see the module docstring). Never raises for a failed solve or an
     error inside it: the outcome's row says failed and why."""
-    start = time.perf_counter()
+    clock = time.perf_counter
+    start = clock()
     warm, how = _warm_start(task)
+    timings = {"warm_start_s": clock() - start}
     options = task.options.replace(max_iter=1) if task.force_fail else task.options
     solution: WalkingSolution | None = None
     result: Result | None = None
@@ -132,21 +138,28 @@ def solve_point(task: PointTask) -> PointOutcome:
     try:
         with _LOCK:
             solution = solve_walking(task.model, options, warm_start=warm)
+            ipopt = sum(s.wall_time_s for s in solution.stages)
+            timings["ipopt_s"] = ipopt
+            timings["build_and_setup_s"] = solution.wall_time_s - ipopt
+            mark = clock()
             gait = gait_from_solution(solution) if solution.success else None
+            timings["record_s"] = clock() - mark
         if solution.success and gait is not None:
+            mark = clock()
             gait.save(task.path)
+            timings["write_s"] = clock() - mark
             ankle, impulse = variant_flags(task.variant)
             row = summary_row(gait, ankle=ankle, impulse=impulse, speed_mode=task.speed_mode,
                               file=task.relfile)
             result = solution.result
         else:
             row = failed_point_row(task, _failure_status(solution),
-                          iterations=sum(s.iterations for s in solution.stages),
-                          wall_time_s=solution.wall_time_s)
+                                   iterations=sum(s.iterations for s in solution.stages),
+                                   wall_time_s=solution.wall_time_s)
     except Exception as exc:  # a bug or an OS error: record the point as failed, go on
         error = traceback.format_exc()
         row = failed_point_row(task, f"error: {type(exc).__name__}: {exc}",
-                      wall_time_s=time.perf_counter() - start)
+                               wall_time_s=clock() - start)
     if not task.force_fail:
         _BUILT.add(task.structure)
     stages = solution.stages if solution is not None else ()
@@ -154,8 +167,8 @@ def solve_point(task: PointTask) -> PointOutcome:
         key=task.key, row=row, result=result, warm=how,
         fell_back=warm is not None and bool(stages) and not stages[0].success,
         stages=len(stages), iterations=sum(s.iterations for s in stages),
-        wall_time_s=time.perf_counter() - start, worker=worker_name(),
-        structures=frozenset(_BUILT), error=error)
+        wall_time_s=clock() - start, worker=worker_name(),
+        structures=frozenset(_BUILT), error=error, timings=timings)
 
 
 def gait_file_matches(gait: Gait, model: RobotModel, options: GaitOptions) -> str:
