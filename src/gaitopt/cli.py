@@ -184,6 +184,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 # Subcommands defined in their own modules register themselves on ``cli`` when imported.
 from gaitopt import cli_gait  # noqa: E402,F401,I001  (imported for its side effect)
+from gaitopt import cli_study  # noqa: E402,F401,I001  (imported for its side effect)
 
 __all__ = ["USER_ERRORS", "UserError", "cli", "main", "make_console", "model_tables"]
 

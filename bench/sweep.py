@@ -1,0 +1,154 @@
+"""Benchmark of a sweep: 4 variants x 20 speeds (3..60 m/min step 3) on local processes.
+
+Measures, in one run: the wall time of the sweep from scratch (process start, transcription
+builds, solves, file writes) and resumed (nothing left to solve), solves per minute, and where
+the time goes (summed over the points: transcription builds, IPOPT, gait records, file
+writes; process start measured separately), against references measured in the same run: a
+worker pool's start-up and one transcription build in this process. Target: under 60 s for
+the 80 points on the 2-core reference machine.
+
+    PYTHONPATH=src python bench/sweep.py [--workers 2] [--speeds 3:60:3] [--free]
+        [--start-methods forkserver,spawn]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+from gaitopt.analysis.executors import local_backend
+from gaitopt.analysis.sweep import run_sweep
+from gaitopt.analysis.sweep_plan import SweepSpec
+from gaitopt.analysis.sweep_worker import PointOutcome
+from gaitopt.cli_study import parse_speeds
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.solve import transcription_for
+from gaitopt.robot import load_model
+from gaitopt.viz.summary import VARIANTS
+
+
+def noop(x: int) -> int:
+    import gaitopt.analysis.sweep_worker  # noqa: F401  (what a real worker imports)
+
+    return os.getpid()
+
+
+def pool_start_s(workers: int, method: str) -> float:
+    """Time until every worker of a new pool has run a task (process start + imports)."""
+    start = time.perf_counter()
+    backend = local_backend(workers, start_method=method)
+    futures = [backend.submit(noop, i) for i in range(workers * 4)]
+    for f in futures:
+        f.result()
+    elapsed = time.perf_counter() - start
+    backend.close()
+    return elapsed
+
+
+def build_s() -> float:
+    """One transcription build (the no-ankle structure) in this process."""
+    start = time.perf_counter()
+    transcription_for(load_model("five-link"), GaitOptions(ankle=False), (8, 5))
+    return time.perf_counter() - start
+
+
+def sweep_once(spec: SweepSpec, folder: Path, workers: int, method: str
+               ) -> tuple[float, list[PointOutcome], int]:
+    """One run of the sweep; the process pool is started only when there is work (as the
+    command does), so a resumed run with nothing left starts none."""
+    start = time.perf_counter()
+    backend = local_backend(workers, start_method=method) if not folder.exists() else None
+    try:
+        report = run_sweep(spec, folder, backend=backend, workers=workers)
+    finally:
+        if backend is not None:
+            backend.close()
+    return time.perf_counter() - start, list(report.outcomes), report.counts.kept
+
+
+def breakdown(outcomes: list[PointOutcome]) -> dict[str, float]:
+    total: dict[str, float] = {}
+    for o in outcomes:
+        for k, v in o.timings.items():
+            total[k] = total.get(k, 0.0) + v
+    total["point_total_s"] = sum(o.wall_time_s for o in outcomes)
+    return total
+
+
+def builds(outcomes: list[PointOutcome]) -> int:
+    """Transcriptions built: (worker, structure) pairs (a worker builds each at most once)."""
+    seen: set[tuple[str, str]] = set()
+    for o in outcomes:
+        seen |= {(o.worker, s) for s in o.structures}
+    return len(seen)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--speeds", default="3:60:3", help="m/min, as for gaitopt sweep")
+    parser.add_argument("--free", action="store_true", help="also the speed-free optima")
+    parser.add_argument("--start-methods", default="forkserver")
+    args = parser.parse_args()
+
+    spec = SweepSpec(model=load_model("five-link"), speeds=parse_speeds(args.speeds),
+                     variants=VARIANTS, free_speed=args.free)
+    n = len(spec.points)
+    load = os.getloadavg()[0]
+    print(f"sweep benchmark: {len(spec.variants)} variants x {len(spec.speeds)} speeds"
+          f"{' + free' if args.free else ''} = {n} points, {args.workers} workers, "
+          f"{os.cpu_count()} CPUs, load average before: {load:.2f}")
+    ref_build = build_s()
+    print(f"reference: one transcription build in this process: {ref_build:.2f} s")
+
+    rows = []
+    for method in args.start_methods.split(","):
+        start_s = pool_start_s(args.workers, method)
+        with tempfile.TemporaryDirectory(prefix="gaitopt-bench-sweep-") as tmp:
+            folder = Path(tmp) / "sweep"
+            cold, outcomes, _ = sweep_once(spec, folder, args.workers, method)
+            resumed, again, kept = sweep_once(spec, folder, args.workers, method)
+        ok = sum(o.success for o in outcomes)
+        parts = breakdown(outcomes)
+        warm = [o.timings.get("ipopt_s", 0.0) for o in outcomes if o.warm == "result"]
+        fallbacks = sum(o.fell_back for o in outcomes)
+        rows.append((method, cold, resumed, ok, len(again), kept))
+        print(f"\n[{method}] pool start (processes + imports): {start_s:.2f} s")
+        print(f"  from scratch: {cold:6.1f} s for {n} points ({ok} converged, "
+              f"{fallbacks} warm starts fell back to cold), {60 * n / cold:.0f} solves/min; "
+              f"target < 60 s: {'met' if cold < 60 else 'MISSED'}")
+        print(f"  resumed:      {resumed:6.2f} s ({kept} kept, {len(again)} solved)")
+        busy = parts["point_total_s"]
+        nb = builds(outcomes)
+        print(f"  where the time went (summed over points, {busy:.1f} s busy of "
+              f"{args.workers} x {cold:.1f} = {args.workers * cold:.1f} worker-s, "
+              f"{100 * busy / (args.workers * cold):.0f} % utilisation):")
+        labels = {"build_and_setup_s": f"transcription builds ({nb}) and setup",
+                  "ipopt_s": "IPOPT solves (all stages)", "record_s": "gait records",
+                  "write_s": "gait file writes (atomic, fsync)",
+                  "warm_start_s": "reading warm-start files"}
+        for key, label in labels.items():
+            value = parts.get(key, 0.0)
+            print(f"    {label:<40} {value:7.2f} s  ({100 * value / busy:4.1f} %)")
+        print(f"    {'estimate: builds x reference build':<40} {nb * ref_build:7.2f} s")
+        if warm:
+            print(f"  warm solves: {len(warm)}, median {statistics.median(warm):.3f} s, max "
+                  f"{max(warm):.3f} s; cold starts: "
+                  + ", ".join(f"{o.key.split('/')[1]} {o.wall_time_s:.1f} s"
+                              for o in outcomes if o.warm == "none"))
+
+    print("\n| start method | points | converged | from scratch (s) | solves/min | "
+          "resumed (s) | solved on resume |")
+    print("|---|---|---|---|---|---|---|")
+    for method, cold, resumed, ok, again_n, _ in rows:
+        print(f"| {method} | {n} | {ok} | {cold:.1f} | {60 * n / cold:.0f} | {resumed:.2f} | "
+              f"{again_n} |")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

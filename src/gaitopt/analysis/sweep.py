@@ -1,0 +1,492 @@
+"""Sweeps: many walking problems on a grid, solved in parallel by continuation, resumable.
+
+``run_sweep(spec, directory)`` solves every point of :class:`~gaitopt.analysis.sweep_plan.
+SweepSpec` (the grid and the warm-start chains are described there) on a
+:class:`~gaitopt.analysis.executors.Backend` (local processes by default, a Dask cluster, or
+this process) and writes the sweep directory (``docs/outputs.md`` section 2):
+
+* ``sweep.json`` first: the settings. A directory made with other settings is refused
+  (:class:`SweepSettingsError` lists the differences); so is one where another sweep runs.
+* each point's gait file, written atomically by the worker when its solve succeeds (a failed
+  point never gets a file);
+* ``summary.csv`` (of each sub-sweep), rewritten atomically after every finished point: a row
+  per finished point, failed points as failed rows naming the failed stage.
+
+The driver keeps ``backend.slots`` points in flight. A point is ready when the neighbour it
+continues from (its *parent*) has finished; it is warm-started from that neighbour's engine
+Result (values and multipliers, passed in memory from task to task), or, when the neighbour
+was kept from an earlier run, from its gait file; when the neighbour failed, from what the
+neighbour was given. Among ready points the driver prefers, in order: one whose problem
+structure the process that just finished has already built; a chain's cold start; the point
+with the most points waiting on it (the longest chain first).
+
+Resuming: rerunning with the same settings keeps every point whose gait file loads, converged
+and was solved with this point's options and model (its summary row is rebuilt from the
+file, so a file written just before a kill is kept too); failed and missing points are
+solved. Killing the sweep at any moment loses no finished point and corrupts no file: every
+write is atomic (temporary file + rename) and leftovers of interrupted writes are removed.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from collections.abc import Callable, Collection, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gaitopt.analysis.executors import (
+    BROKEN_ERRORS,
+    Backend,
+    BackendError,
+    dask_backend,
+    inline_backend,
+    local_backend,
+)
+from gaitopt.analysis.sweep_plan import (
+    SETTINGS_FILE,
+    SETTINGS_FORMAT,
+    SweepPoint,
+    SweepSpec,
+    SweepSpecError,
+    settings_differences,
+    settings_document,
+    sweep_settings,
+)
+from gaitopt.analysis.sweep_worker import (
+    PointOutcome,
+    PointTask,
+    failed_point_row,
+    gait_file_matches,
+    solve_point,
+)
+from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptionsError, validate_options
+from gaitopt.ocp import Result
+from gaitopt.viz.summary import (
+    GAITS_DIR,
+    SUMMARY_FILE,
+    SummaryError,
+    SummaryRow,
+    gait_relpath,
+    read_summary,
+    summary_row,
+    variant_flags,
+    write_summary,
+)
+
+LOCK_FILE = ".sweep.lock"
+#: Restarts of a broken process pool in a row (no point finishing between) before giving up.
+MAX_WORKER_DEATHS = 3
+
+
+class SweepSettingsError(ValueError):
+    """The sweep directory holds another sweep (or one is running there)."""
+
+
+@dataclass(frozen=True)
+class Counts:
+    """Progress: points in the grid, kept from an earlier run, to solve this run, and of
+    those finished (succeeded + failed)."""
+
+    total: int
+    kept: int
+    to_solve: int
+    succeeded: int = 0
+    failed: int = 0
+
+    @property
+    def finished(self) -> int:
+        return self.succeeded + self.failed
+
+    @property
+    def remaining(self) -> int:
+        return self.to_solve - self.finished
+
+
+@dataclass(frozen=True)
+class SweepStart:
+    """What a sweep is about to do: the counts, where it runs, and notes from the scan of
+    an earlier run (unreadable or mismatched gait files, which are solved again)."""
+
+    directory: Path
+    counts: Counts
+    backend: str
+    notes: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class SweepReport:
+    """The outcome of :func:`run_sweep`."""
+
+    directory: Path
+    counts: Counts
+    wall_time_s: float
+    summaries: tuple[Path, ...]
+    interrupted: bool = False
+    notes: tuple[str, ...] = ()
+    outcomes: tuple[PointOutcome, ...] = field(default=(), repr=False)
+
+
+StartFn = Callable[[SweepStart], None]
+PointFn = Callable[[SweepPoint, PointOutcome, Counts], None]
+
+
+# -- the directory ----------------------------------------------------------------------------
+
+@contextmanager
+def directory_lock(directory: Path) -> Iterator[None]:
+    """Hold an exclusive lock on the sweep directory (released when the process ends, even
+    by SIGKILL); raise :class:`SweepSettingsError` if another sweep holds it."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover  (not POSIX: no lock)
+        yield
+        return
+    fh = open(directory / LOCK_FILE, "a")  # noqa: SIM115  (held for the whole sweep)
+    try:
+        try:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise SweepSettingsError(f"{directory}: another sweep is running in this "
+                                     "directory; wait for it or use another directory") from None
+        yield
+    finally:
+        fh.close()
+
+
+def prepare_directory(spec: SweepSpec, directory: Path) -> None:
+    """Create the directory and write ``sweep.json``, or check that the one there has the
+    same settings (:class:`SweepSettingsError` otherwise)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / SETTINGS_FILE
+    wanted = sweep_settings(spec)
+    if path.exists():
+        try:
+            saved = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise SweepSettingsError(f"{path}: cannot read the sweep settings ({exc})") from None
+        if not isinstance(saved, dict) or saved.get("format") != SETTINGS_FORMAT:
+            raise SweepSettingsError(f"{path}: not a gaitopt sweep settings file")
+        diffs = settings_differences(saved.get("settings", {}), wanted)
+        if diffs:
+            raise SweepSettingsError(
+                f"{directory} holds a sweep made with other settings, so it cannot be resumed "
+                f"with these; use another directory (-o) or the same settings. Differences: "
+                + "; ".join(diffs))
+        return
+    if (directory / SUMMARY_FILE).exists() or (directory / GAITS_DIR).exists():
+        raise SweepSettingsError(f"{directory} holds sweep results but no {SETTINGS_FILE}; "
+                                 "use another directory")
+    write_text_atomic(path, json.dumps(settings_document(spec), indent=2) + "\n")
+
+
+def remove_leftovers(directory: Path) -> int:
+    """Delete the temporary files of atomic writes interrupted by a kill (``.<name>.*.tmp``
+    next to gait files and summaries); returns how many."""
+    count = 0
+    for path in directory.rglob(".*.tmp"):
+        if path.is_file() and (".gait.json." in path.name or path.name.startswith(
+                (f".{SUMMARY_FILE}.", f".{SETTINGS_FILE}."))):
+            path.unlink(missing_ok=True)
+            count += 1
+    return count
+
+
+@dataclass
+class _Scan:
+    kept: dict[str, SummaryRow] = field(default_factory=dict)
+    old_failed: dict[str, SummaryRow] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+def scan_directory(spec: SweepSpec, directory: Path) -> _Scan:
+    """Which points an earlier run finished (see the module docstring), and the failed rows
+    it recorded for the others."""
+    scan = _Scan()
+    for point in spec.points:
+        path = directory / point.key
+        if not path.exists():
+            continue
+        try:
+            gait = Gait.load(path)
+        except GaitFileError as exc:
+            scan.notes.append(f"{point.key}: unreadable ({exc}); solving it again")
+            continue
+        why = gait_file_matches(gait, spec.model, spec.options(point))
+        if why:
+            scan.notes.append(f"{point.key}: not kept, {why}; solving it again")
+            continue
+        ankle, impulse = variant_flags(point.variant)
+        scan.kept[point.key] = summary_row(gait, ankle=ankle, impulse=impulse,
+                                           speed_mode=point.speed_mode, file=point.relfile)
+    by_key = {p.key: p for p in spec.points}
+    for sub in sorted({p.subdir for p in spec.points}):
+        summary = directory / sub / SUMMARY_FILE
+        if not summary.exists():
+            continue
+        try:
+            rows = read_summary(summary)
+        except SummaryError as exc:
+            scan.notes.append(f"ignoring the earlier summary: {exc}")
+            continue
+        for row in rows:
+            if row.success:
+                continue
+            speed = None if row.speed_mode == "free" else row.speed_m_s
+            if speed is not None and not math.isfinite(speed):
+                continue
+            rel = gait_relpath(ankle=row.ankle, impulse=row.impulse, speed_mode=row.speed_mode,
+                               speed_m_s=speed)
+            key = f"{sub}/{rel}" if sub else rel
+            if key in by_key and key not in scan.kept:
+                scan.old_failed[key] = row
+    return scan
+
+
+def write_summaries(spec: SweepSpec, directory: Path, rows: dict[str, SummaryRow],
+                    subdirs: Collection[str] | None = None) -> list[Path]:
+    """Write ``summary.csv`` of each sub-sweep (``subdirs``: only these) from ``rows``, in
+    grid order (variant, speed ascending, speed-free last)."""
+    written = []
+    for sub in sorted({p.subdir for p in spec.points}):
+        if subdirs is not None and sub not in subdirs:
+            continue
+        ordered = [rows[p.key] for p in spec.points if p.subdir == sub and p.key in rows]
+        written.append(write_summary(directory / sub / SUMMARY_FILE, ordered))
+    return written
+
+
+def check_points(spec: SweepSpec) -> None:
+    """Validate every point's options before any solve (:class:`SweepSpecError` names the
+    point and the option)."""
+    biped = checked_biped(spec.model)
+    for point in spec.points:
+        try:
+            validate_options(spec.options(point), biped)
+        except GaitOptionsError as exc:
+            raise SweepSpecError(f"{point.label().strip()}: {exc}") from None
+
+
+# -- the driver ---------------------------------------------------------------------------------
+
+def make_backend(*, workers: int | None = None, scheduler: str | None = None,
+                 start_method: str | None = None) -> Backend:
+    """Dask when ``scheduler`` is given; else ``workers`` local processes (default: the
+    CPUs this process may use), or this process for ``workers=0``."""
+    if scheduler:
+        return dask_backend(scheduler)
+    n = default_workers() if workers is None else workers
+    if n == 0:
+        return inline_backend()
+    return local_backend(n, start_method=start_method)
+
+
+def default_workers() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover  (not Linux)
+        return max(1, os.cpu_count() or 1)
+
+
+@dataclass
+class _Driver:
+    spec: SweepSpec
+    directory: Path
+    backend: Backend
+    fail_points: frozenset[str]
+    on_point: PointFn | None
+    rows: dict[str, SummaryRow]
+    state: dict[str, str]  # todo, running, ok, failed, kept
+    offers: dict[str, Result | str | None] = field(default_factory=dict)
+    given: dict[str, Result | str | None] = field(default_factory=dict)
+    tasks: dict[str, PointTask] = field(default_factory=dict)
+    outcomes: list[PointOutcome] = field(default_factory=list)
+    generation: int = 0
+    deaths: int = 0
+
+    def __post_init__(self) -> None:
+        self.points = {p.key: p for p in self.spec.points}
+        self.order = {p.key: i for i, p in enumerate(self.spec.points)}
+        self.parents = self.spec.parents
+        self.children: dict[str, list[str]] = {k: [] for k in self.points}
+        for k, parent in self.parents.items():
+            if parent is not None:
+                self.children[parent].append(k)
+        self.waiting = self._descendants()
+        cold_rank: dict[str, int] = {}
+        self.rank: dict[str, int] = {}
+        for k in self.points:  # round robin over structures among the cold starts
+            if self.parents[k] is None:
+                s = self.points[k].structure
+                self.rank[k] = cold_rank.get(s, 0)
+                cold_rank[s] = self.rank[k] + 1
+        for k, s in self.state.items():
+            if s == "kept":
+                self.offers[k] = str(self.directory / k)
+
+    def _descendants(self) -> dict[str, int]:
+        """Points waiting (directly or not) on each point."""
+        depth: dict[str, int] = {}
+        for k in self.points:
+            d, p = 0, self.parents[k]
+            while p is not None:
+                d, p = d + 1, self.parents[p]
+            depth[k] = d
+        waiting = dict.fromkeys(self.points, 0)
+        for k in sorted(self.points, key=lambda k: -depth[k]):
+            parent = self.parents[k]
+            if parent is not None:
+                waiting[parent] += 1 + waiting[k]
+        return waiting
+
+    def settled(self, key: str | None) -> bool:
+        return key is None or self.state[key] in ("ok", "failed", "kept")
+
+    def ready(self) -> list[str]:
+        return [k for k, s in self.state.items() if s == "todo" and self.settled(
+            self.parents[k])]
+
+    def pick(self, ready: list[str], built: frozenset[str]) -> str:
+        def score(k: str) -> tuple[int, int, int, int, int]:
+            cold = self.parents[k] is None
+            return (0 if self.points[k].structure in built else 1, 0 if cold else 1,
+                    self.rank.get(k, 0), -self.waiting[k], self.order[k])
+        return min(ready, key=score)
+
+    def task(self, key: str) -> PointTask:
+        p, parent = self.points[key], self.parents[key]
+        warm = self.offers.get(parent) if parent is not None else None
+        self.given[key] = warm
+        self.tasks[key] = PointTask(key=key, model=self.spec.model, options=self.spec.options(p),
+                         variant=p.variant, speed_mode=p.speed_mode, structure=p.structure,
+                         warm=warm, path=str((self.directory / key).resolve()),
+                         relfile=p.relfile, force_fail=key in self.fail_points)
+        return self.tasks[key]
+
+    def run(self, counts: Counts) -> Counts:
+        inflight: dict[Any, tuple[str, int]] = {}
+        built: frozenset[str] = frozenset()
+        while True:
+            ready = self.ready()
+            while ready and len(inflight) < self.backend.slots:
+                key = self.pick(ready, built)
+                ready.remove(key)
+                self.state[key] = "running"
+                inflight[self.backend.submit(solve_point, self.task(key))] = (
+                    key, self.generation)
+                built = frozenset()
+            if not inflight:
+                return counts
+            future = self.backend.next_finished()
+            if future is None or future not in inflight:
+                continue
+            key, generation = inflight.pop(future)
+            outcome = self._outcome(key, future, generation)
+            built = outcome.structures
+            counts = self.settle(key, outcome, counts)
+
+    def _outcome(self, key: str, future: Any, generation: int) -> PointOutcome:
+        try:
+            outcome: PointOutcome = future.result()
+            self.deaths = 0
+            return outcome
+        except BaseException as exc:
+            if isinstance(exc, KeyboardInterrupt | SystemExit):
+                raise
+            if isinstance(exc, BROKEN_ERRORS) and generation == self.generation:
+                self.deaths += 1
+                if self.deaths >= MAX_WORKER_DEATHS:
+                    raise BackendError(
+                        f"the worker processes died {self.deaths} times in a row (the last "
+                        f"while solving {key}); see the messages above. A script that runs "
+                        "a sweep must start it under `if __name__ == '__main__':`") from None
+                self.generation += 1
+                self.backend.restart()
+            status = ("error: the worker process died" if isinstance(exc, BROKEN_ERRORS)
+                      else f"error: {type(exc).__name__}: {exc}")
+            return PointOutcome(key=key, row=failed_point_row(self.tasks[key], status),
+                                result=None,
+                                warm="?", fell_back=False, stages=0, iterations=0,
+                                wall_time_s=math.nan, worker="?", structures=frozenset(),
+                                error=repr(exc))
+
+    def settle(self, key: str, outcome: PointOutcome, counts: Counts) -> Counts:
+        self.outcomes.append(outcome)
+        self.rows[key] = outcome.row
+        if outcome.success:
+            self.state[key] = "ok"
+            self.offers[key] = outcome.result
+            counts = Counts(counts.total, counts.kept, counts.to_solve, counts.succeeded + 1,
+                            counts.failed)
+        else:
+            self.state[key] = "failed"
+            self.offers[key] = self.given.get(key)
+            counts = Counts(counts.total, counts.kept, counts.to_solve, counts.succeeded,
+                            counts.failed + 1)
+        write_summaries(self.spec, self.directory, self.rows, {self.points[key].subdir})
+        if self.on_point is not None:
+            self.on_point(self.points[key], outcome, counts)
+        return counts
+
+
+def run_sweep(spec: SweepSpec, directory: str | os.PathLike[str], *,
+              backend: Backend | None = None, workers: int | None = None,
+              scheduler: str | None = None, on_start: StartFn | None = None,
+              on_point: PointFn | None = None,
+              fail_points: Collection[str] = ()) -> SweepReport:
+    """Run (or resume) the sweep ``spec`` in ``directory`` (see the module docstring).
+
+    Args:
+        backend: where points run; default :func:`make_backend` (``workers``, ``scheduler``).
+        on_start: called once with what will be done; on_point: after every finished point.
+        fail_points: testing hook: keys of points solved with ``max_iter = 1`` (they fail).
+
+    Raises :class:`SweepSpecError` (a bad grid or point option) and
+    :class:`SweepSettingsError` (a directory with other settings) before any solve. On
+    Ctrl-C, stops the workers and returns with ``interrupted=True``; the directory is
+    consistent and a rerun resumes.
+    """
+    start = time.perf_counter()
+    out = Path(directory)
+    check_points(spec)
+    prepare_directory(spec, out)
+    with directory_lock(out):
+        remove_leftovers(out)
+        scan = scan_directory(spec, out)
+        rows = {**scan.old_failed, **scan.kept}
+        summaries = write_summaries(spec, out, rows)
+        state = {p.key: ("kept" if p.key in scan.kept else "todo") for p in spec.points}
+        counts = Counts(total=len(state), kept=len(scan.kept),
+                        to_solve=len(state) - len(scan.kept))
+        owned = backend is None and counts.to_solve > 0
+        if owned:
+            backend = make_backend(workers=workers, scheduler=scheduler)
+        if on_start is not None:
+            on_start(SweepStart(directory=out, counts=counts,
+                                backend=backend.name if backend else "nothing to solve",
+                                notes=tuple(scan.notes)))
+        if counts.to_solve == 0 or backend is None:
+            return SweepReport(directory=out, counts=counts,
+                               wall_time_s=time.perf_counter() - start,
+                               summaries=tuple(summaries), notes=tuple(scan.notes))
+        driver = _Driver(spec=spec, directory=out, backend=backend,
+                         fail_points=frozenset(fail_points), on_point=on_point, rows=rows,
+                         state=state)
+        interrupted = False
+        try:
+            counts = driver.run(counts)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            if owned:
+                backend.close(wait=not interrupted)
+        return SweepReport(directory=out, counts=counts, wall_time_s=time.perf_counter() - start,
+                           summaries=tuple(summaries), interrupted=interrupted,
+                           notes=tuple(scan.notes), outcomes=tuple(driver.outcomes))

@@ -1,0 +1,253 @@
+"""What a sweep solves: the grid of points, their warm-start chains and the settings file.
+
+A sweep is a grid: variants (ankle torques on/off x liftoff impulse on/off) x speeds, times
+optional step lengths and single-support fractions, plus (optionally) the speed-free optimal
+walk of every variant. Points of one *group* (same variant, step length and single-support
+fraction) form continuation chains along the speed axis::
+
+    3 <- 6 <- 9 <- [12] -> 15 -> 18 -> ... -> 60        (m/min)
+                     |
+                     +-> free (the speed-free optimum)
+
+The point nearest :data:`START_SPEED` (12 m/min, the paper's optimum) is solved cold; every
+other point is warm-started from its finished neighbour toward that start (its *parent*).
+
+Directory layout: with one combination of step length and single-support fraction the sweep
+directory is a plain sweep (``summary.csv``, ``gaits/<variant>/...``, see
+:mod:`gaitopt.viz.summary`); with several, each combination is such a sub-sweep in a folder
+named by :func:`axis_tag` (``single-support-0.85_step-free``). ``sweep.json`` at the top holds
+the settings (:func:`sweep_settings`); a sweep refuses to resume into a directory made with
+other settings.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+from gaitopt import __version__
+from gaitopt.gait.options import GaitOptions
+from gaitopt.robot.model import RobotModel
+from gaitopt.viz.summary import VARIANTS, SpeedMode, gait_relpath, variant_flags
+
+#: Speed (m/s) of the cold start of each chain: the paper's optimal 12 m/min.
+START_SPEED = 0.2
+SETTINGS_FILE = "sweep.json"
+SETTINGS_FORMAT = "gaitopt.sweep"
+SETTINGS_VERSION = 1
+#: Options set per point (not part of the sweep's shared ``options``).
+POINT_FIELDS = ("speed", "ankle", "impulse", "step_length", "single_support_fraction", "knots")
+
+
+class SweepSpecError(ValueError):
+    """A sweep request is invalid (names the setting and what is allowed)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepSpec:
+    """The grid of a sweep (SI units).
+
+    Attributes:
+        model: the robot model.
+        speeds: fixed speeds (m/s), ascending, no two with the same 0.01 m/min label.
+        variants: subset of :data:`gaitopt.viz.summary.VARIANTS`, in that order.
+        free_speed: also solve the speed-free optimal walk of every group.
+        step_lengths: step lengths (m), ``None`` meaning free (optimized).
+        single_support: single-support fractions of the step time.
+        base: every other problem option (bounds, tolerances, grid ``knots``, ...); its
+            per-point fields (:data:`POINT_FIELDS` but ``knots``) are ignored.
+    """
+
+    model: RobotModel
+    speeds: tuple[float, ...]
+    variants: tuple[str, ...] = VARIANTS
+    free_speed: bool = True
+    step_lengths: tuple[float | None, ...] = (None,)
+    single_support: tuple[float, ...] = (0.85,)
+    base: GaitOptions = field(default_factory=GaitOptions)
+
+    def __post_init__(self) -> None:
+        check_spec(self)
+
+    @property
+    def knots(self) -> tuple[int, int]:
+        return (self.base.knots[0], self.base.knots[1])
+
+    @property
+    def nested(self) -> bool:
+        """Whether each (step length, single-support) combination has its own sub-sweep."""
+        return len(self.step_lengths) * len(self.single_support) > 1
+
+    @cached_property
+    def points(self) -> tuple[SweepPoint, ...]:
+        """Every point, grouped (single support, step length, variant), speeds ascending,
+        the speed-free point last in its group."""
+        out = []
+        for ss in self.single_support:
+            for step in self.step_lengths:
+                for variant in self.variants:
+                    speeds: list[float | None] = list(self.speeds)
+                    if self.free_speed:
+                        speeds.append(None)
+                    for v in speeds:
+                        out.append(SweepPoint(variant=variant, speed=v, step_length=step,
+                                              single_support=ss, nested=self.nested))
+        return tuple(out)
+
+    @cached_property
+    def parents(self) -> Mapping[str, str | None]:
+        """Point key -> the key of the point it is warm-started from (None: cold start)."""
+        parents: dict[str, str | None] = {}
+        groups: dict[tuple[Any, ...], list[SweepPoint]] = {}
+        for p in self.points:
+            groups.setdefault(p.group, []).append(p)
+        for members in groups.values():
+            fixed = [p for p in members if p.speed is not None]
+            free = [p for p in members if p.speed is None]
+            start = start_index([p.speed for p in fixed if p.speed is not None])
+            for i, p in enumerate(fixed):
+                parents[p.key] = (None if i == start else
+                                  fixed[i - 1].key if i > start else fixed[i + 1].key)
+            for p in free:
+                parents[p.key] = fixed[start].key if fixed else None
+        return parents
+
+    def options(self, point: SweepPoint) -> GaitOptions:
+        """The full problem options of a point."""
+        ankle, impulse = variant_flags(point.variant)
+        return self.base.replace(speed=point.speed, ankle=ankle, impulse=impulse,
+                                 step_length=point.step_length,
+                                 single_support_fraction=point.single_support)
+
+
+def start_index(speeds: Sequence[float]) -> int:
+    """Index of the speed nearest :data:`START_SPEED` (the lower one on a tie)."""
+    if not speeds:
+        return 0
+    return min(range(len(speeds)),  # distances compared in m/min to 1e-6: ties are ties
+               key=lambda i: (round(abs(speeds[i] - START_SPEED) * 60.0, 6), speeds[i]))
+
+
+def axis_tag(single_support: float, step_length: float | None) -> str:
+    """The sub-sweep folder of a (single-support fraction, step length) combination."""
+    step = "free" if step_length is None else f"{step_length:g}m"
+    return f"single-support-{single_support:g}_step-{step}"
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepPoint:
+    """One point of the grid; ``speed`` in m/s or ``None`` for the speed-free walk."""
+
+    variant: str
+    speed: float | None
+    step_length: float | None
+    single_support: float
+    nested: bool = False
+
+    @property
+    def speed_mode(self) -> SpeedMode:
+        return "free" if self.speed is None else "fixed"
+
+    @property
+    def subdir(self) -> str:
+        """The sub-sweep folder ("" for a plain sweep)."""
+        return axis_tag(self.single_support, self.step_length) if self.nested else ""
+
+    @property
+    def relfile(self) -> str:
+        """The gait file, relative to the sub-sweep folder (the summary's ``file``)."""
+        ankle, impulse = variant_flags(self.variant)
+        return gait_relpath(ankle=ankle, impulse=impulse, speed_mode=self.speed_mode,
+                            speed_m_s=self.speed)
+
+    @property
+    def key(self) -> str:
+        """Unique name of the point: its gait file relative to the sweep directory."""
+        return f"{self.subdir}/{self.relfile}" if self.subdir else self.relfile
+
+    @property
+    def group(self) -> tuple[str, float | None, float]:
+        """Points of a group share a continuation chain."""
+        return (self.variant, self.step_length, self.single_support)
+
+    @property
+    def structure(self) -> str:
+        """Points with the same structure share a transcription (built once per process)."""
+        return f"ankle={'ankle' in self.variant} single_support={self.single_support:g}"
+
+    def label(self) -> str:
+        speed = "free" if self.speed is None else f"{self.speed * 60:.2f} m/min"
+        extra = f"  [{self.subdir}]" if self.subdir else ""
+        return f"{self.variant:<13} {speed:>12}{extra}"
+
+
+def check_spec(spec: SweepSpec) -> None:
+    """Raise :class:`SweepSpecError` for an empty or malformed grid."""
+    if not spec.speeds:
+        raise SweepSpecError("speeds: at least one speed is needed")
+    for v in spec.speeds:
+        if not (isinstance(v, float | int) and math.isfinite(v) and v > 0):
+            raise SweepSpecError(f"speeds: {v!r} m/s is not a positive speed")
+    if list(spec.speeds) != sorted(spec.speeds):
+        raise SweepSpecError("speeds: must be ascending")
+    labels = [f"{v * 60:06.2f}" for v in spec.speeds]
+    for first, second in zip(labels, labels[1:], strict=False):
+        if first == second:
+            raise SweepSpecError(f"speeds: two speeds round to the same file name "
+                                 f"({first} m/min); keep speeds at least 0.01 m/min apart")
+    if not spec.variants:
+        raise SweepSpecError(f"variants: at least one of {', '.join(VARIANTS)} is needed")
+    for name in spec.variants:
+        if name not in VARIANTS:
+            raise SweepSpecError(f"variants: unknown variant {name!r}; expected one of "
+                                 f"{', '.join(VARIANTS)} (or 'all')")
+    if len(set(spec.variants)) != len(spec.variants):
+        raise SweepSpecError("variants: each variant at most once")
+    if not spec.step_lengths or len(set(spec.step_lengths)) != len(spec.step_lengths):
+        raise SweepSpecError("step lengths: at least one, each at most once")
+    if not spec.single_support or len(set(spec.single_support)) != len(spec.single_support):
+        raise SweepSpecError("single-support fractions: at least one, each at most once")
+
+
+# -- the settings file ---------------------------------------------------------------------------
+
+def sweep_settings(spec: SweepSpec) -> dict[str, Any]:
+    """The settings that define a sweep's results (written to ``sweep.json``): the model
+    (name and content hash), the grid and every shared problem option."""
+    shared = {k: v for k, v in spec.base.to_dict().items()
+              if k not in POINT_FIELDS or k == "knots"}
+    return {
+        "model": {"name": spec.model.name, "content_hash": spec.model.content_hash()},
+        "variants": list(spec.variants),
+        "speeds_m_min": [round(v * 60.0, 9) for v in spec.speeds],
+        "free_speed": spec.free_speed,
+        "step_lengths": list(spec.step_lengths),
+        "single_support_fractions": list(spec.single_support),
+        "options": shared,
+    }
+
+
+def settings_document(spec: SweepSpec) -> dict[str, Any]:
+    """The whole ``sweep.json`` document: format, version, writer and the settings."""
+    return {"format": SETTINGS_FORMAT, "version": SETTINGS_VERSION,
+            "gaitopt_version": __version__, "settings": sweep_settings(spec)}
+
+
+def settings_differences(saved: Mapping[str, Any], wanted: Mapping[str, Any]) -> list[str]:
+    """Human-readable differences between two settings dicts (empty when equal)."""
+    out = []
+    for key in sorted(set(saved) | set(wanted)):
+        a, b = saved.get(key, "<missing>"), wanted.get(key, "<missing>")
+        if isinstance(a, Mapping) and isinstance(b, Mapping):
+            out += [f"{key}.{d}" for d in settings_differences(a, b)]
+        elif a != b:
+            out.append(f"{key}: directory has {_short(a)}, this run asks {_short(b)}")
+    return out
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 70 else text[:67] + "..."

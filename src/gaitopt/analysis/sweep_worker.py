@@ -1,0 +1,195 @@
+"""One sweep point, solved where the executor runs it (a local process or a Dask worker).
+
+:func:`solve_point` is the task function: it receives a :class:`PointTask` (the problem, the
+warm start and where to write), solves, writes the gait file atomically when the solve
+succeeded, and returns a :class:`PointOutcome` (the summary row and, for the neighbours, the
+engine :class:`~gaitopt.ocp.Result` whose values and multipliers warm-start them). A failed
+point writes no file. Everything in both objects pickles (the Result is about 10 kB).
+
+Transcriptions are cached per process by :mod:`gaitopt.gait.solve`; the outcome says which
+problem structures this process has built, so the driver can send a process more points of a
+structure it already has.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import socket
+import threading
+import time
+import traceback
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.solve import WalkingSolution, solve_walking
+from gaitopt.ocp import Guess, Result
+from gaitopt.robot.model import RobotModel
+from gaitopt.viz.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
+
+#: Problem structures whose transcription this process has built (see module docstring).
+_BUILT: set[str] = set()
+#: One solve at a time per process: a Dask worker with several threads shares the process's
+#: cached transcriptions, which are not meant for concurrent use.
+_LOCK = threading.Lock()
+
+
+@dataclass(frozen=True, kw_only=True)
+class PointTask:
+    """What a worker needs to solve one point.
+
+    ``warm`` is the finished neighbour's Result (values and multipliers), or the path of its
+    gait file (a point kept from an earlier run), or None (cold start). ``path`` is the
+    absolute gait file to write; ``relfile`` the path the summary row names.
+    ``force_fail`` (a testing hook) solves with ``max_iter = 1`` so that the point fails
+    through the real solver path.
+    """
+
+    key: str
+    model: RobotModel
+    options: GaitOptions
+    variant: str
+    speed_mode: SpeedMode
+    structure: str
+    warm: Result | str | None
+    path: str
+    relfile: str
+    force_fail: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class PointOutcome:
+    """What came of one point.
+
+    ``row`` is the summary row (failed rows name the failed stage in ``status``); ``result``
+    the final engine result when the point succeeded (for its neighbours), else None;
+    ``warm`` how it started (``result``, ``file``, ``none``, or ``file unreadable``);
+    ``fell_back`` whether a warm start failed and the cold path was taken;
+    ``iterations`` the IPOPT iterations over all stages; ``worker`` host:pid; ``timings``
+    where the time went (s): ``warm_start_s`` (reading a gait file), ``build_and_setup_s``
+    (transcription build on a process's first point of a structure, guesses), ``ipopt_s``
+    (the stages' solves), ``record_s`` (the gait record), ``write_s`` (the atomic save).
+    """
+
+    key: str
+    row: SummaryRow
+    result: Result | None
+    warm: str
+    fell_back: bool
+    stages: int
+    iterations: int
+    wall_time_s: float
+    worker: str
+    structures: frozenset[str]
+    error: str = ""
+    timings: Mapping[str, float] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.row.success
+
+
+def worker_name() -> str:
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def _warm_start(task: PointTask) -> tuple[Guess | Result | None, str]:
+    if isinstance(task.warm, Result):
+        return task.warm, "result"
+    if isinstance(task.warm, str):
+        from gaitopt.gait.api import guess_from_gait
+
+        try:
+            return guess_from_gait(Gait.load(task.warm)), "file"
+        except (GaitFileError, KeyError, ValueError):
+            return None, "file unreadable"
+    return None, "none"
+
+
+def failed_point_row(task: PointTask, status: str, *, iterations: int = 0,
+            wall_time_s: float = math.nan) -> SummaryRow:
+    """The summary row of a point that failed (the requested speed; NaN when free)."""
+    ankle, impulse = variant_flags(task.variant)
+    speed = task.options.speed if task.options.speed is not None else math.nan
+    return failed_row(ankle=ankle, impulse=impulse, speed_mode=task.speed_mode, status=status,
+                      speed_m_s=speed, iterations=iterations, wall_time_s=wall_time_s)
+
+
+def _failure_status(solution: WalkingSolution) -> str:
+    stage = solution.failed_stage
+    where = stage.name if stage is not None else "solve"
+    return f"failed at {where}: {solution.result.status}"
+
+
+def solve_point(task: PointTask) -> PointOutcome:
+    """Solve one point (see the module docstring). Never raises for a failed solve or an
+    error inside it: the outcome's row says failed and why."""
+    clock = time.perf_counter
+    start = clock()
+    warm, how = _warm_start(task)
+    timings = {"warm_start_s": clock() - start}
+    options = task.options.replace(max_iter=1) if task.force_fail else task.options
+    solution: WalkingSolution | None = None
+    result: Result | None = None
+    error = ""
+    try:
+        with _LOCK:
+            solution = solve_walking(task.model, options, warm_start=warm)
+            ipopt = sum(s.wall_time_s for s in solution.stages)
+            timings["ipopt_s"] = ipopt
+            timings["build_and_setup_s"] = solution.wall_time_s - ipopt
+            mark = clock()
+            gait = gait_from_solution(solution) if solution.success else None
+            timings["record_s"] = clock() - mark
+        if solution.success and gait is not None:
+            mark = clock()
+            gait.save(task.path)
+            timings["write_s"] = clock() - mark
+            ankle, impulse = variant_flags(task.variant)
+            row = summary_row(gait, ankle=ankle, impulse=impulse, speed_mode=task.speed_mode,
+                              file=task.relfile)
+            result = solution.result
+        else:
+            row = failed_point_row(task, _failure_status(solution),
+                                   iterations=sum(s.iterations for s in solution.stages),
+                                   wall_time_s=solution.wall_time_s)
+    except Exception as exc:  # a bug or an OS error: record the point as failed, go on
+        error = traceback.format_exc()
+        row = failed_point_row(task, f"error: {type(exc).__name__}: {exc}",
+                               wall_time_s=clock() - start)
+    if not task.force_fail:
+        _BUILT.add(task.structure)
+    stages = solution.stages if solution is not None else ()
+    return PointOutcome(
+        key=task.key, row=row, result=result, warm=how,
+        fell_back=warm is not None and bool(stages) and not stages[0].success,
+        stages=len(stages), iterations=sum(s.iterations for s in stages),
+        wall_time_s=clock() - start, worker=worker_name(),
+        structures=frozenset(_BUILT), error=error, timings=timings)
+
+
+def gait_file_matches(gait: Gait, model: RobotModel, options: GaitOptions) -> str:
+    """Why a saved gait is not the converged solution of ``options`` on ``model`` ("" if
+    it is): used to decide which points of an earlier run to keep."""
+    if not gait.success:
+        return f"its solve failed ({gait.status})"
+    wanted = options.to_dict()
+    saved = {k: _plain(v) for k, v in gait.options.items()}
+    diff = sorted(k for k in set(wanted) | set(saved) if wanted.get(k) != saved.get(k))
+    if diff:
+        return f"it was solved with other options ({', '.join(diff)})"
+    if _plain(gait.model_data) != _plain(model.to_dict()):
+        return "it was solved for another model"
+    return ""
+
+
+def _plain(value: object) -> object:
+    """Plain JSON data (dicts and lists) from the gait's frozen mappings and tuples."""
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return value

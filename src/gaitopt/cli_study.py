@@ -1,0 +1,393 @@
+"""``gaitopt sweep``, ``report``, ``animate`` and ``study`` (the main job): many gaits.
+
+``sweep`` solves a grid (variants x speeds, optionally x step lengths x single-support
+fractions) in parallel with continuation and writes a resumable sweep directory; ``report``
+writes the paper's figures and an HTML report of a sweep; ``animate`` writes a GIF or mp4 of
+a gait; ``study`` does all three for the paper's study. See docs/studies.md.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from gaitopt.analysis.executors import BackendError
+from gaitopt.analysis.sweep import (
+    Counts,
+    SweepReport,
+    SweepSettingsError,
+    SweepStart,
+    default_workers,
+    run_sweep,
+)
+from gaitopt.analysis.sweep_plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.analysis.sweep_worker import PointOutcome
+from gaitopt.cli import UserError, cli, make_console
+from gaitopt.cli_gait import _knots
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.robot.biped import BipedStructureError
+from gaitopt.viz.summary import SUMMARY_FILE, VARIANTS, SummaryError
+
+#: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
+DEFAULT_SPEEDS = "3:60:3"
+#: Default speed grid of ``gaitopt study`` (m/min).
+STUDY_SPEEDS = "3:60:3"
+STUDY_DIR = Path("out/study")
+MAX_SPEEDS = 2000
+
+
+# -- parsing the grid -----------------------------------------------------------------------------
+
+def parse_speeds(text: str) -> tuple[float, ...]:
+    """Speeds in m/s from m/min text: ``3:60:3`` (start:stop:step, stop included), a list
+    ``3,6,12.5`` or both (``3:30:3,45,60``); sorted, duplicates removed."""
+    values: list[float] = []
+    for item in text.replace("m/min", "").split(","):
+        item = item.strip()
+        if not item:
+            continue
+        parts = item.split(":")
+        try:
+            numbers = [float(p) for p in parts]
+        except ValueError:
+            raise UserError(f"--speeds: {item!r} is not a speed in m/min or a range "
+                            "start:stop:step (m/min), e.g. 3:60:3 or 3,12,60") from None
+        if not all(math.isfinite(x) for x in numbers):
+            raise UserError(f"--speeds: {item!r}: speeds must be finite")
+        if len(numbers) == 1:
+            values.append(numbers[0])
+        elif len(numbers) == 3:
+            start, stop, step = numbers
+            if step <= 0 or stop < start:
+                raise UserError(f"--speeds: range {item!r} needs start <= stop and step > 0 "
+                                "(start:stop:step in m/min, stop included)")
+            n = math.floor((stop - start) / step + 1e-9) + 1
+            if n > MAX_SPEEDS:
+                raise UserError(f"--speeds: range {item!r} has {n} speeds; at most "
+                                f"{MAX_SPEEDS}")
+            values.extend(round(start + i * step, 9) for i in range(n))
+        else:
+            raise UserError(f"--speeds: {item!r} must be a speed or start:stop:step (m/min)")
+    if not values:
+        raise UserError("--speeds: no speed given (e.g. 3:60:3)")
+    bad = [v for v in values if v <= 0]
+    if bad:
+        raise UserError(f"--speeds: speeds must be > 0 m/min, got {bad[0]:g}")
+    unique = sorted(set(values))
+    if len(unique) > MAX_SPEEDS:
+        raise UserError(f"--speeds: {len(unique)} speeds; at most {MAX_SPEEDS}")
+    return tuple(v / 60.0 for v in unique)
+
+
+def parse_variants(text: str) -> tuple[str, ...]:
+    """``all`` or a comma list of variant names, returned in the canonical order."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if names == ["all"]:
+        return VARIANTS
+    unknown = [n for n in names if n not in VARIANTS]
+    if unknown or not names:
+        raise UserError(f"--variants: unknown variant {unknown[0] if unknown else text!r}; use "
+                        f"'all' or a comma list of {', '.join(VARIANTS)}")
+    return tuple(v for v in VARIANTS if v in names)
+
+
+def parse_step_lengths(text: str) -> tuple[float | None, ...]:
+    """``free`` or a comma list of step lengths in m (``free`` may be one of them)."""
+    out: list[float | None] = []
+    for item in (i.strip() for i in text.split(",")):
+        if item.lower() == "free":
+            out.append(None)
+            continue
+        try:
+            value = float(item.removesuffix("m"))
+        except ValueError:
+            raise UserError(f"--step-length: {item!r} is not a length in m or 'free'") from None
+        if not (math.isfinite(value) and value > 0):
+            raise UserError(f"--step-length: {item!r} must be > 0 m (or 'free')")
+        out.append(value)
+    return tuple(dict.fromkeys(out))
+
+
+def parse_fractions(text: str) -> tuple[float, ...]:
+    """A comma list of single-support fractions in (0, 1]."""
+    out = []
+    for item in (i.strip() for i in text.split(",")):
+        try:
+            value = float(item)
+        except ValueError:
+            raise UserError(f"--single-support: {item!r} is not a number in (0, 1]") from None
+        if not 0.0 < value <= 1.0:
+            raise UserError(f"--single-support: {item!r} must lie in (0, 1]")
+        out.append(value)
+    return tuple(dict.fromkeys(out))
+
+
+def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
+              single_support: str, knots: str) -> SweepSpec:
+    from gaitopt.gait.api import as_model
+
+    model = as_model(model_name)
+    try:
+        return SweepSpec(model=model, speeds=parse_speeds(speeds),
+                         variants=parse_variants(variants), free_speed=free,
+                         step_lengths=parse_step_lengths(step_length),
+                         single_support=parse_fractions(single_support),
+                         base=GaitOptions(knots=_knots(knots)))
+    except SweepSpecError as exc:
+        raise UserError(str(exc)) from None
+
+
+# -- running a sweep with a progress bar ------------------------------------------------------
+
+def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
+    """One line per finished point: variant, speed, cost, step length, status, iterations,
+    time, how it started."""
+    row = outcome.row
+    if point.speed is None:
+        speed = (f"free ({row.speed_m_min:5.2f})" if math.isfinite(row.speed_m_min)
+                 else "free")
+    else:
+        speed = f"{point.speed * 60:6.2f}"
+    extra = f" [{point.subdir}]" if point.subdir else ""
+    start = {"result": "warm", "file": "warm (file)", "none": "cold"}.get(outcome.warm,
+                                                                           outcome.warm)
+    if outcome.fell_back:
+        start += " -> cold"
+    head = f"{'ok  ' if row.success else 'FAIL'} {point.variant:<13}{extra} {speed:>13} m/min"
+    if row.success:
+        body = (f"cost {row.cost:9.3f}  step {row.step_length:.4f} m  {row.status}")
+    else:
+        body = row.status
+    return (f"{head}  {body}  it {outcome.iterations:4d}  {outcome.wall_time_s:5.2f} s  "
+            f"{start}")
+
+
+def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
+                      workers: int | None, scheduler: str | None,
+                      fail_points: Sequence[str] = ()) -> SweepReport:
+    """:func:`run_sweep` with a progress bar (done/failed/remaining, ETA) and a line per
+    finished point; errors the user can fix become :class:`UserError`."""
+    progress = Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+        TextColumn("failed {task.fields[failed]}  remaining {task.fields[remaining]}"),
+        TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+        console=console, transient=False)
+    task_id: Any = None
+
+    def on_start(start: SweepStart) -> None:
+        nonlocal task_id
+        c = start.counts
+        console.print(f"sweep {start.directory}: {c.total} points, {c.kept} kept from an "
+                      f"earlier run, {c.to_solve} to solve on {start.backend}", soft_wrap=True)
+        for note in start.notes:
+            console.print(f"  note: {note}", soft_wrap=True)
+        if c.to_solve:
+            progress.start()
+            task_id = progress.add_task("solving", total=c.to_solve, failed=0,
+                                        remaining=c.to_solve)
+
+    def on_point(point: SweepPoint, outcome: PointOutcome, counts: Counts) -> None:
+        progress.console.print(point_line(point, outcome), soft_wrap=True)
+        progress.update(task_id, completed=counts.finished, failed=counts.failed,
+                        remaining=counts.remaining)
+
+    try:
+        report = run_sweep(spec, directory, workers=workers, scheduler=scheduler,
+                           on_start=on_start, on_point=on_point, fail_points=fail_points)
+    except (SweepSpecError, SweepSettingsError, BackendError, GaitOptionsError,
+            BipedStructureError) as exc:
+        raise UserError(str(exc)) from None
+    finally:
+        progress.stop()
+    c = report.counts
+    if report.interrupted:
+        console.print(f"interrupted after {c.finished} of {c.to_solve} points; every finished "
+                      "point is saved: rerun the same command to resume", soft_wrap=True)
+        sys.exit(130)
+    console.print(f"done in {report.wall_time_s:.1f} s: {c.succeeded} solved, {c.failed} "
+                  f"failed, {c.kept} kept ({c.total} points); summary: "
+                  + ", ".join(str(p) for p in report.summaries), soft_wrap=True)
+    if c.failed:
+        console.print("failed points are listed in the summary as failed; rerun the same "
+                      "command to try them again", soft_wrap=True)
+    return report
+
+
+def _workers_option(f: Any) -> Any:
+    f = click.option("--scheduler", default=None, metavar="ADDRESS",
+                     help="Run on a Dask cluster (e.g. tcp://host:8786) instead of local "
+                          "processes; its workers need gaitopt and this directory.")(f)
+    return click.option("--workers", type=click.IntRange(min=0), default=None,
+                        help="Local worker processes (default: the CPUs available, "
+                             f"{default_workers()} here; 0 = in this process).")(f)
+
+
+@cli.command("sweep")
+@click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
+              required=True, help="Sweep directory (created; rerun to resume).")
+@click.option("--model", "model_name", default="five-link", show_default=True,
+              help="Built-in model name or model file.")
+@click.option("--speeds", default=DEFAULT_SPEEDS, show_default=True,
+              help="Speeds in m/min: start:stop:step (stop included) and/or a comma list.")
+@click.option("--variants", default="all", show_default=True,
+              help=f"'all' or a comma list of {', '.join(VARIANTS)}.")
+@click.option("--free/--no-free", default=True, show_default=True,
+              help="Also solve the speed-free optimal walk of each variant.")
+@click.option("--step-length", default="free", show_default=True,
+              help="Step lengths in m (comma list), or 'free'.")
+@click.option("--single-support", default="0.85", show_default=True,
+              help="Single-support fractions of the step time (comma list).")
+@click.option("--knots", default="8,5", show_default=True,
+              help="Grid points per phase: single support, double support.")
+@_workers_option
+def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
+                  step_length: str, single_support: str, knots: str, workers: int | None,
+                  scheduler: str | None) -> None:
+    """Solve a grid of walking problems in parallel, by continuation in speed.
+
+    Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
+    Rerunning the same command resumes: finished points are kept. Exit status 1 if a point
+    failed.
+    """
+    console = make_console()
+    spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
+                     step_length=step_length, single_support=single_support, knots=knots)
+    report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    if report.counts.failed:
+        sys.exit(1)
+
+
+# -- report and animate -------------------------------------------------------------------------
+
+def sweep_dirs(directory: Path) -> list[Path]:
+    """The (sub-)sweeps of a sweep directory: itself, or its sub-folders with a summary."""
+    if (directory / SUMMARY_FILE).exists():
+        return [directory]
+    subs = sorted(p.parent for p in directory.glob(f"*/{SUMMARY_FILE}"))
+    if not subs:
+        what = "no sweep" if not (directory / SETTINGS_FILE).exists() else "no finished point"
+        raise UserError(f"{directory}: {what} here (no {SUMMARY_FILE}); run `gaitopt sweep -o "
+                        f"{directory}` first")
+    return subs
+
+
+def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
+    """Write the report of each (sub-)sweep, print where and the findings."""
+    from gaitopt.analysis.findings import findings_text
+    from gaitopt.viz.report import write_report
+
+    pages = []
+    for sweep in sweep_dirs(directory):
+        target = out if sweep == directory else out / sweep.name
+        try:
+            info = write_report(sweep, target)
+        except SummaryError as exc:
+            raise UserError(str(exc)) from None
+        console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)",
+                      soft_wrap=True)
+        for problem in info.problems:
+            console.print(f"  problem: {problem}", soft_wrap=True)
+        console.print(findings_text(info.findings), soft_wrap=True)
+        pages.append(info.html)
+    return pages
+
+
+@cli.command("report")
+@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
+@click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Folder of the report (default: DIRECTORY/report).")
+def report_command(directory: Path, output: Path | None) -> None:
+    """Write the figures and the HTML report of a sweep, and print the findings."""
+    if not directory.is_dir():
+        raise UserError(f"{directory}: no such directory")
+    write_reports(make_console(), directory, output or directory / "report")
+
+
+def animate_file(console: Console, file: Path, output: Path, *, steps: int, fps: int) -> None:
+    from gaitopt.viz.animation import animate_gait
+
+    try:
+        gait = Gait.load(file)
+    except GaitFileError as exc:
+        raise UserError(str(exc)) from None
+    start = time.perf_counter()
+    try:
+        info = animate_gait(gait, output, steps=steps, fps=fps)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    console.print(f"animation: {info.path} ({info.frames} frames, {info.duration_s:.2f} s at "
+                  f"{info.fps:g} fps, {steps} steps of {gait.speed * 60:.1f} m/min; written "
+                  f"in {time.perf_counter() - start:.1f} s)", soft_wrap=True)
+
+
+@cli.command("animate")
+@click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              default=Path("walk.gif"), show_default=True, help="A .gif or .mp4 file.")
+@click.option("--steps", type=click.IntRange(min=1, max=100), default=4, show_default=True,
+              help="Steps to show.")
+@click.option("--fps", type=click.IntRange(min=1, max=120), default=30, show_default=True,
+              help="Frames per second (the movie plays in real time).")
+def animate_command(file: Path, output: Path, steps: int, fps: int) -> None:
+    """Write an animation of a gait file: the stick figure walking, with contact forces."""
+    animate_file(make_console(), file, output, steps=steps, fps=fps)
+
+
+# -- the main job -------------------------------------------------------------------------------
+
+@cli.command("study")
+@click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
+              default=STUDY_DIR, show_default=True,
+              help="Study directory (the sweep; the report goes to its report/ folder).")
+@click.option("--model", "model_name", default="five-link", show_default=True,
+              help="Built-in model name or model file.")
+@click.option("--speeds", default=STUDY_SPEEDS, show_default=True,
+              help="Speeds in m/min: start:stop:step and/or a comma list.")
+@_workers_option
+def study_command(directory: Path, model_name: str, speeds: str, workers: int | None,
+                  scheduler: str | None) -> None:
+    """The paper's study: the four variants over the speed grid plus each speed-free
+    optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
+    Rerunning resumes."""
+    from gaitopt.analysis.findings import optimal_row
+    from gaitopt.viz.summary import read_summary
+
+    console = make_console()
+    start = time.perf_counter()
+    spec = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
+                     step_length="free", single_support="0.85", knots="8,5")
+    run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    out = directory / "report"
+    pages = write_reports(console, directory, out)
+    rows = read_summary(directory / SUMMARY_FILE)
+    best = next((r for v in VARIANTS if (r := optimal_row(rows, v)) is not None), None)
+    if best is not None:
+        animate_file(console, directory / best.file, out / "optimal-walk.gif", steps=4,
+                     fps=30)
+        console.print(f"(the animated gait is the {best.variant} optimum, "
+                      f"{best.speed_m_min:.1f} m/min, step {best.step_length:.3f} m)",
+                      soft_wrap=True)
+    else:
+        console.print("no point converged: no animation", soft_wrap=True)
+    console.print(f"study done in {time.perf_counter() - start:.0f} s. Open {pages[0]}",
+                  soft_wrap=True)
+
+
+__all__ = ["animate_command", "parse_speeds", "parse_variants", "report_command",
+           "study_command", "sweep_command"]

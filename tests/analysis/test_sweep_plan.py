@@ -1,0 +1,123 @@
+"""The sweep grid: points, continuation chains, file layout, settings (no solve)."""
+
+from __future__ import annotations
+
+import pytest
+
+from gaitopt.analysis.sweep import check_points
+from gaitopt.analysis.sweep_plan import (
+    SweepSpec,
+    SweepSpecError,
+    settings_differences,
+    start_index,
+    sweep_settings,
+)
+from gaitopt.gait.options import GaitOptions
+from gaitopt.robot import load_model
+from gaitopt.viz.summary import VARIANTS
+
+MODEL = load_model("five-link")
+
+
+def spec(**kw: object) -> SweepSpec:
+    args: dict[str, object] = {"model": MODEL, "speeds": tuple(v / 60 for v in range(3, 61, 3))}
+    args.update(kw)
+    return SweepSpec(**args)  # type: ignore[arg-type]
+
+
+def chain_from(s: SweepSpec, key: str) -> list[str]:
+    """The keys from ``key`` back to its chain's cold start."""
+    out = [key]
+    while (parent := s.parents[out[-1]]) is not None:
+        out.append(parent)
+    return out
+
+
+def test_chains_start_at_12_m_min_and_march_both_ways() -> None:
+    s = spec(variants=("ankle",))
+    speed = {p.key: p.speed for p in s.points}
+    cold = [k for k, parent in s.parents.items() if parent is None]
+    assert cold == ["gaits/ankle/speed-012.00m_min.gait.json"]
+    # every fixed point's chain moves monotonically toward 12 m/min by one grid step
+    for p in s.points:
+        if p.speed is None:
+            continue
+        chain = [speed[k] for k in chain_from(s, p.key)]
+        assert chain[-1] == pytest.approx(0.2)
+        assert len(chain) == round(abs(p.speed - 0.2) * 60 / 3) + 1
+        steps = [abs(a - b) * 60 for a, b in zip(chain, chain[1:], strict=False)]
+        assert all(st == pytest.approx(3.0) for st in steps)
+    free = "gaits/ankle/speed-free.gait.json"
+    assert s.parents[free] == "gaits/ankle/speed-012.00m_min.gait.json"
+    assert len(s.points) == 21
+
+
+def test_start_is_the_speed_nearest_12_m_min() -> None:
+    assert start_index([0.05, 0.1, 0.15]) == 2
+    assert start_index([0.3, 0.5]) == 0
+    assert start_index([0.15, 0.25]) == 0  # a tie goes to the lower speed
+    s = spec(speeds=(0.1, 0.35, 0.5), variants=("plain",))
+    cold = [k for k, parent in s.parents.items() if parent is None]
+    assert cold == ["gaits/plain/speed-006.00m_min.gait.json"]
+
+
+def test_one_chain_set_per_variant_and_axis_combination_in_subfolders() -> None:
+    s = spec(speeds=(0.1, 0.2), step_lengths=(None, 0.1), single_support=(0.85, 1.0),
+             free_speed=False)
+    assert s.nested and len(s.points) == 4 * 2 * 2 * 2
+    keys = {p.key for p in s.points}
+    assert len(keys) == len(s.points)
+    assert "single-support-1_step-0.1m/gaits/plain/speed-006.00m_min.gait.json" in keys
+    assert "single-support-0.85_step-free/gaits/ankle+impulse/speed-012.00m_min.gait.json" \
+        in keys
+    # a chain never crosses a group: parent and child share variant and axes
+    by_key = {p.key: p for p in s.points}
+    for key, parent in s.parents.items():
+        if parent is not None:
+            assert by_key[key].group == by_key[parent].group
+    assert sum(parent is None for parent in s.parents.values()) == 16
+    opts = s.options(by_key["single-support-1_step-0.1m/gaits/plain/speed-006.00m_min.gait.json"])
+    assert (opts.speed, opts.step_length, opts.single_support_fraction, opts.ankle,
+            opts.impulse) == (0.1, 0.1, 1.0, False, False)
+
+
+def test_plain_layout_matches_the_report_layout() -> None:
+    s = spec(speeds=(0.2,))
+    assert not s.nested
+    assert [p.key for p in s.points if p.variant == "ankle+impulse"] == [
+        "gaits/ankle+impulse/speed-012.00m_min.gait.json",
+        "gaits/ankle+impulse/speed-free.gait.json"]
+    assert tuple(dict.fromkeys(p.variant for p in s.points)) == VARIANTS
+
+
+@pytest.mark.parametrize(("kw", "message"), [
+    ({"speeds": ()}, "at least one speed"),
+    ({"speeds": (0.2, 0.1)}, "ascending"),
+    ({"speeds": (-0.1, 0.2)}, "not a positive speed"),
+    ({"speeds": (0.2, 0.2 + 1e-5)}, "same file name"),
+    ({"variants": ("ankle", "walking")}, "unknown variant 'walking'"),
+    ({"variants": ()}, "at least one of"),
+    ({"single_support": (0.85, 0.85)}, "each at most once"),
+])
+def test_bad_grids_are_refused_with_the_setting_named(kw: dict[str, object],
+                                                      message: str) -> None:
+    with pytest.raises(SweepSpecError, match=message):
+        spec(**kw)
+
+
+def test_every_point_is_validated_before_any_solve() -> None:
+    with pytest.raises(SweepSpecError, match=r"plain .*120.00 m/min: speed = .* speed_bounds"):
+        check_points(spec(speeds=(0.2, 2.0), variants=("plain",)))
+    with pytest.raises(SweepSpecError, match="step_length = 3 m: longer than the legs"):
+        check_points(spec(speeds=(0.2,), step_lengths=(3.0,)))
+
+
+def test_settings_differences_name_each_changed_field() -> None:
+    a = sweep_settings(spec())
+    assert settings_differences(a, sweep_settings(spec())) == []
+    b = sweep_settings(spec(speeds=(0.2,), base=GaitOptions(tol=1e-6)))
+    diffs = settings_differences(a, b)
+    assert any(d.startswith("speeds_m_min:") for d in diffs)
+    assert any(d.startswith("options.tol:") for d in diffs)
+    assert len(diffs) == 2
+    assert a["model"]["content_hash"] == MODEL.content_hash()
