@@ -102,3 +102,30 @@ def test_compiled_modes_give_the_same_solution(mode: str, tmp_path: object,
 def test_mx_evaluation_without_expand() -> None:
     res = transcribe(P.two_phase_jump(4), expand=False).solve()
     assert res.objective == pytest.approx(60.0 / 13.0, rel=1e-9)
+
+
+def test_path_rows_relax_one_path_constraint_without_rebuilding() -> None:
+    limit = 1.2
+    tr = transcribe(P.with_path_constraint(20, limit))
+    bound = tr.solve()
+    rows = tr.path_rows("move", "speed")
+    # One row per knot and per midpoint (the constraint is imposed at both).
+    assert rows.size == 21 + 20
+    assert np.allclose(tr.bounds().ubg[rows], limit)
+    free = tr.solve(bounds=tr.bounds().with_rows(rows, -np.inf, np.inf))
+    unconstrained = transcribe(P.double_integrator(20)).solve()
+    assert bound.success and free.success
+    # Relaxed, it is the unconstrained double integrator again (J = 12); bound, it costs more.
+    assert free.objective == pytest.approx(unconstrained.objective, rel=1e-8)
+    assert bound.objective > free.objective * 1.01
+    assert tr.builds["nlp"] == 1
+    with pytest.raises(ValueError, match="no path constraint 'nope'"):
+        tr.path_rows("move", "nope")
+
+
+def test_a_solver_with_other_options_shares_the_derivatives() -> None:
+    tr = transcribe(P.brachistochrone(intervals=10), options={"ipopt.tol": 1e-10})
+    first = tr.solve(P.brachistochrone_guess())
+    other = tr.solve(P.brachistochrone_guess(), options={"ipopt.mu_init": 1e-2})
+    assert tr.builds["solver"] == 2
+    assert other.success and other.objective == pytest.approx(first.objective, rel=1e-8)
