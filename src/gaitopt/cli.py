@@ -1,71 +1,25 @@
 """The ``gaitopt`` command line: one subcommand per step.
 
-Errors the user can fix (a bad model file, a bad option) are printed as one clear line
-(``Error: ...``) on stderr and exit with status 2; they never show a traceback. A subcommand
-signals one by raising :class:`UserError`, or any exception type listed in
-:data:`USER_ERRORS` (converted by the ``cli`` group), e.g. :class:`~gaitopt.robot.ModelError`.
+The group and the shared pieces (:class:`UserError`, :data:`USER_ERRORS`, the console) are in
+:mod:`gaitopt.cli_base`; the subcommands in this module (``model``) and in
+:mod:`gaitopt.cli_gait` (``solve``, ``verify``) and :mod:`gaitopt.cli_study` (``sweep``,
+``report``, ``animate``, ``study``), which register on the group when imported here.
 """
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import click
 from rich import box
-from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from gaitopt import __version__
-from gaitopt.robot import ModelError, RobotModel, builtin_names, builtin_text, load_model
-
-#: Exception types that are the user's to fix: shown as one line, exit status 2.
-USER_ERRORS: tuple[type[Exception], ...] = (ModelError,)
-
-#: Width of tables when the output is not a terminal (a pipe, a file, a CI log).
-PIPE_WIDTH = 120
-
-
-class UserError(click.ClickException):
-    """An error in what the user asked for: printed as one message, exit status 2."""
-
-    exit_code = 2
-
-    def __init__(self, message: str) -> None:
-        super().__init__(" ".join(message.split()))
-
-
-class _Group(click.Group):
-    """A click group that turns :data:`USER_ERRORS` into :class:`UserError`."""
-
-    def invoke(self, ctx: click.Context) -> Any:
-        try:
-            return super().invoke(ctx)
-        except USER_ERRORS as exc:
-            raise UserError(str(exc)) from None
-
-
-def make_console() -> Console:
-    """A rich console on stdout; at least :data:`PIPE_WIDTH` columns when not a terminal
-    (unless ``COLUMNS`` says otherwise), so piped tables are not squeezed to 80 columns.
-
-    Markup is off: text such as ``[kg]`` or ``[-2, 2]`` is printed as it is.
-    """
-    console = Console(markup=False, highlight=False)
-    if not console.is_terminal and "COLUMNS" not in os.environ:
-        console = Console(markup=False, highlight=False, width=max(console.width, PIPE_WIDTH))
-    return console
-
-
-@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="gaitopt")
-def cli() -> None:
-    """gaitopt: energy-optimal walking gaits for planar multibody bipeds."""
-
+from gaitopt import cli_gait, cli_study  # noqa: F401  (they register their subcommands)
+from gaitopt.cli_base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
+from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model
 
 # -- gaitopt model ---------------------------------------------------------------------------
 
@@ -182,11 +136,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-# Subcommands defined in their own modules register themselves on ``cli`` when imported.
-from gaitopt import cli_gait  # noqa: E402,F401,I001  (imported for its side effect)
-from gaitopt import cli_study  # noqa: E402,F401,I001  (imported for its side effect)
 
-__all__ = ["USER_ERRORS", "UserError", "cli", "main", "make_console", "model_tables"]
+__all__ = ["PIPE_WIDTH", "USER_ERRORS", "UserError", "cli", "main", "make_console", "model_tables"]
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 from rich.table import Table
 
-from gaitopt.cli import USER_ERRORS, UserError, cli, make_console
+from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.solve import StageReport

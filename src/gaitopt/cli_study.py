@@ -37,7 +37,7 @@ from gaitopt.analysis.sweep import (
 )
 from gaitopt.analysis.sweep_plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
 from gaitopt.analysis.sweep_worker import PointOutcome
-from gaitopt.cli import UserError, cli, make_console
+from gaitopt.cli_base import UserError, cli, make_console
 from gaitopt.cli_gait import _knots
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError

@@ -1,0 +1,61 @@
+"""The ``gaitopt`` command group and what every subcommand shares.
+
+Errors the user can fix (a bad model file, a bad option) are printed as one clear line
+(``Error: ...``) on stderr and exit with status 2; they never show a traceback. A subcommand
+signals one by raising :class:`UserError`, or any exception type listed in
+:data:`USER_ERRORS` (converted by the ``cli`` group), e.g. :class:`~gaitopt.robot.ModelError`.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import click
+from rich.console import Console
+
+from gaitopt import __version__
+from gaitopt.robot import ModelError
+
+#: Exception types that are the user's to fix: shown as one line, exit status 2.
+USER_ERRORS: tuple[type[Exception], ...] = (ModelError,)
+
+#: Width of tables when the output is not a terminal (a pipe, a file, a CI log).
+PIPE_WIDTH = 120
+
+
+class UserError(click.ClickException):
+    """An error in what the user asked for: printed as one message, exit status 2."""
+
+    exit_code = 2
+
+    def __init__(self, message: str) -> None:
+        super().__init__(" ".join(message.split()))
+
+
+class _Group(click.Group):
+    """A click group that turns :data:`USER_ERRORS` into :class:`UserError`."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except USER_ERRORS as exc:
+            raise UserError(str(exc)) from None
+
+
+def make_console() -> Console:
+    """A rich console on stdout; at least :data:`PIPE_WIDTH` columns when not a terminal
+    (unless ``COLUMNS`` says otherwise), so piped tables are not squeezed to 80 columns.
+
+    Markup is off: text such as ``[kg]`` or ``[-2, 2]`` is printed as it is.
+    """
+    console = Console(markup=False, highlight=False)
+    if not console.is_terminal and "COLUMNS" not in os.environ:
+        console = Console(markup=False, highlight=False, width=max(console.width, PIPE_WIDTH))
+    return console
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="gaitopt")
+def cli() -> None:
+    """gaitopt: energy-optimal walking gaits for planar multibody bipeds."""
