@@ -31,7 +31,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/gaitopt model show five-link
+	$(BIN)/gaitopt study -o out/study
 
 lint: $(STAMP)
 	$(BIN)/ruff check
