@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 from gaitopt.analysis.executors import local_backend
+from gaitopt.analysis.summary import VARIANTS
 from gaitopt.analysis.sweep import run_sweep
 from gaitopt.analysis.sweep_plan import SweepSpec
 from gaitopt.analysis.sweep_worker import PointOutcome
@@ -28,7 +29,6 @@ from gaitopt.cli_study import parse_speeds
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import transcription_for
 from gaitopt.robot import load_model
-from gaitopt.viz.summary import VARIANTS
 
 
 def noop(x: int) -> int:

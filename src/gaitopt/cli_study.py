@@ -27,6 +27,7 @@ from rich.progress import (
 )
 
 from gaitopt.analysis.executors import BackendError
+from gaitopt.analysis.summary import SUMMARY_FILE, VARIANTS, SummaryError
 from gaitopt.analysis.sweep import (
     Counts,
     SweepReport,
@@ -42,7 +43,6 @@ from gaitopt.cli_gait import _knots
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
-from gaitopt.viz.summary import SUMMARY_FILE, VARIANTS, SummaryError
 
 #: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
 DEFAULT_SPEEDS = "3:60:3"
@@ -366,7 +366,7 @@ def study_command(directory: Path, model_name: str, speeds: str, workers: int | 
     optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
     Rerunning resumes."""
     from gaitopt.analysis.findings import optimal_row
-    from gaitopt.viz.summary import read_summary
+    from gaitopt.analysis.summary import read_summary
 
     console = make_console()
     start = time.perf_counter()

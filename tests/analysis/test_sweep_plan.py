@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from gaitopt.analysis.summary import VARIANTS
 from gaitopt.analysis.sweep import check_points
 from gaitopt.analysis.sweep_plan import (
     SweepSpec,
@@ -14,7 +15,6 @@ from gaitopt.analysis.sweep_plan import (
 )
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot import load_model
-from gaitopt.viz.summary import VARIANTS
 
 MODEL = load_model("five-link")
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from gaitopt.analysis.summary import SUMMARY_FILE, read_summary
 from gaitopt.analysis.sweep import (
     SweepReport,
     SweepSettingsError,
@@ -22,7 +23,6 @@ from gaitopt.analysis.sweep import (
 from gaitopt.analysis.sweep_plan import SETTINGS_FILE, SweepSpec
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
-from gaitopt.viz.summary import SUMMARY_FILE, read_summary
 
 MODEL = load_model("five-link")
 K9, K12, K15 = (f"gaits/plain/speed-{v:06.2f}m_min.gait.json" for v in (9, 12, 15))

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from gaitopt.analysis.summary import SummaryError
 from gaitopt.viz.report import ReportInfo, write_report
-from gaitopt.viz.summary import SummaryError
 from tests.viz.synthetic import synthetic_sweep
 
 STEMS = ("fig3_energy", "fig4_step_length", "fig5_hip_motion", "fig6_heights",

@@ -47,6 +47,17 @@ from gaitopt.analysis.executors import (
     inline_backend,
     local_backend,
 )
+from gaitopt.analysis.summary import (
+    GAITS_DIR,
+    SUMMARY_FILE,
+    SummaryError,
+    SummaryRow,
+    gait_relpath,
+    read_summary,
+    summary_row,
+    variant_flags,
+    write_summary,
+)
 from gaitopt.analysis.sweep_plan import (
     SETTINGS_FILE,
     SETTINGS_FORMAT,
@@ -69,17 +80,6 @@ from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptionsError, validate_options
 from gaitopt.ocp import Result
-from gaitopt.viz.summary import (
-    GAITS_DIR,
-    SUMMARY_FILE,
-    SummaryError,
-    SummaryRow,
-    gait_relpath,
-    read_summary,
-    summary_row,
-    variant_flags,
-    write_summary,
-)
 
 LOCK_FILE = ".sweep.lock"
 #: Restarts of a broken process pool in a row (no point finishing between) before giving up.

@@ -14,8 +14,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 
+from gaitopt.analysis.summary import VARIANTS, SummaryRow, rows_of
 from gaitopt.viz.style import VARIANT_LABELS, VARIANT_STYLES, new_figure
-from gaitopt.viz.summary import VARIANTS, SummaryRow, rows_of
 
 COST_LABEL = "cost J = (∫uᵀu dt + P²) / step length  [N² m s]"
 HUMAN_LABEL = "human $E_m$ = 32/v + 0.005 v  [cal/kg/m]"

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.viz.summary import (
+from gaitopt.analysis.summary import (
     SUMMARY_COLUMNS,
     VARIANTS,
     SummaryError,
