@@ -50,7 +50,6 @@ from gaitopt.dynamics.backend import (
     vector,
 )
 from gaitopt.dynamics.contact import contact_dynamics
-from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.robot.biped import BipedStructure, BipedStructureError, Leg, biped_structure
 from gaitopt.robot.model import RobotModel
 
@@ -271,8 +270,3 @@ def double_support_dynamics(model: RobotModel, stance: int, z: Any, zd: Any, tau
     rdd, alphadd = polar_accelerations(zs[0], zs[1], zds[0], zds[1], qdd[_X:_Y + 1])
     zdd = vector([rdd, alphadd, qdd[_TORSO]])
     return ReducedSolution(zdd=zdd, q=q, qd=qd, qdd=sol.qdd, forces=sol.forces)
-
-
-def tip_position(model: RobotModel, q: Any, leg: Leg) -> Any:
-    """World position (m) of a leg's tip."""
-    return contact_position(model, q, leg.contact)

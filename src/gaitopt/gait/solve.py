@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -83,7 +83,6 @@ class WalkingSolution:
     result: Result
     stages: tuple[StageReport, ...]
     wall_time_s: float
-    transcription: Transcription = field(repr=False)
 
     @property
     def success(self) -> bool:
@@ -158,7 +157,7 @@ class _Run:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
         self.stages: list[StageReport] = []
-        self.results: list[tuple[Result, Transcription]] = []
+        self.results: list[Result] = []
 
     def stage(self, name: str, knots: tuple[int, int], relax: Relaxation,
               guess: Guess | Result, bounds: dict[str, Any], *,
@@ -178,7 +177,7 @@ class _Run:
             violation=result.constraint_violation, wall_time_s=time.perf_counter() - start,
             parameters=dict(result.parameters))
         self.stages.append(report)
-        self.results.append((result, tr))
+        self.results.append(result)
         if self.progress is not None:
             self.progress(report)
         return result
@@ -266,14 +265,14 @@ class _Run:
                 return None
         return current
 
-    def final(self) -> tuple[Result, Transcription]:
+    def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
-        the last stage whose values are."""
-        for result, tr in reversed(self.results):
+        the last stage whose values are, marked failed."""
+        for result in reversed(self.results):
             if np.all(np.isfinite(result.w)):
-                if result is not self.results[-1][0]:
-                    return _as_failed(result, self.results[-1][0]), tr
-                return result, tr
+                if result is not self.results[-1]:
+                    return _as_failed(result, self.results[-1])
+                return result
         return self.results[-1]
 
 
@@ -309,7 +308,6 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
             released = run.release(coarse)
             if released.success:
                 run.refine(released)
-    final, tr = run.final()
+    final = run.final()
     return WalkingSolution(model=model, options=options, result=final,
-                           stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
-                           transcription=tr)
+                           stages=tuple(run.stages), wall_time_s=time.perf_counter() - start)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from gaitopt.dynamics.actuation import generalized_forces
-from gaitopt.dynamics.backend import Scalar, Scalars, as_scalars, vector
+from gaitopt.dynamics.backend import Scalar, Scalars, as_scalars, cos, sin, sqrt, vector
 from gaitopt.dynamics.impact import impact, liftoff_impulse
 from gaitopt.dynamics.kinematics import contact_velocity, point_position
 from gaitopt.dynamics.reduced import (
@@ -212,18 +212,10 @@ def tip_vertical_velocity(model: RobotModel, q: Any, qd: Any, leg: Leg) -> Scala
 def front_leg_reach(x_end_or_x: Any, step_length: Scalar) -> Scalar:
     """Distance (m) from the hip to tip 2 at ``(L, 0)`` in double support."""
     z, _ = split_state(x_end_or_x, N_DOUBLE)
-    from gaitopt.dynamics.backend import cos, sin, sqrt
-
     r, alpha = z[0], z[1]
     dx = step_length + r * sin(alpha)
     dy = -r * cos(alpha)
     return sqrt(dx * dx + dy * dy)
-
-
-def double_support_to_full(model: RobotModel, x: Any, step_length: Scalar) -> tuple[Any, Any]:
-    """Full ``(q, qd)`` of a double-support state."""
-    z, zd = split_state(x, N_DOUBLE)
-    return double_support_state(model, 0, z, zd, ORIGIN, (step_length, 0.0))
 
 
 def single_support_to_full(model: RobotModel, x: Any) -> tuple[Any, Any]:
