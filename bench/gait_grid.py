@@ -34,7 +34,7 @@ from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 
 VARIANTS = {
     "ankle+impulse": {"ankle": True, "impulse": True},
@@ -116,10 +116,14 @@ def solve_point(variant: str, speed_m_min: float, *, check: bool) -> Point:
     wall = time.perf_counter() - start
     failed = solution.failed_stage
     nan = float("nan")
-    gait = gait_from_solution(solution) if solution.success else None
+    status, stage = solution.result.status, failed.name if failed else ""
+    try:
+        gait = gait_from_solution(solution) if solution.success else None
+    except MotionOutOfReachError:
+        gait, status, stage = None, "motion out of reach between knots", "record"
     return Point(
-        variant=variant, speed_m_min=speed_m_min, success=solution.success,
-        status=solution.result.status, failed_stage=failed.name if failed else "",
+        variant=variant, speed_m_min=speed_m_min, success=gait is not None,
+        status=status, failed_stage=stage,
         wall_time_s=wall, iterations=sum(s.iterations for s in solution.stages),
         stages=len(solution.stages),
         step_length=gait.step_length if gait else nan,

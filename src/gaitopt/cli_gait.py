@@ -79,6 +79,7 @@ def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, im
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
     from gaitopt.gait.api import as_model, solve_gait
+    from gaitopt.gait.record import MotionOutOfReachError
 
     console = make_console()
     model = as_model(model_name)
@@ -101,6 +102,9 @@ def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, im
                           compiled="codegen" if compiled else None)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
+    except MotionOutOfReachError as exc:
+        console.print(f"FAILED after the last stage: {exc}. No gait file written.")
+        sys.exit(1)
     if not gait.success:
         stages = gait.solver.get("stages", [])
         failed = [s for s in stages if not s["success"]]

@@ -2,19 +2,23 @@
 
 from __future__ import annotations
 
+import dataclasses
+import re
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 
 from gaitopt.gait.api import solve_gait, solve_gait_solution
 from gaitopt.gait.gait_file import FAILED_WARNING, Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.robot import ModelError, load_model
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.robot.loader import builtin_text
+from tests.gait.conftest import Solved
 
 #: A solve forced to fail: 3 IPOPT iterations per stage and no speed continuation.
 FAILING = GaitOptions(max_iter=3, continuation=False)
@@ -100,3 +104,25 @@ def test_a_forced_failure_is_reported_as_failed(tmp_path: Path) -> None:
 def test_missing_model_file_raises_model_error(no_solve: None, tmp_path: Path) -> None:
     with pytest.raises(ModelError, match="no-such.yaml"):
         solve_gait(tmp_path / "no-such.yaml", GaitOptions())
+
+
+def test_motion_out_of_reach_between_knots_is_a_clear_error(default_solved: Solved) -> None:
+    """A solution whose interpolated motion leaves the stance leg's reach between knots (the
+    reach is enforced at knots and midpoints only) cannot be recorded: a clear error that
+    names the phase and the times, not a NaN-filled gait or a traceback from the gait file."""
+    solution = default_solved.solution
+    single = solution.result.phases[0]
+    r = single.states.index("r")
+    xdot = single.xdot.copy()
+    xdot[3, r] = 50.0  # the cubic between knots 3 and 4 bulges far beyond the leg's reach
+    bulged = dataclasses.replace(single, xdot=xdot)
+    result = dataclasses.replace(solution.result,
+                                 phases=(bulged, *solution.result.phases[1:]))
+    broken = dataclasses.replace(solution, result=result)
+    t3, t4 = single.t[3], single.t[4]
+    with pytest.raises(MotionOutOfReachError, match="phase single_support") as err:
+        gait_from_solution(broken)
+    times = [float(v) for v in re.findall(r"t = ([0-9.]+) to ([0-9.]+) s", str(err.value))[0]]
+    assert t3 < times[0] <= times[1] < t4
+    # The unmodified solution records.
+    assert np.all(np.isfinite(gait_from_solution(solution).samples.q))

@@ -7,6 +7,7 @@ import problems as P
 import pytest
 
 from gaitopt.ocp import Guess, PhaseGuess, transcribe
+from gaitopt.ocp.solver import merge_options
 
 
 def test_resolve_with_changed_parameter_bounds_does_not_rebuild() -> None:
@@ -129,3 +130,25 @@ def test_a_solver_with_other_options_shares_the_derivatives() -> None:
     other = tr.solve(P.brachistochrone_guess(), options={"ipopt.mu_init": 1e-2})
     assert tr.builds["solver"] == 2
     assert other.success and other.objective == pytest.approx(first.objective, rel=1e-8)
+
+
+def test_a_limited_memory_solver_derives_no_hessian_and_finds_the_same_optimum() -> None:
+    """``build_solver=False`` defers the solver to the first solve; a limited-memory solve
+    derives no Hessian, and an exact-Hessian solver built afterwards does not try to share
+    the Hessian that the limited-memory one never had."""
+    lm = {"ipopt.hessian_approximation": "limited-memory"}
+    tr = transcribe(P.brachistochrone(intervals=10), options={"ipopt.tol": 1e-10},
+                    build_solver=False)
+    assert tr.builds["solver"] == 0
+    quasi = tr.solve(P.brachistochrone_guess(), options=lm)
+    assert tr.builds["solver"] == 1
+    assert not tr.solver(merge_options(tr.options, lm)).has_function("nlp_hess_l")
+    exact = tr.solve(P.brachistochrone_guess())
+    assert tr.solver(tr.options).has_function("nlp_hess_l")
+    # A second limited-memory solver with other options shares the first one's functions.
+    again = tr.solve(P.brachistochrone_guess(), options={**lm, "ipopt.mu_init": 1e-2})
+    assert tr.builds["solver"] == 3
+    assert quasi.success and exact.success and again.success
+    assert quasi.objective == pytest.approx(exact.objective, rel=1e-7)
+    assert again.objective == pytest.approx(exact.objective, rel=1e-7)
+    assert exact.iterations < quasi.iterations  # Newton's steps against quasi-Newton's

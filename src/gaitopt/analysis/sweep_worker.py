@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from gaitopt.analysis.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.solve import WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, Result
 from gaitopt.robot.model import RobotModel
@@ -156,6 +156,12 @@ def solve_point(task: PointTask) -> PointOutcome:
             row = failed_point_row(task, _failure_status(solution),
                                    iterations=sum(s.iterations for s in solution.stages),
                                    wall_time_s=solution.wall_time_s)
+    except MotionOutOfReachError as exc:  # converged on the grid, not a gait between knots
+        error = str(exc)
+        row = failed_point_row(task, "failed: motion leaves a leg's reach between knots",
+                               iterations=sum(s.iterations for s in solution.stages)
+                               if solution is not None else 0,
+                               wall_time_s=clock() - start)
     except Exception as exc:  # a bug or an OS error: record the point as failed, go on
         error = traceback.format_exc()
         row = failed_point_row(task, f"error: {type(exc).__name__}: {exc}",

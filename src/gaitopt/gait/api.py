@@ -69,6 +69,10 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
         warm_start: a neighbouring gait to start from (the cold path is the fallback).
         progress: called with a :class:`~gaitopt.gait.solve.StageReport` after every stage.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
+
+    Raises:
+        MotionOutOfReachError: the solution's motion between knots leaves a leg's reach (it
+            cannot be recorded as a gait; solve on a finer grid).
     """
     solution = solve_gait_solution(model, options, warm_start=warm_start, progress=progress,
                                    compiled=compiled)

@@ -34,6 +34,15 @@ COST_FORMULA = ("energy per metre (paper eq. 5): (integral over the step of u'u 
 SAMPLE_RATE = 200.0
 
 
+class MotionOutOfReachError(ValueError):
+    """The solution's interpolated motion has no configuration at some sample time.
+
+    The reach of the legs is enforced at the knots and midpoints of the grid only; between
+    them the interpolated hip can pass beyond a leg's reach, where the leg's inverse
+    kinematics has no solution. Such a solution is not a gait (it cannot be recorded or
+    verified); a finer grid enforces the reach more densely."""
+
+
 @functools.lru_cache(maxsize=32)
 def _phase_functions(model: RobotModel, phase: str, controls: tuple[str, ...]) -> ca.Function:
     """``(x, u, L) -> (q, qd, qdd, forces, u_full)`` for a phase, as one SX function."""
@@ -77,7 +86,11 @@ def _evaluate(fn: ca.Function, x: Array, u: Array, step: float) -> list[Array]:
 
 
 def gait_from_solution(solution: WalkingSolution) -> Gait:
-    """The gait record of a walking solution (converged or not: ``solver.success`` says)."""
+    """The gait record of a walking solution (converged or not: ``solver.success`` says).
+
+    Raises:
+        MotionOutOfReachError: the interpolated motion leaves a leg's reach between knots.
+    """
     model, options, res = solution.model, solution.options, solution.result
     legs = checked_biped(model).legs
     step, speed, impulse = (res.parameters[k] for k in ("step_length", "speed", "impulse"))
@@ -164,6 +177,14 @@ def _samples(model: RobotModel, options: GaitOptions, res: Any, step: float) -> 
         uc = ph.u_at(t[mask])
         fn = _phase_functions(model, ph.name, tuple(ph.controls))
         q_s, qd_s, _, _, u_s, _ = _evaluate(fn, np.atleast_2d(x), np.atleast_2d(uc), step)
+        bad = ~np.all(np.isfinite(q_s) & np.isfinite(qd_s), axis=1)
+        if bad.any():
+            times = t[mask][bad]
+            raise MotionOutOfReachError(
+                f"the solution's motion between knots leaves a leg's reach in phase "
+                f"{ph.name} at {bad.sum()} of the {count} samples (t = {times[0]:.4f} to "
+                f"{times[-1]:.4f} s): the reach is enforced at knots and midpoints only; "
+                f"solve on a finer grid (more knots)")
         q[mask], qd[mask], u[mask] = q_s, qd_s, u_s
     pts = np.asarray(_points_function(model).map(count)(q.T), dtype=float)  # (2, 6 * count)
     pts = pts.T.reshape(count, len(POINTS), 2)  # sample k, point j at row 6 k + j

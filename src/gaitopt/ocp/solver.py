@@ -43,6 +43,19 @@ COMPILED_MODES = (None, "codegen", "jit")
 EVAL_KINDS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l")
 
 
+def exact_hessian(options: Mapping[str, Any]) -> bool:
+    """Whether ``options`` ask IPOPT for the exact Hessian of the Lagrangian (the default)
+    rather than a limited-memory quasi-Newton approximation, which needs no Hessian
+    function: none is derived, which saves most of the build time of a large NLP."""
+    return options.get("ipopt.hessian_approximation", "exact") != "limited-memory"
+
+
+def derivative_kinds(options: Mapping[str, Any]) -> tuple[str, ...]:
+    """The solver functions ``options`` need: all of :data:`EVAL_KINDS`, or all but
+    ``nlp_hess_l`` with a limited-memory Hessian."""
+    return EVAL_KINDS if exact_hessian(options) else EVAL_KINDS[:-1]
+
+
 def merge_options(*layers: Mapping[str, Any] | None) -> dict[str, Any]:
     """Flatten nested ``{"ipopt": {...}}`` to ``"ipopt.key"`` and merge, later layers win."""
     out: dict[str, Any] = {}
@@ -87,7 +100,9 @@ def _nlp_hash(nlp: NlpFunctions) -> str:
 
 def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any],
                     flags: tuple[str, ...]) -> ca.Function:
-    digest = hashlib.sha256((_nlp_hash(nlp) + " ".join(flags)).encode()).hexdigest()[:16]
+    kinds = derivative_kinds(options)
+    digest = hashlib.sha256((_nlp_hash(nlp) + " ".join(flags) + " ".join(kinds)).encode()
+                            ).hexdigest()[:16]
     lib_name = f"ocp_{digest}"
     cached = sorted(codegen.cache_dir().glob(f"{lib_name}-*.so"))
     if cached:
@@ -95,15 +110,17 @@ def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any],
     else:
         base = ca.nlpsol(f"{name}_base", "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g},
                          options)
-        fns = [base.get_function(k) for k in EVAL_KINDS]
+        fns = [base.get_function(k) for k in kinds]
         path = codegen.compile_library(codegen.generate_source(fns, lib_name), lib_name,
                                        flags=flags)
-    ext = {k: ca.external(k, str(path)) for k in EVAL_KINDS}
+    ext = {k: ca.external(k, str(path)) for k in kinds}
     X = ca.MX.sym("w", nlp.x.shape[0])
     P = ca.MX.sym("p", 0)
     opts = dict(options)
-    opts.update(grad_f=ext["nlp_grad_f"], jac_g=ext["nlp_jac_g"], hess_lag=ext["nlp_hess_l"],
-                no_nlp_grad=True, calc_lam_p=False)
+    opts.update(grad_f=ext["nlp_grad_f"], jac_g=ext["nlp_jac_g"], no_nlp_grad=True,
+                calc_lam_p=False)
+    if "nlp_hess_l" in ext:
+        opts["hess_lag"] = ext["nlp_hess_l"]
     return ca.nlpsol(name, "ipopt", {"x": X, "f": ext["nlp_f"](X, P), "g": ext["nlp_g"](X, P)},
                      opts)
 
@@ -135,14 +152,17 @@ def solver_sharing_derivatives(name: str, base: ca.Function, n_w: int,
     It takes ``base``'s objective, constraint, gradient, Jacobian and Hessian functions
     (``nlp_f``, ``nlp_g``, ``nlp_grad_f``, ``nlp_jac_g``, ``nlp_hess_l``) instead of deriving
     them again, which for a large expanded NLP costs seconds at the first call of every new
-    solver.
+    solver. ``base`` must have the functions ``options`` need (:func:`derivative_kinds`): an
+    exact-Hessian solver cannot share from a limited-memory one.
     """
-    fns = {k: base.get_function(k) for k in EVAL_KINDS}
+    fns = {k: base.get_function(k) for k in derivative_kinds(options)}
     x = ca.MX.sym("w", n_w)
     p = ca.MX.sym("p", 0)
     opts = dict(options)
-    opts.update(grad_f=fns["nlp_grad_f"], jac_g=fns["nlp_jac_g"], hess_lag=fns["nlp_hess_l"],
-                no_nlp_grad=True, calc_lam_p=False)
+    opts.update(grad_f=fns["nlp_grad_f"], jac_g=fns["nlp_jac_g"], no_nlp_grad=True,
+                calc_lam_p=False)
+    if "nlp_hess_l" in fns:
+        opts["hess_lag"] = fns["nlp_hess_l"]
     return ca.nlpsol(name, "ipopt", {"x": x, "f": fns["nlp_f"](x, p), "g": fns["nlp_g"](x, p)},
                      opts)
 

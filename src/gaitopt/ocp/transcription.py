@@ -34,6 +34,7 @@ from gaitopt.ocp.solver import (
     EVAL_KINDS,
     SolverOutput,
     call_solver,
+    exact_hessian,
     make_solver,
     merge_options,
     nlp_symbols,
@@ -59,7 +60,8 @@ class Transcription:
     def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool | None = None,
                  compiled: str | None = None, options: Mapping[str, Any] | None = None,
                  scaling: bool = True, cse: bool = True,
-                 compile_flags: Sequence[str] | None = None) -> None:
+                 compile_flags: Sequence[str] | None = None, build_solver: bool = True
+                 ) -> None:
         check_problem(problem)
         if method not in METHODS:
             raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -94,25 +96,33 @@ class Transcription:
         self._bounds.check()
         self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
         self.builds["nlp"] += 1
-        self._solvers: dict[str, ca.Function] = {}
-        self.solver(self.options)
+        # Solvers by options, and whether each has the exact Hessian (see solver()).
+        self._solvers: dict[str, tuple[ca.Function, bool]] = {}
+        if build_solver:
+            self.solver(self.options)
 
     # -- solvers ---------------------------------------------------------------------------
     def solver(self, options: Mapping[str, Any]) -> ca.Function:
-        """The (cached) IPOPT solver for ``options`` (built on first use)."""
+        """The (cached) IPOPT solver for ``options``, built on first use.
+
+        The first solver of each Hessian mode derives the NLP's derivative functions (for a
+        large expanded NLP most of that time goes to the exact Hessian of the Lagrangian,
+        which a limited-memory solver never derives); later solvers with other options
+        share them (:func:`solver_sharing_derivatives`)."""
         key = options_key(options)
         if key not in self._solvers:
             name = f"ocp_solver_{len(self._solvers)}"
-            if self._solvers:
-                # Same NLP, other options: reuse the first solver's derivative functions.
-                base = next(iter(self._solvers.values()))
-                self._solvers[key] = solver_sharing_derivatives(name, base, self.layout.size,
-                                                                dict(options))
+            exact = exact_hessian(options)
+            base = next((fn for fn, ex in self._solvers.values() if ex == exact), None)
+            if base is not None:
+                solver = solver_sharing_derivatives(name, base, self.layout.size,
+                                                    dict(options))
             else:
-                self._solvers[key] = make_solver(name, self._symbols, dict(options),
-                                                  self.compiled, self.compile_flags)
+                solver = make_solver(name, self._symbols, dict(options), self.compiled,
+                                     self.compile_flags)
+            self._solvers[key] = (solver, exact)
             self.builds["solver"] += 1
-        return self._solvers[key]
+        return self._solvers[key][0]
 
     # -- bounds and guesses ----------------------------------------------------------------
     def path_rows(self, phase: str, name: str) -> NDArray[np.int64]:
@@ -258,7 +268,8 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
                intervals: IntervalsSpec | Mapping[str, IntervalsSpec] | None = None,
                expand: bool | None = None, compiled: str | None = None,
                options: Mapping[str, Any] | None = None, scaling: bool = True,
-               cse: bool = True, compile_flags: Sequence[str] | None = None) -> Transcription:
+               cse: bool = True, compile_flags: Sequence[str] | None = None,
+               build_solver: bool = True) -> Transcription:
     """Validate ``problem``, build its NLP and solver once, and return the transcription.
 
     Args:
@@ -277,10 +288,14 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
         compile_flags: C compiler flags for ``compiled="codegen"`` (default
             ``gaitopt.codegen.DEFAULT_FLAGS``, ``-O2``; ``("-O1", "-fPIC", "-shared")``
             compiles faster).
+        build_solver: build the solver for ``options`` now (default), or at the first solve
+            (a caller that solves with a limited-memory Hessian first never derives the
+            exact one it would not use: for a large expanded NLP, most of the build time).
     """
     if method not in METHODS:
         raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
     check_problem(problem)
     mesh = make_mesh(problem, intervals)
     return Transcription(problem, method, mesh, expand=expand, compiled=compiled,
-                         options=options, scaling=scaling, cse=cse, compile_flags=compile_flags)
+                         options=options, scaling=scaling, cse=cse, compile_flags=compile_flags,
+                         build_solver=build_solver)
