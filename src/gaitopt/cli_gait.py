@@ -70,19 +70,29 @@ def _knots(text: str) -> tuple[int, int]:
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
+@click.option("--warm-start", "warm_start", type=click.Path(dir_okay=False, path_type=Path),
+              default=None, help="A gait file to start from (e.g. a neighbouring speed's "
+                                 "gait); the cold path is the fallback.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, impulse: bool,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
-                  unilateral_impulses: bool, compiled: bool, output: Path) -> None:
+                  unilateral_impulses: bool, compiled: bool, warm_start: Path | None,
+                  output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
-    from gaitopt.gait.api import as_model, solve_gait
+    from gaitopt.gait.api import as_model, solve_gait, warm_start_usable
     from gaitopt.gait.record import MotionOutOfReachError
 
     console = make_console()
     model = as_model(model_name)
+    start: Gait | None = None
+    if warm_start is not None:
+        try:
+            start = Gait.load(warm_start)
+        except GaitFileError as exc:
+            raise UserError(f"--warm-start: {exc}") from None
     options = GaitOptions(
         speed=_speed(speed), step_length=_step(step_length), ankle=ankle, impulse=impulse,
         single_support_fraction=single_support, knots=_knots(knots),
@@ -94,11 +104,15 @@ def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, im
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   f", {options.knots[0]}+{options.knots[1]} knots")
 
+    if start is not None and not warm_start_usable(start, options):
+        console.print(f"note: {warm_start} was solved with other ankle torques or another "
+                      "single-support fraction; starting cold")
+
     def progress(stage: StageReport) -> None:
         console.print("  stage " + stage.line())
 
     try:
-        gait = solve_gait(model, options, progress=progress,
+        gait = solve_gait(model, options, progress=progress, warm_start=start,
                           compiled="codegen" if compiled else None)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None

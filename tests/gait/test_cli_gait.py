@@ -16,6 +16,7 @@ from click.testing import CliRunner, Result
 from gaitopt.cli import cli
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.record import MotionOutOfReachError
 from tests.gait.test_walking_errors import one_legged_model_file
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -123,3 +124,47 @@ def test_failed_solve_exits_1_names_the_stage_and_writes_nothing(
     assert "FAILED at stage 'relaxed contact': Maximum_Iterations_Exceeded" in text
     assert "No gait file written" in text
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_motion_out_of_reach_exits_1_with_the_reason_and_writes_nothing(
+        no_solve: None, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """A solution that cannot be recorded (its motion leaves a leg's reach between knots,
+    see tests/gait/test_walking_errors.py) is a failed solve: a message, exit 1, no file."""
+    def unrecordable(*args: object, **kwargs: object) -> Gait:
+        raise MotionOutOfReachError("the solution's motion between knots leaves a leg's reach "
+                                    "in phase double_support")
+
+    monkeypatch.setattr("gaitopt.gait.api.solve_gait", unrecordable)
+    out = tmp_path / "g.gait.json"
+    result = solve("-o", str(out))
+    assert result.exit_code == 1, result.output
+    text = " ".join(result.output.split())
+    assert "FAILED after the last stage" in text and "leaves a leg's reach" in text
+    assert "No gait file written" in text and "Traceback" not in text
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_warm_start_from_a_gait_file_solves_a_nearby_speed_in_one_stage(
+        tmp_path: Path, default_gait: Gait, default_gait_file: Path) -> None:
+    out = tmp_path / "faster.gait.json"
+    result = solve("--speed", "12.6m/min", "--warm-start", str(default_gait_file), "-o",
+                   str(out))
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "stage warm start" in text and "stage relaxed contact" not in text
+    gait = Gait.load(out)
+    assert gait.success and gait.speed == pytest.approx(0.21)
+    # Energy per metre grows with speed near the optimum (paper Fig. 3).
+    assert gait.cost_value > default_gait.cost_value
+    # A gait of another variant is not used: the solve starts cold and says so.
+    other = solve("--no-ankle", "--warm-start", str(default_gait_file), "-o",
+                  str(tmp_path / "plain.gait.json"))
+    assert other.exit_code == 0, other.output
+    other_text = " ".join(other.output.split())  # rich wraps lines at the terminal width
+    assert "starting cold" in other_text and "stage relaxed contact" in other_text
+    # A missing or broken file is a one-line error before any solve.
+    broken = tmp_path / "broken.gait.json"
+    broken.write_text("{")
+    bad = solve("--warm-start", str(broken), "-o", str(tmp_path / "x.gait.json"))
+    assert bad.exit_code == 2 and "--warm-start" in " ".join(bad.output.split())
+    assert "Traceback" not in bad.output

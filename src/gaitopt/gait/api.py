@@ -42,6 +42,14 @@ def guess_from_gait(gait: Gait) -> Guess:
                                             "impulse": p["liftoff_impulse"]})
 
 
+def warm_start_usable(gait: Gait, options: GaitOptions) -> bool:
+    """Whether ``gait`` can start a solve with ``options``: the same controls (ankle torques
+    or not) and the same phases (single-support fraction). Otherwise it is not used."""
+    return bool(gait.options.get("ankle") == options.ankle and
+                gait.options.get("single_support_fraction") ==
+                options.single_support_fraction)
+
+
 def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
                         options: GaitOptions | None = None, *,
                         warm_start: Gait | None = None, progress: ProgressFn | None = None,
@@ -50,9 +58,7 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     robot = as_model(model)
     opts = options or GaitOptions()
     guess = None
-    if warm_start is not None and warm_start.options.get("ankle") == opts.ankle and \
-            bool(warm_start.options.get("single_support_fraction") ==
-                 opts.single_support_fraction):
+    if warm_start is not None and warm_start_usable(warm_start, opts):
         guess = guess_from_gait(warm_start)
     return solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
 
