@@ -25,13 +25,22 @@ def _speed(text: str) -> float | None:
         raise UserError(f"--speed: {exc}") from None
 
 
-def _step(text: str) -> float | None:
+def _free_or_value(text: str, option: str, unit: str, quantity: str) -> float | None:
+    """``free`` -> None, else a number with an optional unit suffix (``0.1m``, ``0.6s``)."""
     if text.strip().lower() == "free":
         return None
     try:
-        return float(text.removesuffix("m"))
+        return float(text.strip().removesuffix(unit))
     except ValueError:
-        raise UserError(f"--step-length: {text!r} is not a length in m or 'free'") from None
+        raise UserError(f"{option}: {text!r} is not a {quantity} in {unit} or 'free'") from None
+
+
+def _step(text: str) -> float | None:
+    return _free_or_value(text, "--step-length", "m", "length")
+
+
+def _step_time(text: str) -> float | None:
+    return _free_or_value(text, "--step-time", "s", "time")
 
 
 def _knots(text: str) -> tuple[int, int]:
@@ -52,6 +61,8 @@ def _knots(text: str) -> tuple[int, int]:
               help="Average speed with a unit (12m/min, 0.2m/s) or 'free' (the optimal walk).")
 @click.option("--step-length", default="free", show_default=True,
               help="Step length in m, or 'free'.")
+@click.option("--step-time", default="free", show_default=True,
+              help="Step time in s (step length / speed), or 'free'; not with --step-length.")
 @click.option("--ankle/--no-ankle", default=True, show_default=True,
               help="Ankle torques at the tips on the ground.")
 @click.option("--impulse/--no-impulse", default=True, show_default=True,
@@ -75,7 +86,8 @@ def _knots(text: str) -> tuple[int, int]:
                                  "gait); the cold path is the fallback.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
-def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, impulse: bool,
+def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
+                  impulse: bool,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, compiled: bool, warm_start: Path | None,
@@ -94,7 +106,8 @@ def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, im
         except GaitFileError as exc:
             raise UserError(f"--warm-start: {exc}") from None
     options = GaitOptions(
-        speed=_speed(speed), step_length=_step(step_length), ankle=ankle, impulse=impulse,
+        speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
+        ankle=ankle, impulse=impulse,
         single_support_fraction=single_support, knots=_knots(knots),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
@@ -102,7 +115,8 @@ def solve_command(model_name: str, speed: str, step_length: str, ankle: bool, im
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
-                  f", {options.knots[0]}+{options.knots[1]} knots")
+                  + ("" if options.step_time is None else f", step time {options.step_time} s")
+                  + f", {options.knots[0]}+{options.knots[1]} knots")
 
     if start is not None and not warm_start_usable(start, options):
         console.print(f"note: {warm_start} was solved with other ankle torques or another "

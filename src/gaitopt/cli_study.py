@@ -107,19 +107,22 @@ def parse_variants(text: str) -> tuple[str, ...]:
     return tuple(v for v in VARIANTS if v in names)
 
 
-def parse_step_lengths(text: str) -> tuple[float | None, ...]:
-    """``free`` or a comma list of step lengths in m (``free`` may be one of them)."""
+def parse_step_lengths(text: str, *, option: str = "--step-length", unit: str = "m",
+                       quantity: str = "length") -> tuple[float | None, ...]:
+    """``free`` or a comma list of step lengths in m (``free`` may be one of them); with
+    ``option="--step-time", unit="s", quantity="time"``, of step times in s."""
     out: list[float | None] = []
     for item in (i.strip() for i in text.split(",")):
         if item.lower() == "free":
             out.append(None)
             continue
         try:
-            value = float(item.removesuffix("m"))
+            value = float(item.removesuffix(unit))
         except ValueError:
-            raise UserError(f"--step-length: {item!r} is not a length in m or 'free'") from None
+            raise UserError(f"{option}: {item!r} is not a {quantity} in {unit} or "
+                            "'free'") from None
         if not (math.isfinite(value) and value > 0):
-            raise UserError(f"--step-length: {item!r} must be > 0 m (or 'free')")
+            raise UserError(f"{option}: {item!r} must be > 0 {unit} (or 'free')")
         out.append(value)
     return tuple(dict.fromkeys(out))
 
@@ -139,7 +142,7 @@ def parse_fractions(text: str) -> tuple[float, ...]:
 
 
 def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
-              single_support: str, knots: str) -> SweepSpec:
+              single_support: str, knots: str, step_time: str = "free") -> SweepSpec:
     from gaitopt.gait.api import as_model
 
     model = as_model(model_name)
@@ -147,6 +150,8 @@ def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_l
         return SweepSpec(model=model, speeds=parse_speeds(speeds),
                          variants=parse_variants(variants), free_speed=free,
                          step_lengths=parse_step_lengths(step_length),
+                         step_times=parse_step_lengths(step_time, option="--step-time",
+                                                       unit="s", quantity="time"),
                          single_support=parse_fractions(single_support),
                          base=GaitOptions(knots=_knots(knots)))
     except SweepSpecError as exc:
@@ -251,14 +256,16 @@ def _workers_option(f: Any) -> Any:
               help="Also solve the speed-free optimal walk of each variant.")
 @click.option("--step-length", default="free", show_default=True,
               help="Step lengths in m (comma list), or 'free'.")
+@click.option("--step-time", default="free", show_default=True,
+              help="Step times in s (comma list), or 'free'; not with --step-length.")
 @click.option("--single-support", default="0.85", show_default=True,
               help="Single-support fractions of the step time (comma list).")
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
-                  step_length: str, single_support: str, knots: str, workers: int | None,
-                  scheduler: str | None) -> None:
+                  step_length: str, step_time: str, single_support: str, knots: str,
+                  workers: int | None, scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -267,7 +274,8 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     """
     console = make_console()
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
-                     step_length=step_length, single_support=single_support, knots=knots)
+                     step_length=step_length, single_support=single_support, knots=knots,
+                     step_time=step_time)
     report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
     if report.counts.failed:
         sys.exit(1)

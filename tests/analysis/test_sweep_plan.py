@@ -81,6 +81,23 @@ def test_one_chain_set_per_variant_and_axis_combination_in_subfolders() -> None:
             opts.impulse) == (0.1, 0.1, 1.0, False, False)
 
 
+def test_a_step_time_axis_fixes_the_step_length_through_the_speed() -> None:
+    s = spec(speeds=(0.15, 0.2), step_times=(0.5, 0.7), variants=("plain",))
+    assert s.nested and len(s.points) == 2 * 3
+    by_key = {p.key: p for p in s.points}
+    point = by_key["single-support-0.85_step-time-0.7s/gaits/plain/speed-012.00m_min.gait.json"]
+    opts = s.options(point)
+    assert (opts.speed, opts.step_time, opts.step_length) == (0.2, 0.7, None)
+    free = by_key["single-support-0.85_step-time-0.5s/gaits/plain/speed-free.gait.json"]
+    assert s.options(free).speed is None and s.options(free).step_time == 0.5
+    assert sweep_settings(s)["step_times"] == [0.5, 0.7]
+    # A sweep without step times writes the settings it always wrote (old sweeps resume).
+    assert "step_times" not in sweep_settings(spec(speeds=(0.2,)))
+    # A step time whose step length at some speed leaves the bounds is refused up front.
+    with pytest.raises(SweepSpecError, match="step_time = 5 s: with the speed"):
+        check_points(spec(speeds=(0.2,), step_times=(5.0,)))
+
+
 def test_plain_layout_matches_the_report_layout() -> None:
     s = spec(speeds=(0.2,))
     assert not s.nested
@@ -98,6 +115,9 @@ def test_plain_layout_matches_the_report_layout() -> None:
     ({"variants": ("ankle", "walking")}, "unknown variant 'walking'"),
     ({"variants": ()}, "at least one of"),
     ({"single_support": (0.85, 0.85)}, "each at most once"),
+    ({"step_times": (0.5, 0.5)}, "step times: at least one, each at most once"),
+    ({"step_times": (-0.5,)}, "not a positive time"),
+    ({"step_times": (0.5,), "step_lengths": (0.1,)}, "give one of them"),
 ])
 def test_bad_grids_are_refused_with_the_setting_named(kw: dict[str, object],
                                                       message: str) -> None:

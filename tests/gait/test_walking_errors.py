@@ -61,6 +61,13 @@ BAD_OPTIONS: dict[str, tuple[dict[str, Any], tuple[str, ...]]] = {
     "negative friction": ({"friction": -0.5}, ("friction", "> 0")),
     "NaN step length": ({"step_length": float("nan")}, ("step_length", "finite")),
     "inverted step bounds": ({"step_length_bounds": (0.5, 0.1)}, ("step_length_bounds",)),
+    "step time and step length": ({"step_time": 0.5, "step_length": 0.1},
+                                  ("step_time", "step_length", "at most one")),
+    "negative step time": ({"step_time": -0.5}, ("step_time", "> 0")),
+    "step time too long for the speed": ({"step_time": 8.0},
+                                         ("step_time", "step length 1.6 m", "reach")),
+    "step time too short for any speed": ({"speed": None, "step_time": 0.01},
+                                          ("step_time", "speed_bounds")),
 }
 
 

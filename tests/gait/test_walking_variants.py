@@ -92,6 +92,28 @@ def test_step_length_fixed(solved: SolveFn, default_gait: Gait, reference: RefFn
     _verified(gait)
 
 
+def test_step_time_fixed_with_the_speed_given_and_free(
+        solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
+    """A step time fixes the step length at a given speed (the same optimum as that step
+    length) and, with the speed free, gives the optimal walk of that step time."""
+    timed = solved(GaitOptions(step_time=0.75)).gait
+    by_length = solved(GaitOptions(step_length=0.15)).gait
+    assert timed.success and timed.step_length == pytest.approx(0.15, abs=1e-9)
+    assert timed.cost_value == pytest.approx(by_length.cost_value, rel=1e-6)
+    walk = solved(GaitOptions(speed=None, step_time=0.8)).gait
+    assert walk.success
+    assert walk.parameters["step_time"] == pytest.approx(0.8, abs=1e-7)
+    assert walk.step_length == pytest.approx(0.8 * walk.speed, abs=1e-7)
+    # Constrained, it costs no less than the free optimum (whose step time is about 0.57 s)
+    # nor more than the 12 m/min gait of the same step time.
+    free = solved(GaitOptions(speed=None)).gait
+    assert walk.cost_value >= free.cost_value * (1 - REL)
+    fixed_speed = solved(GaitOptions(step_time=0.8)).gait
+    assert walk.cost_value <= fixed_speed.cost_value * (1 + REL)
+    assert_physics(reference(walk.model), walk)
+    _verified(walk)
+
+
 def test_single_support_fraction_one_has_no_double_support(
         solved: SolveFn, reference: RefFn) -> None:
     """The single-support gait: tip 2 strikes, tip 1 leaves at that instant with no impulse,

@@ -39,7 +39,8 @@ SETTINGS_FILE = "sweep.json"
 SETTINGS_FORMAT = "gaitopt.sweep"
 SETTINGS_VERSION = 1
 #: Options set per point (not part of the sweep's shared ``options``).
-POINT_FIELDS = ("speed", "ankle", "impulse", "step_length", "single_support_fraction", "knots")
+POINT_FIELDS = ("speed", "ankle", "impulse", "step_length", "step_time",
+                "single_support_fraction", "knots")
 
 
 class SweepSpecError(ValueError):
@@ -56,6 +57,8 @@ class SweepSpec:
         variants: subset of :data:`gaitopt.analysis.summary.VARIANTS`, in that order.
         free_speed: also solve the speed-free optimal walk of every group.
         step_lengths: step lengths (m), ``None`` meaning free (optimized).
+        step_times: step times (s), ``None`` meaning free; with a fixed speed a step time
+            fixes the step length, so give step lengths or step times, not both.
         single_support: single-support fractions of the step time.
         base: every other problem option (bounds, tolerances, grid ``knots``, ...); its
             per-point fields (:data:`POINT_FIELDS` but ``knots``) are ignored.
@@ -66,6 +69,7 @@ class SweepSpec:
     variants: tuple[str, ...] = VARIANTS
     free_speed: bool = True
     step_lengths: tuple[float | None, ...] = (None,)
+    step_times: tuple[float | None, ...] = (None,)
     single_support: tuple[float, ...] = (0.85,)
     base: GaitOptions = field(default_factory=GaitOptions)
 
@@ -78,23 +82,26 @@ class SweepSpec:
 
     @property
     def nested(self) -> bool:
-        """Whether each (step length, single-support) combination has its own sub-sweep."""
-        return len(self.step_lengths) * len(self.single_support) > 1
+        """Whether each (step length or time, single-support) combination has its own
+        sub-sweep."""
+        return len(self.step_lengths) * len(self.step_times) * len(self.single_support) > 1
 
     @cached_property
     def points(self) -> tuple[SweepPoint, ...]:
-        """Every point, grouped (single support, step length, variant), speeds ascending,
-        the speed-free point last in its group."""
+        """Every point, grouped (single support, step length or time, variant), speeds
+        ascending, the speed-free point last in its group."""
         out = []
         for ss in self.single_support:
             for step in self.step_lengths:
-                for variant in self.variants:
-                    speeds: list[float | None] = list(self.speeds)
-                    if self.free_speed:
-                        speeds.append(None)
-                    for v in speeds:
-                        out.append(SweepPoint(variant=variant, speed=v, step_length=step,
-                                              single_support=ss, nested=self.nested))
+                for period in self.step_times:
+                    for variant in self.variants:
+                        speeds: list[float | None] = list(self.speeds)
+                        if self.free_speed:
+                            speeds.append(None)
+                        for v in speeds:
+                            out.append(SweepPoint(variant=variant, speed=v, step_length=step,
+                                                  step_time=period, single_support=ss,
+                                                  nested=self.nested))
         return tuple(out)
 
     @cached_property
@@ -119,7 +126,7 @@ class SweepSpec:
         """The full problem options of a point."""
         ankle, impulse = variant_flags(point.variant)
         return self.base.replace(speed=point.speed, ankle=ankle, impulse=impulse,
-                                 step_length=point.step_length,
+                                 step_length=point.step_length, step_time=point.step_time,
                                  single_support_fraction=point.single_support)
 
 
@@ -131,8 +138,12 @@ def start_index(speeds: Sequence[float]) -> int:
                key=lambda i: (round(abs(speeds[i] - START_SPEED) * 60.0, 6), speeds[i]))
 
 
-def axis_tag(single_support: float, step_length: float | None) -> str:
-    """The sub-sweep folder of a (single-support fraction, step length) combination."""
+def axis_tag(single_support: float, step_length: float | None,
+             step_time: float | None = None) -> str:
+    """The sub-sweep folder of a (single-support fraction, step length or step time)
+    combination."""
+    if step_time is not None:
+        return f"single-support-{single_support:g}_step-time-{step_time:g}s"
     step = "free" if step_length is None else f"{step_length:g}m"
     return f"single-support-{single_support:g}_step-{step}"
 
@@ -145,6 +156,7 @@ class SweepPoint:
     speed: float | None
     step_length: float | None
     single_support: float
+    step_time: float | None = None
     nested: bool = False
 
     @property
@@ -154,7 +166,8 @@ class SweepPoint:
     @property
     def subdir(self) -> str:
         """The sub-sweep folder ("" for a plain sweep)."""
-        return axis_tag(self.single_support, self.step_length) if self.nested else ""
+        return (axis_tag(self.single_support, self.step_length, self.step_time)
+                if self.nested else "")
 
     @property
     def relfile(self) -> str:
@@ -169,14 +182,15 @@ class SweepPoint:
         return f"{self.subdir}/{self.relfile}" if self.subdir else self.relfile
 
     @property
-    def group(self) -> tuple[str, float | None, float]:
+    def group(self) -> tuple[str, float | None, float | None, float]:
         """Points of a group share a continuation chain."""
-        return (self.variant, self.step_length, self.single_support)
+        return (self.variant, self.step_length, self.step_time, self.single_support)
 
     @property
     def structure(self) -> str:
         """Points with the same structure share a transcription (built once per process)."""
-        return f"ankle={'ankle' in self.variant} single_support={self.single_support:g}"
+        return (f"ankle={'ankle' in self.variant} single_support={self.single_support:g}"
+                + (" step_time" if self.step_time is not None else ""))
 
     def label(self) -> str:
         speed = "free" if self.speed is None else f"{self.speed * 60:.2f} m/min"
@@ -208,6 +222,16 @@ def check_spec(spec: SweepSpec) -> None:
         raise SweepSpecError("variants: each variant at most once")
     if not spec.step_lengths or len(set(spec.step_lengths)) != len(spec.step_lengths):
         raise SweepSpecError("step lengths: at least one, each at most once")
+    if not spec.step_times or len(set(spec.step_times)) != len(spec.step_times):
+        raise SweepSpecError("step times: at least one, each at most once")
+    for period in spec.step_times:
+        if period is not None and not (isinstance(period, float | int)
+                                       and math.isfinite(period) and period > 0):
+            raise SweepSpecError(f"step times: {period!r} s is not a positive time")
+    if any(x is not None for x in spec.step_lengths) and any(
+            x is not None for x in spec.step_times):
+        raise SweepSpecError("step lengths and step times: give one of them (with the speed "
+                             "each fixes the other)")
     if not spec.single_support or len(set(spec.single_support)) != len(spec.single_support):
         raise SweepSpecError("single-support fractions: at least one, each at most once")
 
@@ -227,7 +251,7 @@ def sweep_settings(spec: SweepSpec) -> dict[str, Any]:
         "step_lengths": list(spec.step_lengths),
         "single_support_fractions": list(spec.single_support),
         "options": shared,
-    }
+    } | ({"step_times": list(spec.step_times)} if spec.step_times != (None,) else {})
 
 
 def settings_document(spec: SweepSpec) -> dict[str, Any]:

@@ -32,6 +32,9 @@ class GaitOptions:
         speed_bounds: bounds (m/s) when the speed is free.
         step_length: step length (m), or ``None`` for free.
         step_length_bounds: bounds (m) when the step length is free.
+        step_time: step time ``L / v`` (s), or ``None`` for free. With a given speed it
+            fixes the step length; with the speed free, the optimal walk of that step time.
+            Give at most one of ``step_length`` and ``step_time``.
         ankle: ankle torques on (at the tips on the ground).
         impulse: liftoff impulse on.
         single_support_fraction: phase-1 share of the step time, in (0, 1]; 1 gives the
@@ -58,6 +61,7 @@ class GaitOptions:
     speed_bounds: tuple[float, float] = (0.02, 1.5)
     step_length: float | None = None
     step_length_bounds: tuple[float, float] = (0.02, 0.8)
+    step_time: float | None = None
     ankle: bool = True
     impulse: bool = True
     single_support_fraction: float = 0.85
@@ -156,6 +160,24 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         if not l_lo <= step <= l_hi:
             raise GaitOptionsError(f"step_length = {step:g} m: must lie in step_length_bounds "
                                    f"[{l_lo:g}, {l_hi:g}] m")
+    if o.step_time is not None:
+        period = _finite("step_time", o.step_time)
+        if period <= 0.0:
+            raise GaitOptionsError(f"step_time = {period:g} s: must be > 0 (or free)")
+        if o.step_length is not None:
+            raise GaitOptionsError(f"step_time = {period:g} s and step_length = "
+                                   f"{o.step_length:g} m: give at most one of them (with the "
+                                   "speed they fix each other)")
+        lo_v, hi_v = (o.speed, o.speed) if o.speed is not None else (v_lo, v_hi)
+        if period * hi_v < l_lo or period * lo_v > min(l_hi, longest):
+            what = (f"speed {format_speed(o.speed)}" if o.speed is not None else
+                    f"speed_bounds [{format_speed(v_lo)}, {format_speed(v_hi)}]")
+            steps = (f"{period * lo_v:.3g} m" if lo_v == hi_v else
+                     f"{period * lo_v:.3g}-{period * hi_v:.3g} m")
+            raise GaitOptionsError(
+                f"step_time = {period:g} s: with the {what} the step length {steps} would "
+                f"leave [{l_lo:g}, {min(l_hi, longest):.3f}] m (step_length_bounds and the "
+                "legs' reach)")
     if l_lo >= longest:
         raise GaitOptionsError(f"step_length_bounds = ({l_lo:g}, {l_hi:g}) m: the legs reach "
                                f"steps shorter than {longest:.3f} m only")

@@ -39,7 +39,13 @@ import numpy as np
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait.guess import WalkingGuess, default_step_length, naive_guess
 from gaitopt.gait.options import GaitOptions, validate_options
-from gaitopt.gait.problem import Relaxation, parameter_bounds, relaxed_bounds, walking_problem
+from gaitopt.gait.problem import (
+    Relaxation,
+    parameter_bounds,
+    relaxed_bounds,
+    walking_problem,
+    with_step_time,
+)
 from gaitopt.ocp import Bounds, Guess, PhaseGuess, Result, Transcription, transcribe
 from gaitopt.robot.model import RobotModel
 
@@ -130,6 +136,7 @@ def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, in
                    compiled: str | None) -> tuple[Any, ...]:
     o = options
     return (model.content_hash(), o.ankle, o.single_support_fraction, tuple(knots),
+            o.step_time is not None,
             o.transcription, o.periodic_controls, o.friction, o.unilateral_impulses,
             o.min_stance_knee_flexion,
             tuple(o.torso_bounds), o.rate_bound, o.max_impulse, o.tol, o.max_iter,
@@ -195,7 +202,7 @@ class _Run:
         ``solver_options`` are merged over the transcription's."""
         tr = transcription_for(self.model, self.options, knots, compiled=self.compiled)
         start = time.perf_counter()
-        nlp_bounds = relaxed_bounds(tr, relax)
+        nlp_bounds = with_step_time(relaxed_bounds(tr, relax), self.options)
         if hold_ankles:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
@@ -220,8 +227,12 @@ class _Run:
         bounds = dict(parameter_bounds(o))
         bounds["speed"] = (speed, speed)
         bounds["impulse"] = (0.0, 0.0)
-        steps = [o.step_length] if o.step_length is not None else \
-            [default_step_length(speed) * f for f in (1.0, 0.7, 1.4)]
+        if o.step_length is not None:
+            steps = [o.step_length]
+        elif o.step_time is not None:
+            steps = [o.step_time * speed]
+        else:
+            steps = [default_step_length(speed) * f for f in (1.0, 0.7, 1.4)]
         for step0 in steps:
             guess = naive_guess(self.model, speed=speed, step_length=step0,
                                 single_support_fraction=o.single_support_fraction,
@@ -271,7 +282,9 @@ class _Run:
             held[name] = (result.parameters[name], result.parameters[name])
         fine = self.stage("target grid", o.knots, Relaxation(), result, held,
                           solver_options={**PRIMAL_WARM_OPTIONS, **FINE_STAGE_OPTIONS})
-        if not fine.success or (o.step_length is not None and o.speed is not None):
+        all_fixed = o.speed is not None and (o.step_length is not None or
+                                             o.step_time is not None)
+        if not fine.success or all_fixed:
             return fine
         return self.stage("target grid, all free", o.knots, Relaxation(), fine,
                           parameter_bounds(o), solver_options=FINE_STAGE_OPTIONS)
