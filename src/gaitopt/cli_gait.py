@@ -11,7 +11,7 @@ from rich.table import Table
 from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.solve import StageReport
+from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
 
@@ -23,6 +23,10 @@ def _speed(text: str) -> float | None:
         return parse_speed(text)
     except ValueError as exc:
         raise UserError(f"--speed: {exc}") from None
+
+
+#: Speeds (m/s) this far from 12 m/min get the multistart hint (15 m/min).
+FAR_FROM_REFERENCE = 0.25
 
 
 def _free_or_value(text: str, option: str, unit: str, quantity: str) -> float | None:
@@ -81,6 +85,9 @@ def _knots(text: str) -> tuple[int, int]:
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
+@click.option("--multistart", is_flag=True,
+              help="Solve from every naive guess and, away from 12 m/min, by continuation in "
+                   "speed; keep the lowest optimum (slower, fewer poor local optima).")
 @click.option("--warm-start", "warm_start", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="A gait file to start from (e.g. a neighbouring speed's "
                                  "gait); the cold path is the fallback.")
@@ -90,8 +97,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   impulse: bool,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
-                  unilateral_impulses: bool, compiled: bool, warm_start: Path | None,
-                  output: Path) -> None:
+                  unilateral_impulses: bool, compiled: bool, multistart: bool,
+                  warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
     from gaitopt.gait.api import as_model, solve_gait, warm_start_usable
@@ -111,13 +118,17 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         single_support_fraction=single_support, knots=_knots(knots),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
-        unilateral_impulses=unilateral_impulses)
+        unilateral_impulses=unilateral_impulses, multistart=multistart)
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
                   + f", {options.knots[0]}+{options.knots[1]} knots")
 
+    if (start is None and not multistart and options.speed is not None
+            and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
+        console.print("note: far from 12 m/min a cold solve can end in a worse local optimum; "
+                      "--multistart also tries the continuation in speed and keeps the best")
     if start is not None and not warm_start_usable(start, options):
         console.print(f"note: {warm_start} was solved with other ankle torques or another "
                       "single-support fraction; starting cold")

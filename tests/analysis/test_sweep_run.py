@@ -160,3 +160,33 @@ def test_a_failed_point_is_recorded_as_failed_then_solved_on_resume(tmp_path: Pa
     assert all(r.success for r in read_summary(folder / SUMMARY_FILE))
     assert {k: v for k, v in mtimes(folder).items() if k != K9} == kept
 
+
+
+def test_files_and_settings_written_before_an_option_existed_are_kept(
+        swept: tuple[Path, SweepReport]) -> None:
+    """A gait file or sweep.json written before an option was added (step_time,
+    multistart) lacks it; it was solved with the option's default, so a resume keeps it."""
+    import dataclasses
+
+    from gaitopt.analysis.sweep_plan import (
+        settings_differences,
+        sweep_settings,
+        with_option_defaults,
+    )
+    from gaitopt.analysis.sweep_worker import gait_file_matches
+
+    folder, _ = swept
+    spec = plain_spec(9, 12, 15)
+    gait = Gait.load(folder / K12)
+    point = next(p for p in spec.points if p.key == K12)
+    old = {k: v for k, v in gait.options.items() if k not in ("step_time", "multistart")}
+    assert gait_file_matches(dataclasses.replace(gait, options=old), MODEL,
+                             spec.options(point)) == ""
+    changed = dict(old, multistart=True)
+    assert "multistart" in gait_file_matches(dataclasses.replace(gait, options=changed), MODEL,
+                                             spec.options(point))
+    settings = sweep_settings(spec)
+    older = dict(settings, options={k: v for k, v in settings["options"].items()
+                                    if k != "multistart"})
+    assert settings_differences(older, settings)  # without the defaults: a difference
+    assert settings_differences(with_option_defaults(older), settings) == []

@@ -114,6 +114,24 @@ def test_step_time_fixed_with_the_speed_given_and_free(
     _verified(walk)
 
 
+def test_multistart_finds_the_lower_branch_at_high_speed(solved: SolveFn,
+                                                         reference: RefFn) -> None:
+    """Without ankle torques at 45 m/min the cold solve ends on a long-step local optimum;
+    the continuation in speed from 12 m/min that ``multistart`` adds reaches the short-step
+    one, about 13 % cheaper (docs/benchmarks-gait.md), and ``multistart`` keeps it."""
+    options = GaitOptions(speed=0.75, ankle=False, impulse=False)
+    single = solved(options).gait
+    multi = solved(options.replace(multistart=True)).gait
+    assert single.success and multi.success
+    assert multi.cost_value < 0.95 * single.cost_value, (multi.cost_value, single.cost_value)
+    assert multi.step_length < single.step_length
+    names = [s["name"] for s in multi.solver["stages"]]
+    assert names.count("relaxed contact") == 4  # three naive guesses at 45, one at 12 m/min
+    assert names[-1] == "continuation 45.0 m/min"
+    assert_physics(reference(multi.model), multi)
+    _verified(multi)
+
+
 def test_single_support_fraction_one_has_no_double_support(
         solved: SolveFn, reference: RefFn) -> None:
     """The single-support gait: tip 2 strikes, tip 1 leaves at that instant with no impulse,

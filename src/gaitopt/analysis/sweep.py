@@ -67,6 +67,7 @@ from gaitopt.analysis.sweep_plan import (
     settings_differences,
     settings_document,
     sweep_settings,
+    with_option_defaults,
 )
 from gaitopt.analysis.sweep_worker import (
     PointOutcome,
@@ -174,7 +175,7 @@ def prepare_directory(spec: SweepSpec, directory: Path) -> None:
             raise SweepSettingsError(f"{path}: cannot read the sweep settings ({exc})") from None
         if not isinstance(saved, dict) or saved.get("format") != SETTINGS_FORMAT:
             raise SweepSettingsError(f"{path}: not a gaitopt sweep settings file")
-        diffs = settings_differences(saved.get("settings", {}), wanted)
+        diffs = settings_differences(with_option_defaults(saved.get("settings", {})), wanted)
         if diffs:
             raise SweepSettingsError(
                 f"{directory} holds a sweep made with other settings, so it cannot be resumed "

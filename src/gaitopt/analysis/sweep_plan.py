@@ -260,6 +260,16 @@ def settings_document(spec: SweepSpec) -> dict[str, Any]:
             "gaitopt_version": __version__, "settings": sweep_settings(spec)}
 
 
+def with_option_defaults(settings: Mapping[str, Any]) -> dict[str, Any]:
+    """``settings`` (of ``sweep.json``) with every problem option it lacks at its default: a
+    sweep written before an option existed was solved with that option's default."""
+    out = dict(settings)
+    if isinstance(out.get("options"), Mapping):
+        defaults = {k: v for k, v in GaitOptions().to_dict().items() if k not in POINT_FIELDS}
+        out["options"] = {**defaults, **out["options"]}
+    return out
+
+
 def settings_differences(saved: Mapping[str, Any], wanted: Mapping[str, Any]) -> list[str]:
     """Human-readable differences between two settings dicts (empty when equal)."""
     out = []

@@ -55,6 +55,9 @@ class GaitOptions:
         max_impulse: upper bound of the liftoff impulse (N s).
         tol: IPOPT tolerance; max_iter: IPOPT iteration limit per stage.
         continuation: use the automatic continuation from a naive start (else one solve).
+        multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
+            by continuation in speed, and keep the lowest optimum (slower; a cold solve can
+            otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
     """
 
     speed: float | None = 0.2
@@ -77,6 +80,7 @@ class GaitOptions:
     tol: float = 1e-7
     max_iter: int = 1000
     continuation: bool = True
+    multistart: bool = False
 
     # -- derived -------------------------------------------------------------------------------
     @property

@@ -18,8 +18,12 @@ itself, in stages that each warm-start the next (primal values and multipliers):
    limited-memory Hessian, :data:`FINE_STAGE_OPTIONS`).
 
 If stage 1 or 2 fails, the same is tried from guesses with shorter and longer steps, then by
-continuation in speed from the reference speed (12 m/min). Given a warm start (a neighbouring
-gait), the target problem is solved from it directly and the cold path is the fallback.
+continuation in speed from the reference speed (12 m/min). With ``multistart`` all three
+guesses and (away from 12 m/min) the continuation in speed are solved and the lowest
+coarse optimum is kept: the problem has several local optima (a long-step and a short-step
+branch at high speed), and a single cold start can end on the worse one. Given a warm start
+(a neighbouring gait), the target problem is solved from it directly and the cold path is the
+fallback.
 Every stage is reported through ``progress`` and kept in the solution, so a failure says which
 stage failed and why.
 
@@ -30,7 +34,7 @@ and reused: speed, step length and impulse enter through parameter bounds only.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -218,9 +222,10 @@ class _Run:
             self.progress(report)
         return result
 
-    def cold(self, speed: float) -> Result | None:
+    def cold(self, speed: float, *, every_start: bool = False) -> Result | None:
         """Stages 1-2 on the coarse grid at ``speed`` without impulse, from naive guesses
-        (the requested step length, or a speed-based guess and two others)."""
+        (the requested step length, or a speed-based guess and two others): the first that
+        converges, or with ``every_start`` the best of all that converge."""
         o, coarse = self.options, coarse_knots(self.options)
         legs = checked_biped(self.model).legs
         r_max = min(leg.reach(-o.min_stance_knee_flexion) for leg in legs)
@@ -233,6 +238,7 @@ class _Run:
             steps = [o.step_time * speed]
         else:
             steps = [default_step_length(speed) * f for f in (1.0, 0.7, 1.4)]
+        found: list[Result] = []
         for step0 in steps:
             guess = naive_guess(self.model, speed=speed, step_length=step0,
                                 single_support_fraction=o.single_support_fraction,
@@ -245,8 +251,10 @@ class _Run:
             enforced = self.stage("enforced contact", coarse, Relaxation(), relaxed, bounds,
                                   hold_ankles=o.ankle)
             if enforced.success:
-                return enforced
-        return None
+                if not every_start:
+                    return enforced
+                found.append(enforced)
+        return best_of(found)
 
     def release(self, result: Result) -> Result:
         """Free what the cold stages held fixed: the ankle torques, the impulse, the speed."""
@@ -319,6 +327,12 @@ class _Run:
         return self.results[-1]
 
 
+def best_of(results: Sequence[Result | None]) -> Result | None:
+    """The converged result with the lowest objective (None if none converged)."""
+    ok = [r for r in results if r is not None and r.success]
+    return min(ok, key=lambda r: r.objective) if ok else None
+
+
 def _as_failed(result: Result, failed: Result) -> Result:
     """``result``'s values with the failed stage's status (never reported as converged)."""
     import dataclasses
@@ -342,15 +356,17 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                            parameter_bounds(options), solver_options=PRIMAL_WARM_OPTIONS)
         if not result.success:
             result = None
+    outcome: Result | None = result
     if result is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
-        coarse = run.cold(speed)
-        if coarse is None and options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9:
-            coarse = run.speed_continuation(speed)
+        coarse = run.cold(speed, every_start=options.multistart)
+        far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9
+        if far and (coarse is None or options.multistart):
+            coarse = best_of([coarse, run.speed_continuation(speed)])
         if coarse is not None:
-            released = run.release(coarse)
-            if released.success:
-                run.refine(released)
-    final = run.final()
+            outcome = run.release(coarse)
+            if outcome.success:
+                outcome = run.refine(outcome)
+    final = outcome if outcome is not None and outcome.success else run.final()
     return WalkingSolution(model=model, options=options, result=final,
                            stages=tuple(run.stages), wall_time_s=time.perf_counter() - start)
