@@ -39,7 +39,7 @@ from gaitopt.analysis.sweep import (
 from gaitopt.analysis.sweep_plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
 from gaitopt.analysis.sweep_worker import PointOutcome
 from gaitopt.cli_base import UserError, cli, make_console
-from gaitopt.cli_gait import _knots
+from gaitopt.cli_gait import _free_or_value, _knots
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
@@ -113,15 +113,8 @@ def parse_step_lengths(text: str, *, option: str = "--step-length", unit: str = 
     ``option="--step-time", unit="s", quantity="time"``, of step times in s."""
     out: list[float | None] = []
     for item in (i.strip() for i in text.split(",")):
-        if item.lower() == "free":
-            out.append(None)
-            continue
-        try:
-            value = float(item.removesuffix(unit))
-        except ValueError:
-            raise UserError(f"{option}: {item!r} is not a {quantity} in {unit} or "
-                            "'free'") from None
-        if not (math.isfinite(value) and value > 0):
+        value = _free_or_value(item, option, unit, quantity)
+        if value is not None and not (math.isfinite(value) and value > 0):
             raise UserError(f"{option}: {item!r} must be > 0 {unit} (or 'free')")
         out.append(value)
     return tuple(dict.fromkeys(out))

@@ -59,13 +59,13 @@ REFERENCE_SPEED = 0.2
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
-#: IPOPT options of the first stage, solved from the naive guess. The adaptive barrier
-#: update (Nocedal, Waechter and Waltz 2008) needs fewer iterations from a poor start and
-#: finds the lower local optimum more often than the default monotone one: on the 40-point
-#: speed grid (IPOPT 3.14.19 with MUMPS 5.8.2, as CasADi 3.8 bundles it) the monotone update
-#: took up to 522 iterations and stopped in worse optima at 6-12 m/min, and failed at 3 m/min
-#: with ankle torques. The later stages start from a solution and keep the monotone update
-#: with a small initial barrier (see :meth:`gaitopt.ocp.Transcription.solve`).
+#: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
+#: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
+#: the lower local optimum more often than the default monotone one: over 20 speeds with and
+#: without ankle torques (IPOPT 3.14.19 with MUMPS 5.8.2, as CasADi 3.8 bundles it) the
+#: monotone update took up to 522 iterations and stopped in worse optima at 6-12 m/min, and
+#: failed at 3 m/min with ankle torques. The later stages start from a solution and keep the
+#: monotone update with a small initial barrier (see :meth:`gaitopt.ocp.Transcription.solve`).
 COLD_START_OPTIONS = {"ipopt.mu_strategy": "adaptive"}
 #: IPOPT options of a stage started from the values of a solution without its multipliers
 #: (a coarse solution interpolated onto the target grid, a neighbouring gait): the start is
@@ -78,9 +78,9 @@ PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
 #: The Hessian of the target-grid stages of a cold solve: a limited-memory quasi-Newton
 #: approximation (as SNOPT's, which the paper used). Deriving the exact Hessian of the
 #: expanded NLP costs far more than these stages: at 40 + 10 knots 9-12 s against 2 s for
-#: the functions without it, while the stage took 160 quasi-Newton iterations (2.6 s) against
-#: 33 exact ones (2.1 s) to the same optimum and tolerance. Warm starts on a fine grid (a
-#: sweep's neighbours) use the exact Hessian, built once per process.
+#: the functions without it, while the two stages took 78 + 27 quasi-Newton iterations (about
+#: 2 s) to the same optimum and tolerance. Warm starts on a fine grid (a sweep's neighbours)
+#: use the exact Hessian, built once per process.
 FINE_STAGE_OPTIONS = {"ipopt.hessian_approximation": "limited-memory"}
 
 ProgressFn = Callable[["StageReport"], None]
