@@ -84,6 +84,14 @@ def _knots(text: str) -> tuple[int, int]:
 @click.option("--unilateral-impulses/--paper-impulse-maps", default=True, show_default=True,
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
+@click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
+              show_default=True,
+              help="reduced: the paper's coordinates (five-link biped); full: the whole "
+                   "tree's q, qd with the held points as constraints (any two-legged model, "
+                   "knees may straighten).")
+@click.option("--min-knee-flexion", type=float, default=None,
+              help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
+                   "stance knee straighten, with --formulation full].")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("--multistart", is_flag=True,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "
@@ -97,7 +105,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   impulse: bool,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
-                  unilateral_impulses: bool, compiled: bool, multistart: bool,
+                  unilateral_impulses: bool, formulation: str,
+                  min_knee_flexion: float | None, compiled: bool, multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
@@ -118,12 +127,16 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         single_support_fraction=single_support, knots=_knots(knots),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
-        unilateral_impulses=unilateral_impulses, multistart=multistart)
+        unilateral_impulses=unilateral_impulses, multistart=multistart,
+        formulation=formulation)  # type: ignore[arg-type]
+    if min_knee_flexion is not None:
+        options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots")
+                  + f", {options.knots[0]}+{options.knots[1]} knots, {options.formulation} "
+                  "coordinates")
 
     if (start is None and not multistart and options.speed is not None
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):

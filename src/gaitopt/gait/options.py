@@ -17,6 +17,8 @@ from gaitopt.robot.biped import BipedStructure
 from gaitopt.units import format_speed
 
 Transcription = Literal["hermite-simpson", "trapezoidal"]
+Formulation = Literal["reduced", "full"]
+FORMULATIONS: tuple[str, ...] = ("reduced", "full")
 
 
 class GaitOptionsError(ValueError):
@@ -47,14 +49,20 @@ class GaitOptions:
             impulses >= 0 on every held tip). ``False`` uses the paper's maps as they are, in
             which the held tip may be pulled (the liftoff impulse along the trailing leg lifts
             the front tip unless the ground pulls it down; see docs/walking.md).
-        min_stance_knee_flexion: smallest knee bend (rad, > 0) of a leg on the ground; it sets
+        min_stance_knee_flexion: smallest knee bend (rad) of a leg on the ground; it sets
             the largest hip-to-tip distance, the polar box ``r <= r_max`` (paper section 3.5),
-            and keeps the leg inverse kinematics away from its singularity at a straight knee.
+            and keeps the leg inverse kinematics away from its singularity at a straight knee
+            (> 0 in the reduced formulation; >= 0 in the full one, where 0 lets the stance
+            knee straighten up to its joint limit).
         torso_bounds: torso angle bounds (rad).
         rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates.
         max_impulse: upper bound of the liftoff impulse (N s).
         tol: IPOPT tolerance; max_iter: IPOPT iteration limit per stage.
         continuation: use the automatic continuation from a naive start (else one solve).
+        formulation: ``"reduced"`` (the paper's: polar hip coordinates and leg inverse
+            kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
+            with the held contact points as constraints: any model with two legs; a knee may
+            straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, and keep the lowest optimum (slower; a cold solve can
             otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
@@ -81,6 +89,7 @@ class GaitOptions:
     max_iter: int = 1000
     continuation: bool = True
     multistart: bool = False
+    formulation: Formulation = "reduced"
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -148,9 +157,17 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
             raise GaitOptionsError(f"speed = {format_speed(speed)}: must lie in speed_bounds "
                                    f"[{format_speed(v_lo)}, {format_speed(v_hi)}]")
     l_lo, l_hi = _bounds("step_length_bounds", o.step_length_bounds, positive=True)
+    if o.formulation not in FORMULATIONS:
+        raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
+                               f"{', '.join(FORMULATIONS)}")
     flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
-    if not 0.0 < flex < 1.5:
-        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5)")
+    if o.formulation == "full" and not 0.0 <= flex < 1.5:
+        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in [0, 1.5) "
+                               "(full formulation)")
+    if o.formulation == "reduced" and not 0.0 < flex < 1.5:
+        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5) "
+                               "in the reduced formulation (its leg inverse kinematics is "
+                               "singular at a straight knee; formulation 'full' allows 0)")
     reach = min(leg.reach(-flex) for leg in biped.legs)
     longest = 2.0 * reach * 0.97
     if o.step_length is not None:

@@ -40,16 +40,10 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.gait.formulation import biped_of, formulation_guess, problem_for, stage_bounds
 from gaitopt.gait.guess import WalkingGuess, default_step_length, naive_guess
 from gaitopt.gait.options import GaitOptions, validate_options
-from gaitopt.gait.problem import (
-    Relaxation,
-    parameter_bounds,
-    relaxed_bounds,
-    walking_problem,
-    with_step_time,
-)
+from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
 from gaitopt.ocp import Bounds, Guess, PhaseGuess, Result, Transcription, transcribe
 from gaitopt.robot.model import RobotModel
 
@@ -59,6 +53,8 @@ REFERENCE_SPEED = 0.2
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
+#: Smallest stance knee bend (rad) of the reduced solve that starts a full-coordinate one.
+REDUCED_START_FLEXION = 0.1
 #: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
 #: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
 #: the lower local optimum more often than the default monotone one: over 20 speeds with and
@@ -139,7 +135,7 @@ _CACHE: dict[tuple[Any, ...], Transcription] = {}
 def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, int],
                    compiled: str | None) -> tuple[Any, ...]:
     o = options
-    return (model.content_hash(), o.ankle, o.single_support_fraction, tuple(knots),
+    return (model.content_hash(), o.formulation, o.ankle, o.single_support_fraction, tuple(knots),
             o.step_time is not None,
             o.transcription, o.periodic_controls, o.friction, o.unilateral_impulses,
             o.min_stance_knee_flexion,
@@ -152,7 +148,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int,
     """The (process-wide cached) transcription of the walking problem on ``knots``."""
     key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
-        problem = walking_problem(model, options.replace(knots=tuple(knots)))
+        problem = problem_for(model, options.replace(knots=tuple(knots)))
         intervals = {problem.phases[i].name: knots[i] - 1 for i in range(len(problem.phases))}
         _CACHE[key] = transcribe(
             problem, method=options.transcription, intervals=intervals, compiled=compiled,
@@ -165,7 +161,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int,
 
 def held_ankles(model: RobotModel, tr: Transcription, bounds: Bounds) -> Bounds:
     """``bounds`` with every ankle torque of every phase bounded to zero."""
-    ankles = {leg.ankle_actuator for leg in checked_biped(model).legs}
+    ankles = {a.name for a in model.actuators if a.contact is not None}
     for ph in tr.problem.phases:
         for name in ph.controls:
             if name in ankles:
@@ -206,7 +202,7 @@ class _Run:
         ``solver_options`` are merged over the transcription's."""
         tr = transcription_for(self.model, self.options, knots, compiled=self.compiled)
         start = time.perf_counter()
-        nlp_bounds = with_step_time(relaxed_bounds(tr, relax), self.options)
+        nlp_bounds = with_step_time(stage_bounds(tr, relax, self.options), self.options)
         if hold_ankles:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
@@ -227,7 +223,7 @@ class _Run:
         (the requested step length, or a speed-based guess and two others): the first that
         converges, or with ``every_start`` the best of all that converge."""
         o, coarse = self.options, coarse_knots(self.options)
-        legs = checked_biped(self.model).legs
+        legs = biped_of(self.model, o).legs
         r_max = min(leg.reach(-o.min_stance_knee_flexion) for leg in legs)
         bounds = dict(parameter_bounds(o))
         bounds["speed"] = (speed, speed)
@@ -244,7 +240,8 @@ class _Run:
                                 single_support_fraction=o.single_support_fraction,
                                 knots=coarse, ankle=o.ankle, r_max=r_max,
                                 ankle_torques=False)
-            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
+            relaxed = self.stage("relaxed contact", coarse, RELAXED,
+                                 formulation_guess(self.model, o, ocp_guess(guess)), bounds,
                                  hold_ankles=o.ankle, solver_options=COLD_START_OPTIONS)
             if not relaxed.success:
                 continue
@@ -316,6 +313,34 @@ class _Run:
                 return None
         return current
 
+    def from_reduced(self) -> Result | None:
+        """The full-coordinate solve started from the reduced formulation's optimum on the
+        coarse grid (its robust cold start; a knee bend of at least
+        :data:`REDUCED_START_FLEXION` there), then released and refined in full coordinates.
+        None if the reduced solve fails (the caller falls back to the full cold start)."""
+        o, coarse = self.options, coarse_knots(self.options)
+        reduced = o.replace(formulation="reduced", knots=coarse,
+                            min_stance_knee_flexion=max(o.min_stance_knee_flexion,
+                                                        REDUCED_START_FLEXION))
+
+        def report(stage: StageReport) -> None:
+            import dataclasses
+
+            stage = dataclasses.replace(stage, name=f"reduced: {stage.name}")
+            self.stages.append(stage)
+            if self.progress is not None:
+                self.progress(stage)
+
+        start = solve_walking(self.model, reduced, progress=report, compiled=self.compiled)
+        if not start.success:
+            return None
+        guess = formulation_guess(self.model, o, result_guess(start.result))
+        result = self.stage("full coordinates", coarse, Relaxation(), guess,
+                            parameter_bounds(o), solver_options=PRIMAL_WARM_OPTIONS)
+        if not result.success:
+            return result
+        return self.refine(result)
+
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
         the last stage whose values are, marked failed."""
@@ -325,6 +350,24 @@ class _Run:
                     return _as_failed(result, self.results[-1])
                 return result
         return self.results[-1]
+
+
+def reduced_start_possible(model: RobotModel) -> bool:
+    """Whether the reduced formulation can solve ``model`` (the five-link shape)."""
+    from gaitopt.robot.biped import BipedStructureError
+
+    try:
+        biped_of(model, GaitOptions())
+    except BipedStructureError:
+        return False
+    return True
+
+
+def result_guess(result: Result) -> Guess:
+    """An engine guess holding a result's knot values (normalised times) and parameters."""
+    phases = {ph.name: PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0]))
+              for ph in result.phases}
+    return Guess(phases=phases, parameters=dict(result.parameters))
 
 
 def best_of(results: Sequence[Result | None]) -> Result | None:
@@ -347,7 +390,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   compiled: str | None = None) -> WalkingSolution:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed."""
-    validate_options(options, checked_biped(model))
+    validate_options(options, biped_of(model, options))
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
@@ -357,7 +400,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         if not result.success:
             result = None
     outcome: Result | None = result
-    if result is None:
+    if result is None and options.formulation == "full" and reduced_start_possible(model):
+        outcome = run.from_reduced()
+        result = outcome if outcome is not None and outcome.success else None
+    if result is None and outcome is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
         coarse = run.cold(speed, every_start=options.multistart)
         far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9
