@@ -86,6 +86,9 @@ EVENT_FRICTION = "friction cones of the impulses"
 STEP_TIME = "step time L / v"
 #: Bound on the projection controls (m/s and m/s^2 per unit of J^T): generous, they vanish.
 PROJECTION_BOUND = 10.0
+#: Scales of the rate states (rad/s, m/s) and of the projection controls in the NLP.
+RATE_SCALE = 1.0
+PROJECTION_SCALE = 0.01
 
 
 @dataclass(frozen=True)
@@ -329,14 +332,15 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
 
         control_bounds = {a: model.actuators[model.actuator_index(a)].limits for a in acts}
         control_bounds |= {n: (-PROJECTION_BOUND, PROJECTION_BOUND) for n in proj}
-        scales = {n: 1.0 for n in names} | {f"{n}_rate": 1.0 for n in model.coordinate_names}
+        scales = {n: 1.0 for n in names} | {f"{n}_rate": RATE_SCALE
+                                            for n in model.coordinate_names}
         phases.append(Phase(
             name=ph.name, states=names, controls=controls, dynamics=dynamics,
             duration=Duration.of_parameters(_step_share(ph.fraction)),
             state_bounds=state_bounds(held), control_bounds=control_bounds,
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
-            control_scales={n: 0.01 for n in proj},
+            control_scales={n: PROJECTION_SCALE for n in proj},
             intervals=options.knots[min(len(phases), len(options.knots) - 1)] - 1))
 
     linkages: list[Linkage | ControlLinkage] = []
