@@ -360,7 +360,7 @@ class _Importer:
 
     def base_chain(self) -> tuple[str, list[_UJoint]]:
         """The base link and the floating-base joints above it (see the module docstring)."""
-        cur, chain = self.root, []
+        cur, chain = self.root, list[_UJoint]()
         while self.links[cur].mass == 0.0 and len(self.children[cur]) == 1:
             j = self.children[cur][0]
             kinds = [c.type for c in chain]
@@ -472,7 +472,7 @@ class _Importer:
             local[i0], local[i1] = spec.point
             contacts.append((spec.name, k, self.in_plane(pos + rot @ local)))
             taken.add(spec.name)
-        for name_, k, p in contacts:
+        for _, k, p in contacts:
             bodies[k].points.append(p)
         return model_from_dict(self.to_dict(bodies, contacts, name), source=self.r.source)
 
