@@ -360,7 +360,8 @@ class _Importer:
 
     def base_chain(self) -> tuple[str, list[_UJoint]]:
         """The base link and the floating-base joints above it (see the module docstring)."""
-        cur, chain = self.root, list[_UJoint]()
+        cur = self.root
+        chain: list[_UJoint] = []
         while self.links[cur].mass == 0.0 and len(self.children[cur]) == 1:
             j = self.children[cur][0]
             kinds = [c.type for c in chain]
@@ -439,7 +440,7 @@ class _Importer:
             elif j.type in ("revolute", "continuous"):
                 sign = self.about_normal(f"{where} axis", rot @ j.axis)
                 assert j.limits is not None
-                lo, hi = (j.limits if sign > 0 else (-j.limits[1], -j.limits[0]))
+                lo, hi = (j.limits if sign > 0 else (-j.limits[1] + 0.0, -j.limits[0] + 0.0))
                 at = self.in_plane(pos)
                 bodies[k].points.append(at)
                 bodies.append(_Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
@@ -486,7 +487,8 @@ class _Importer:
                 raise self.r.fail(f"link {b.name!r}", 0.0, "a mass > 0 on every gaitopt link "
                                   "(a link between two moving joints, with the links fixed to "
                                   "it)", problem="no mass")
-            com = sum((m * c for m, c, _ in b.parts), np.zeros(2)) / mass
+            com = (b.parts[0][1] if len(b.parts) == 1 else
+                   sum((m * c for m, c, _ in b.parts), np.zeros(2)) / mass)
             inertia = sum(i_ + m * float(np.sum((c - com) ** 2)) for m, c, i_ in b.parts)
             if not inertia > 0.0:
                 raise self.r.fail(f"link {b.name!r}", inertia, "an inertia > 0 about the "
