@@ -69,6 +69,17 @@ def test_without_the_gaitopt_element_only_what_urdf_cannot_hold_is_lost() -> Non
     assert [a.name for a in original.actuators if a.contact is not None] == ["ankle_1", "ankle_2"]
 
 
+def test_gaitopt_element_keeps_directions_and_lengths_the_rule_would_change() -> None:
+    # shank_1 longer than its tip (0.6 m, tip at 0.5 m): the rule alone says 0.5
+    original = five_link()
+    links = list(original.links)
+    links[2] = dataclasses.replace(links[2], length=0.6, shape=None)
+    model = dataclasses.replace(original, links=tuple(links))
+    text = urdf_from_model(model)
+    assert model_from_urdf(text) == model
+    assert model_from_urdf(strip_gaitopt_element(text)).links[2].length == 0.5
+
+
 def test_export_writes_joint_axes_about_minus_y_and_contact_frames() -> None:
     root = ET.fromstring(urdf_from_model(five_link()))
     joints = {j.get("name"): j for j in root.findall("joint")}

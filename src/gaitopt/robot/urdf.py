@@ -22,7 +22,8 @@ the parallel-axis theorem). Contact points come from fixed joints named
 ``gaitopt_contact_NAME`` to a massless leaf link NAME (what the export writes) and from
 :class:`ContactSpec` arguments (``--contact NAME=LINK:X,Z``). What URDF cannot hold (ground
 torques at contact points such as ankles, the order and exact bounds of the actuators,
-gravity, the description, the shapes inertias came from) travels in a ``<gaitopt>`` element
+gravity, the description, each link's direction and length, the shapes inertias came from)
+travels in a ``<gaitopt>`` element
 inside ``<robot>``, which other URDF readers ignore.
 
 Parser: the XML is read with :mod:`xml.etree.ElementTree`. The maintained PyPI parsers do not
@@ -493,7 +494,8 @@ class _Importer:
             if not inertia > 0.0:
                 raise self.r.fail(f"link {b.name!r}", inertia, "an inertia > 0 about the "
                                   f"{self.axis} axis (kg m^2)")
-            direction, length = _direction_and_length(b.points, com, base=i == 0)
+            direction, length = ext.links.get(b.name) or _direction_and_length(
+                b.points, com, base=i == 0)
             entry: dict[str, Any] = {"name": b.name,
                                      "parent": None if b.parent < 0 else bodies[b.parent].name}
             if b.joint is not None:
@@ -566,14 +568,15 @@ def _direction_and_length(points: list[np.ndarray], com: np.ndarray,
 
 
 class _Extension:
-    """The ``<gaitopt>`` element: actuators, gravity, description and shapes, in gaitopt's
-    own terms (names, N m, m/s^2 in gaitopt's world frame)."""
+    """The ``<gaitopt>`` element: actuators, gravity, description, link directions and
+    lengths, shapes, in gaitopt's own terms (names, m, N m, m/s^2 in gaitopt's world frame)."""
 
     def __init__(self, r: _Reader, elem: ET.Element | None) -> None:
         self.actuators: list[dict[str, Any]] | None = None
         self.gravity: list[float] | None = None
         self.description: str | None = None
         self.shapes: dict[str, dict[str, Any]] = {}
+        self.links: dict[str, tuple[str, float]] = {}
         if elem is None:
             return
         where = "<gaitopt>"
@@ -602,6 +605,15 @@ class _Extension:
             if s.get("radius") is not None:
                 shape["radius"] = r.number(f"{where} shape {link!r} radius", s.get("radius"))
             self.shapes[link] = shape
+        for e in elem.findall("link"):
+            link = r.name(f"{where} <link>", e)
+            direction = e.get("direction")
+            if direction not in ("up", "down"):
+                raise r.fail(f"{where} link {link!r} direction", direction, "up or down")
+            length = r.number(f"{where} link {link!r} length", e.get("length"))
+            if not length > 0.0:
+                raise r.fail(f"{where} link {link!r} length", length, "a length > 0 (m)")
+            self.links[link] = (direction, length)
 
 
 # -- export ----------------------------------------------------------------------------------
@@ -623,8 +635,9 @@ def urdf_from_model(model: RobotModel) -> str:
     ``iyy`` is the model's inertia; ``ixx`` and ``izz`` are those of the link's ellipsoid
     (``shape``) or else equal to ``iyy`` (they do not enter planar motion). Contact points are
     massless links joined by fixed joints ``gaitopt_contact_NAME``; joint efforts are the
-    largest bound of the joint's actuator (0: none); the exact actuators, gravity, description
-    and shapes are in a ``<gaitopt>`` element.
+    largest bound of the joint's actuator (0: none; ``velocity="0.0"``: gaitopt has no
+    velocity limit, URDF requires the attribute); the exact actuators, gravity, description,
+    link directions and lengths and shapes are in a ``<gaitopt>`` element.
     """
     robot = ET.Element("robot", name=model.name)
     robot.append(ET.Comment(
@@ -676,6 +689,9 @@ def urdf_from_model(model: RobotModel) -> str:
     ext = ET.SubElement(robot, "gaitopt", version="1")
     ET.SubElement(ext, "gravity", x=_num(model.gravity[0]), y=_num(model.gravity[1]))
     ET.SubElement(ext, "description").text = model.description
+    for link in model.links:
+        ET.SubElement(ext, "link", name=link.name, direction=link.direction,
+                      length=_num(link.length))
     for link in model.links:
         if link.shape is not None:
             attrs = {"link": link.name, "type": link.shape.type}
