@@ -340,7 +340,7 @@ REFUSALS = {
                     "joint 'loop'", "already has parent joint 'left_ankle_mount'"),
     "cycle": (edit_walker("</robot>", '<joint name="up" type="fixed"><parent link="imu"/>'
                           '<child link="pelvis"/></joint></robot>'),
-              "every link has a parent", "a tree"),
+              "closed loop of links", "pelvis -> imu -> pelvis (joints imu_mount, up)"),
     "mimic": (edit_walker('<axis xyz="0 -1 0"/>\n    <limit', '<axis xyz="0 -1 0"/><mimic '
                           'joint="left_hip"/>\n    <limit'), "joint 'right_hip'", "mimic"),
     "no inertia": (edit_walker('<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" '

@@ -331,20 +331,25 @@ class _Importer:
             self.parent_joint[j.child] = j
             self.children[j.parent].append(j)
         roots = [n for n in self.links if n not in self.parent_joint]
-        if len(roots) != 1:
-            problem = ("every link has a parent (a closed loop)" if not roots else
-                       f"{len(roots)} links without a parent ({', '.join(roots)})")
-            raise reader.fail("", roots, "one root link and a tree of joints", problem=problem)
-        self.root = roots[0]
-        seen, todo = set(), [self.root]
+        if len(roots) > 1:
+            raise reader.fail("", roots, "one root link and a tree of joints",
+                              problem=f"{len(roots)} links without a parent "
+                                      f"({', '.join(roots)})")
+        seen, todo = set(), roots[:1]
         while todo:
             n = todo.pop()
             seen.add(n)
             todo.extend(j.child for j in self.children[n])
-        if len(seen) != len(self.links):
-            loop = sorted(set(self.links) - seen)
-            raise reader.fail(f"link {loop[0]!r}", loop, "a tree of joints from the root "
-                              f"link {self.root!r}", problem=f"a closed loop ({', '.join(loop)})")
+        if len(seen) != len(self.links):  # a link outside the tree is on a loop of parents
+            path = [next(n for n in self.links if n not in seen)]
+            while (up := self.parent_joint[path[-1]].parent) not in path:
+                path.append(up)
+            loop = [*path[path.index(up):], up][::-1]
+            joints = [self.parent_joint[n].name for n in loop[1:]]
+            raise reader.fail(f"joint {joints[0]!r}", loop, "a tree of joints from one root "
+                              "link", problem=f"a closed loop of links {' -> '.join(loop)} "
+                              f"(joints {', '.join(joints)})")
+        self.root = roots[0]
 
     # -- frames ------------------------------------------------------------------------------
     def in_plane(self, v: np.ndarray) -> np.ndarray:
