@@ -27,10 +27,11 @@ travels in a ``<gaitopt>`` element
 inside ``<robot>``, which other URDF readers ignore.
 
 Parser: the XML is read with :mod:`xml.etree.ElementTree`. The maintained PyPI parsers do not
-fit: ``yourdfpy`` pulls in ``trimesh[easy]`` (a mesh stack of a dozen packages) to read a few
-XML elements and silently puts ``ixx = iyy = izz = 1`` in place of a missing ``<inertia>``
-(and mass 0 for a missing ``<mass>``), which must be refused here; ``urdf-parser-py`` has had
-no release since 2021. Every problem is a one-line :class:`ModelError` naming the joint or link.
+fit: ``yourdfpy`` (0.0.60) pulls in ``trimesh[easy]`` (a mesh stack of a dozen packages) to
+read a few XML elements, and silently reads a missing ``ixx``, ``iyy`` or ``izz`` as 1 and a
+``<mass>`` without a value as 0, which must be refused here; ``urdf-parser-py`` has had no
+release since 2021 (0.0.4). Every problem is a one-line :class:`ModelError` naming the joint
+or link.
 """
 
 from __future__ import annotations
@@ -263,7 +264,7 @@ def _read_source(source: str | os.PathLike[str]) -> tuple[str, str]:
         return source, "<string>"
     label = os.fspath(source)
     try:
-        return Path(label).read_text("utf-8"), label
+        return Path(label).read_text("utf-8-sig"), label
     except (OSError, UnicodeDecodeError) as exc:
         detail = getattr(exc, "strerror", None) or str(exc)
         raise ModelError(label, "", label, "a readable URDF file (UTF-8 XML)",
@@ -491,8 +492,8 @@ class _Importer:
             mass = sum(m for m, _, _ in b.parts)
             if not mass > 0.0:
                 raise self.r.fail(f"link {b.name!r}", 0.0, "a mass > 0 on every gaitopt link "
-                                  "(a link between two moving joints, with the links fixed to "
-                                  "it)", problem="no mass")
+                                  "(the base, or a URDF link after a revolute joint, with the "
+                                  "links fixed to it)", problem="no mass")
             com = (b.parts[0][1] if len(b.parts) == 1 else
                    sum((m * c for m, c, _ in b.parts), np.zeros(2)) / mass)
             inertia = sum(i_ + m * float(np.sum((c - com) ** 2)) for m, c, i_ in b.parts)
