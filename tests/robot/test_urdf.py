@@ -345,6 +345,12 @@ REFUSALS = {
                           'joint="left_hip"/>\n    <limit'), "joint 'right_hip'", "mimic"),
     "no inertia": (edit_walker('<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" '
                                'izz="0.002"/>', ""), "link 'left_foot'", "no <inertia>"),
+    "no ixx": (edit_walker('<inertia ixx="0.001" ixy="0"', '<inertia ixy="0"'),
+               "link 'left_foot' inertia ixx", "missing"),
+    "no joint limit": (edit_walker('<limit lower="0" upper="2.2" effort="60" velocity="10"/>',
+                                   ""), "joint 'left_knee' <limit>", "missing"),
+    "tilted prismatic base": (walker_with_base("prismatic").replace(
+        '<axis xyz="1 0 0"/>', '<axis xyz="1 0 1"/>'), "joint 'px'", "floating-base chain"),
     "prismatic knee": (edit_walker('name="right_knee" type="continuous"',
                                    'name="right_knee" type="prismatic"'),
                        "joint 'right_knee'", "prismatic joint outside the floating-base"),

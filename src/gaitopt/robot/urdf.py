@@ -48,14 +48,12 @@ import numpy as np
 
 from gaitopt.robot.model import RobotModel, Shape
 from gaitopt.robot.schema import INERTIA_RTOL, ModelError, model_from_dict, shape_inertia
+from gaitopt.robot.urdf_export import urdf_from_model
+from gaitopt.robot.urdf_xml import CONTACT_PREFIX, Extension, Reader, UJoint, ULink
 
 __all__ = ["CONTACT_PREFIX", "ContactSpec", "model_from_urdf", "parse_contact_option",
            "urdf_from_model"]
 
-#: Name prefix of the fixed joints that mark contact frames (``gaitopt_contact_tip_1``).
-CONTACT_PREFIX = "gaitopt_contact_"
-#: Limits (rad) given to a continuous joint: a full turn each way (gaitopt limits are finite).
-CONTINUOUS_LIMITS = (-2.0 * math.pi, 2.0 * math.pi)
 #: Coordinates smaller than this (m) after a frame rotation are taken as exactly 0.
 SNAP = 1e-12
 #: Tolerance on a joint axis being the common axis (a unit vector).
@@ -66,7 +64,6 @@ _PLANE = {"y": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
           "x": np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])}
 #: Which URDF coordinates of a link frame a ``--contact`` point gives, for each common axis.
 _IN_PLANE = {"y": (0, 2, "X,Z"), "x": (1, 2, "Y,Z")}
-_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
 @dataclass(frozen=True)
@@ -94,154 +91,6 @@ def parse_contact_option(text: str) -> ContactSpec:
     except ValueError:
         raise ValueError(f"--contact: got {text!r}; allowed: {form}") from None
     return ContactSpec(name.strip(), link.strip(), (x, z))
-
-
-# -- reading the XML -------------------------------------------------------------------------
-
-@dataclass
-class _ULink:
-    name: str
-    mass: float = 0.0
-    com: np.ndarray = field(default_factory=lambda: np.zeros(3))      # link frame, m
-    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # link axes, at com
-
-
-@dataclass
-class _UJoint:
-    name: str
-    type: str
-    parent: str
-    child: str
-    rot: np.ndarray       # child frame axes in the parent frame (3, 3)
-    pos: np.ndarray       # child origin in the parent frame (3,), m
-    axis: np.ndarray      # unit vector in the child frame
-    limits: tuple[float, float] | None
-    effort: float | None
-
-
-def _rpy(r: float, p: float, y: float) -> np.ndarray:
-    """URDF's fixed-axis roll-pitch-yaw: ``Rz(y) Ry(p) Rx(r)``."""
-    if r == p == y == 0.0:
-        return np.eye(3)
-    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
-                              math.cos(y), math.sin(y))
-    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
-    return rz @ ry @ rx
-
-
-class _Reader:
-    """Parses the XML of one URDF; ``source`` names it in errors."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, where: str, value: Any, allowed: str, problem: str | None = None) -> ModelError:
-        return ModelError(self.source, where, value, allowed, problem=problem)
-
-    def number(self, where: str, text: str | None, default: float | None = None) -> float:
-        if text is None:
-            if default is None:
-                raise self.fail(where, None, "a finite number", problem="missing")
-            return default
-        try:
-            x = float(text)
-        except ValueError:
-            x = math.nan
-        if not math.isfinite(x):
-            raise self.fail(where, text, "a finite number")
-        return x
-
-    def vector(self, where: str, text: str | None, default: tuple[float, ...]) -> np.ndarray:
-        if text is None:
-            return np.array(default, dtype=float)
-        parts = text.split()
-        if len(parts) != 3:
-            raise self.fail(where, text, "three numbers separated by spaces")
-        return np.array([self.number(where, t) for t in parts])
-
-    def origin(self, where: str, elem: ET.Element | None) -> tuple[np.ndarray, np.ndarray]:
-        if elem is None:
-            return np.eye(3), np.zeros(3)
-        rpy = self.vector(f"{where} origin rpy", elem.get("rpy"), (0.0, 0.0, 0.0))
-        return _rpy(*rpy), self.vector(f"{where} origin xyz", elem.get("xyz"), (0.0, 0.0, 0.0))
-
-    def name(self, where: str, elem: ET.Element, attr: str = "name") -> str:
-        value = elem.get(attr)
-        if not value:
-            raise self.fail(where, value, f"a non-empty '{attr}' attribute", problem="missing")
-        return value
-
-    def link(self, elem: ET.Element) -> _ULink:
-        link = _ULink(self.name("<link>", elem))
-        where = f"link {link.name!r}"
-        inertial = elem.find("inertial")
-        if inertial is None:
-            return link
-        mass = inertial.find("mass")
-        if mass is None:
-            raise self.fail(f"{where} <inertial>", None, "a <mass value=...> in <inertial>",
-                            problem="no <mass>")
-        link.mass = self.number(f"{where} mass", mass.get("value"))
-        if link.mass < 0.0:
-            raise self.fail(f"{where} mass", link.mass, "a mass >= 0 (kg)")
-        tensor = inertial.find("inertia")
-        if tensor is None:
-            if link.mass > 0.0:
-                raise self.fail(f"{where} <inertial>", link.mass,
-                                "an <inertia ixx iyy izz .../> with every mass",
-                                problem=f"mass {link.mass:g} kg but no <inertia>")
-            return link
-        i = {k: self.number(f"{where} inertia {k}", tensor.get(k), None if k in (
-            "ixx", "iyy", "izz") else 0.0) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-        local = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
-                          [i["ixz"], i["iyz"], i["izz"]]])
-        rot, link.com = self.origin(where + " inertial", inertial.find("origin"))
-        link.inertia = rot @ local @ rot.T  # about the com, along the link frame's axes
-        return link
-
-    def joint(self, elem: ET.Element) -> _UJoint:
-        name = self.name("<joint>", elem)
-        where = f"joint {name!r}"
-        kind = elem.get("type")
-        if kind not in _JOINT_TYPES:
-            raise self.fail(f"{where} type", kind, f"one of {', '.join(_JOINT_TYPES)}")
-        if elem.find("mimic") is not None:
-            raise self.fail(where, "mimic", "joints with their own coordinate (no <mimic>)",
-                            problem="a mimic joint")
-        ends = []
-        for tag in ("parent", "child"):
-            e = elem.find(tag)
-            if e is None:
-                raise self.fail(f"{where} <{tag}>", None, f"a <{tag} link=...>",
-                                problem="missing")
-            ends.append(self.name(f"{where} <{tag}>", e, "link"))
-        rot, pos = self.origin(where, elem.find("origin"))
-        axis_elem = elem.find("axis")
-        axis = self.vector(f"{where} axis", None if axis_elem is None else axis_elem.get("xyz"),
-                           (1.0, 0.0, 0.0))
-        norm = float(np.linalg.norm(axis))
-        if norm == 0.0:
-            raise self.fail(f"{where} axis", "0 0 0", "a non-zero axis vector")
-        limit = elem.find("limit")
-        limits, effort = None, None
-        if limit is not None:
-            effort = self.number(f"{where} limit effort", limit.get("effort"), 0.0)
-            if effort < 0.0:
-                raise self.fail(f"{where} limit effort", effort, "an effort >= 0 (N m)")
-            if kind == "revolute":
-                lo = self.number(f"{where} limit lower", limit.get("lower"), 0.0)
-                hi = self.number(f"{where} limit upper", limit.get("upper"), 0.0)
-                if lo > hi:
-                    raise self.fail(f"{where} limit", f"{lo:g} > {hi:g}", "lower <= upper (rad)")
-                limits = (lo, hi)
-        if kind == "revolute" and limits is None:
-            raise self.fail(f"{where} <limit>", None, "a <limit lower upper effort velocity> "
-                            "on a revolute joint (or type continuous)", problem="missing")
-        if kind == "continuous":
-            limits = CONTINUOUS_LIMITS
-        return _UJoint(name, kind, ends[0], ends[1], rot, pos, axis / norm, limits, effort)
 
 
 # -- import ----------------------------------------------------------------------------------
@@ -295,13 +144,13 @@ def model_from_urdf(source: str | os.PathLike[str], *, contacts: Iterable[Contac
     if root.tag != "robot":
         raise ModelError(label, "", f"<{root.tag}>", "a <robot> element",
                          problem=f"the root element is <{root.tag}>")
-    return _Importer(_Reader(label), root, _PLANE[axis], axis).model(list(contacts), name)
+    return _Importer(Reader(label), root, _PLANE[axis], axis).model(list(contacts), name)
 
 
 class _Importer:
-    def __init__(self, reader: _Reader, root: ET.Element, plane: np.ndarray, axis: str) -> None:
+    def __init__(self, reader: Reader, root: ET.Element, plane: np.ndarray, axis: str) -> None:
         self.r, self.plane, self.axis = reader, plane, axis
-        self.links: dict[str, _ULink] = {}
+        self.links: dict[str, ULink] = {}
         for elem in root.findall("link"):
             link = reader.link(elem)
             if link.name in self.links:
@@ -317,8 +166,8 @@ class _Importer:
             joint_names.add(j.name)
         self.extension = root.find("gaitopt")
         self.robot_name = root.get("name") or "robot"
-        self.parent_joint: dict[str, _UJoint] = {}
-        self.children: dict[str, list[_UJoint]] = {n: [] for n in self.links}
+        self.parent_joint: dict[str, UJoint] = {}
+        self.children: dict[str, list[UJoint]] = {n: [] for n in self.links}
         for j in self.joints:
             for end in (j.parent, j.child):
                 if end not in self.links:
@@ -365,10 +214,10 @@ class _Importer:
                               f"+-{self.axis} (the common joint axis; the robot is planar)")
         return 1.0 if g[2] > 0 else -1.0
 
-    def base_chain(self) -> tuple[str, list[_UJoint]]:
+    def base_chain(self) -> tuple[str, list[UJoint]]:
         """The base link and the floating-base joints above it (see the module docstring)."""
         cur = self.root
-        chain: list[_UJoint] = []
+        chain: list[UJoint] = []
         while self.links[cur].mass == 0.0 and len(self.children[cur]) == 1:
             j = self.children[cur][0]
             kinds = [c.type for c in chain]
@@ -381,43 +230,27 @@ class _Importer:
             else:
                 break
         moving = [j for j in chain if j.type != "fixed"]
-        rot = np.eye(3)
-        allowed = (f"a floating base of two prismatic joints (along x and z) and a revolute "
-                   f"joint about {self.axis} through massless links, a planar or a floating "
-                   "joint, at the root")
+        rot, prismatic = np.eye(3), []
         for j in chain:
             rot = rot @ j.rot
-            world_axis = rot @ j.axis
+            world_axis = rot @ j.axis  # a joint axis is given in the child frame
             if j.type == "planar":
                 self.about_normal(f"joint {j.name!r} axis (the plane normal)", world_axis)
             elif j.type in ("revolute", "continuous"):
                 self.about_normal(f"joint {j.name!r} axis", world_axis)
-        if moving and moving[0].type == "prismatic":
-            directions = sorted(int(np.argmax(np.abs(self.plane @ (r @ j.axis))))
-                                for j, r in self._chain_rotations(chain) if j.type == "prismatic")
-            if [j.type for j in moving][-1] not in ("revolute", "continuous") or \
-                    len(moving) != 3 or directions != [0, 1]:
-                raise self.r.fail(f"joint {moving[0].name!r}", moving[0].type, allowed,
-                                  problem="an incomplete floating-base chain")
-            for j, r in self._chain_rotations(chain):
-                g = self.plane @ (r @ j.axis)
-                if j.type == "prismatic" and abs(np.max(np.abs(g)) - 1.0) > AXIS_TOL:
-                    raise self.r.fail(f"joint {j.name!r} axis", j.axis.tolist(),
-                                      "a prismatic axis along x or z of the world")
-        for name in [j.child for j in chain[:-1]] + ([self.root] if chain else []):
-            if self.links[name].mass != 0.0:
-                raise self.r.fail(f"link {name!r}", self.links[name].mass, "massless links in "
-                                  "the floating-base chain", problem="a link with mass")
+            elif j.type == "prismatic":
+                prismatic.append(np.abs(self.plane @ world_axis))
+        # the walk takes revolute joints only after a prismatic one, and stops after them
+        if prismatic and not (len(moving) == 3 and moving[-1].type != "prismatic" and sorted(
+                int(np.argmax(g)) for g in prismatic) == [0, 1] and all(
+                abs(float(np.max(g)) - 1.0) <= AXIS_TOL for g in prismatic)):
+            raise self.r.fail(f"joint {moving[0].name!r}", moving[0].type,
+                              "a floating base of two prismatic joints (along x and z) and a "
+                              f"revolute joint about {self.axis} through massless links, a "
+                              "planar or a floating joint, at the root",
+                              problem="an incomplete floating-base chain")
         self.base_rot = rot
         return cur, chain
-
-    @staticmethod
-    def _chain_rotations(chain: list[_UJoint]) -> list[tuple[_UJoint, np.ndarray]]:
-        out, rot = [], np.eye(3)
-        for j in chain:
-            rot = rot @ j.rot
-            out.append((j, rot))
-        return out
 
     # -- the model ---------------------------------------------------------------------------
     def model(self, specs: list[ContactSpec], name: str | None) -> RobotModel:
@@ -486,7 +319,7 @@ class _Importer:
 
     def to_dict(self, bodies: list[_Body], contacts: list[tuple[str, int, np.ndarray]],
                 name: str | None) -> dict[str, Any]:
-        ext = _Extension(self.r, self.extension)
+        ext = Extension(self.r, self.extension)
         links: list[dict[str, Any]] = []
         for i, b in enumerate(bodies):
             mass = sum(m for m, _, _ in b.parts)
@@ -571,143 +404,3 @@ def _direction_and_length(points: list[np.ndarray], com: np.ndarray,
     if height < 0.0:
         return "down", max(-2.0 * height, below)
     return "down", 1.0
-
-
-class _Extension:
-    """The ``<gaitopt>`` element: actuators, gravity, description, link directions and
-    lengths, shapes, in gaitopt's own terms (names, m, N m, m/s^2 in gaitopt's world frame)."""
-
-    def __init__(self, r: _Reader, elem: ET.Element | None) -> None:
-        self.actuators: list[dict[str, Any]] | None = None
-        self.gravity: list[float] | None = None
-        self.description: str | None = None
-        self.shapes: dict[str, dict[str, Any]] = {}
-        self.links: dict[str, tuple[str, float]] = {}
-        if elem is None:
-            return
-        where = "<gaitopt>"
-        if elem.get("version", "1") != "1":
-            raise r.fail(f"{where} version", elem.get("version"), "1")
-        acts = elem.findall("actuator")
-        if acts:
-            self.actuators = []
-            for a in acts:
-                name = r.name(f"{where} <actuator>", a)
-                target = {k: a.get(k) for k in ("joint", "contact") if a.get(k) is not None}
-                self.actuators.append({
-                    "name": name, **target,
-                    "limits": [r.number(f"{where} actuator {name!r} lower", a.get("lower")),
-                               r.number(f"{where} actuator {name!r} upper", a.get("upper"))]})
-        g = elem.find("gravity")
-        if g is not None:
-            self.gravity = [r.number(f"{where} gravity x", g.get("x")),
-                            r.number(f"{where} gravity y", g.get("y"))]
-        d = elem.find("description")
-        if d is not None:
-            self.description = d.text or ""
-        for s in elem.findall("shape"):
-            link = r.name(f"{where} <shape>", s, "link")
-            shape: dict[str, Any] = {"type": s.get("type")}
-            if s.get("radius") is not None:
-                shape["radius"] = r.number(f"{where} shape {link!r} radius", s.get("radius"))
-            self.shapes[link] = shape
-        for e in elem.findall("link"):
-            link = r.name(f"{where} <link>", e)
-            direction = e.get("direction")
-            if direction not in ("up", "down"):
-                raise r.fail(f"{where} link {link!r} direction", direction, "up or down")
-            length = r.number(f"{where} link {link!r} length", e.get("length"))
-            if not length > 0.0:
-                raise r.fail(f"{where} link {link!r} length", length, "a length > 0 (m)")
-            self.links[link] = (direction, length)
-
-
-# -- export ----------------------------------------------------------------------------------
-
-def _num(x: float) -> str:
-    return repr(float(x) + 0.0)  # shortest text that reads back to the same float; no -0.0
-
-
-def _xyz(p: tuple[float, float]) -> str:
-    """A gaitopt point (x, y) in a link frame as URDF ``xyz`` (plane x-z, y = 0)."""
-    return f"{_num(p[0])} 0.0 {_num(p[1])}"
-
-
-def urdf_from_model(model: RobotModel) -> str:
-    """The model as URDF text (see ``docs/urdf.md``); ``model_from_urdf`` reads it back.
-
-    The base is the root link (no world link: give your simulator a planar root joint). Joint
-    axes are URDF -y, so URDF joint angles, limits and torques equal gaitopt's. Link inertias:
-    ``iyy`` is the model's inertia; ``ixx`` and ``izz`` are those of the link's ellipsoid
-    (``shape``) or else equal to ``iyy`` (they do not enter planar motion). Contact points are
-    massless links joined by fixed joints ``gaitopt_contact_NAME``; joint efforts are the
-    largest bound of the joint's actuator (0: none; ``velocity="0.0"``: gaitopt has no
-    velocity limit, URDF requires the attribute); the exact actuators, gravity, description,
-    link directions and lengths and shapes are in a ``<gaitopt>`` element.
-    """
-    robot = ET.Element("robot", name=model.name)
-    robot.append(ET.Comment(
-        f" written by gaitopt from the model {model.name!r}. Frames: gaitopt (x, y) = URDF "
-        "(x, z); joints turn about URDF -y, so their angles, limits and torques are gaitopt's. "
-        f"The root link {model.base.name!r} is the floating base (no world link). "))
-    names = [link.name for link in model.links] + [c.name for c in model.contacts]
-    if len(set(names)) != len(names):
-        dup = next(n for n in names if names.count(n) > 1)
-        raise ModelError(model.name, "contacts", dup, "contact names that are not link names "
-                         "(URDF links share one namespace)", problem=f"{dup!r} names a link "
-                         "and a contact point")
-    effort: dict[str, float] = {}
-    for a in model.actuators:
-        if a.joint is not None:
-            effort[a.joint] = max(abs(a.limits[0]), abs(a.limits[1]))
-    for link in model.links:
-        elem = ET.SubElement(robot, "link", name=link.name)
-        inertial = ET.SubElement(elem, "inertial")
-        ET.SubElement(inertial, "origin", xyz=_xyz(link.com_local), rpy="0.0 0.0 0.0")
-        ET.SubElement(inertial, "mass", value=_num(link.mass))
-        along = link.inertia  # about the link axis (URDF z), out-of-plane
-        if link.shape is not None and link.shape.type == "ellipsoid":
-            assert link.shape.radius is not None
-            along = 2.0 * link.mass * link.shape.radius ** 2 / 5.0
-        ET.SubElement(inertial, "inertia", ixx=_num(link.inertia), ixy="0.0", ixz="0.0",
-                      iyy=_num(link.inertia), iyz="0.0", izz=_num(along))
-    for link in model.links[1:]:
-        assert link.joint is not None and link.parent is not None
-        parent = model.link(link.parent)
-        j = ET.SubElement(robot, "joint", name=link.joint.name, type="revolute")
-        ET.SubElement(j, "parent", link=link.parent)
-        ET.SubElement(j, "child", link=link.name)
-        ET.SubElement(j, "origin", xyz=_xyz(parent.local_point(*link.joint.at)),
-                      rpy="0.0 0.0 0.0")
-        ET.SubElement(j, "axis", xyz="0 -1 0")
-        ET.SubElement(j, "limit", lower=_num(link.joint.limits[0]),
-                      upper=_num(link.joint.limits[1]),
-                      effort=_num(effort.get(link.joint.name, 0.0)), velocity="0.0")
-    for c in model.contacts:
-        robot.append(ET.Comment(f" gaitopt contact point {c.name!r} on {c.link!r} "))
-        ET.SubElement(robot, "link", name=c.name)
-        j = ET.SubElement(robot, "joint", name=CONTACT_PREFIX + c.name, type="fixed")
-        ET.SubElement(j, "parent", link=c.link)
-        ET.SubElement(j, "child", link=c.name)
-        ET.SubElement(j, "origin", xyz=_xyz(model.link(c.link).local_point(*c.at)),
-                      rpy="0.0 0.0 0.0")
-    robot.append(ET.Comment(" what URDF has no place for, in gaitopt's terms (docs/urdf.md) "))
-    ext = ET.SubElement(robot, "gaitopt", version="1")
-    ET.SubElement(ext, "gravity", x=_num(model.gravity[0]), y=_num(model.gravity[1]))
-    ET.SubElement(ext, "description").text = model.description
-    for link in model.links:
-        ET.SubElement(ext, "link", name=link.name, direction=link.direction,
-                      length=_num(link.length))
-    for link in model.links:
-        if link.shape is not None:
-            attrs = {"link": link.name, "type": link.shape.type}
-            if link.shape.radius is not None:
-                attrs["radius"] = _num(link.shape.radius)
-            ET.SubElement(ext, "shape", attrs)
-    for a in model.actuators:
-        target = {"joint": a.joint} if a.joint is not None else {"contact": a.contact or ""}
-        ET.SubElement(ext, "actuator", {"name": a.name, **target, "lower": _num(a.limits[0]),
-                                        "upper": _num(a.limits[1])})
-    ET.indent(robot, space="  ")
-    return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
-
