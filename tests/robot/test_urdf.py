@@ -371,6 +371,26 @@ def test_refusals_name_the_joint_or_link(case: str) -> None:
     assert where in message and why in message, message
 
 
+@pytest.mark.parametrize(("text", "message"), [
+    ('<robot name="r"/>', "<string>: no links; allowed: a <robot> with <link> elements"),
+    ("<robot", "<string>: not valid XML"),
+    ('<urdf name="r"/>', "<string>: the root element is <urdf>"),
+    ('<robot name="r"><link name="a"/><link name="b"/></robot>',
+     "<string>: 2 links without a parent"),
+    ('<robot name="r"><link name="a"><inertial><mass value="-1"/></inertial></link></robot>',
+     "<string>: link 'a' mass: got -1.0; allowed: a mass >= 0 (kg)"),
+])
+def test_malformed_urdf_gives_one_line(text: str, message: str) -> None:
+    with pytest.raises(ModelError) as info:
+        model_from_urdf(text)
+    assert str(info.value).startswith(message) and "\n" not in str(info.value), info.value
+
+
+def test_missing_file_is_a_model_error(tmp_path: Path) -> None:
+    with pytest.raises(ModelError, match="none.urdf: cannot be read"):
+        model_from_urdf(tmp_path / "none.urdf")
+
+
 def test_unknown_contact_link_is_refused() -> None:
     with pytest.raises(ModelError, match=r"contact 'heel'.*no link 'calf'"):
         model_from_urdf(WALKER, contacts=[ContactSpec("heel", "calf", (0.0, 0.0))])

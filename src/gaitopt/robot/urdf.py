@@ -181,6 +181,8 @@ class _Importer:
             self.parent_joint[j.child] = j
             self.children[j.parent].append(j)
         roots = [n for n in self.links if n not in self.parent_joint]
+        if not self.links:
+            raise reader.fail("", None, "a <robot> with <link> elements", problem="no links")
         if len(roots) > 1:
             raise reader.fail("", roots, "one root link and a tree of joints",
                               problem=f"{len(roots)} links without a parent "
