@@ -15,10 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from gaitopt.cli import cli
 from gaitopt.dynamics import aba, crba, rnea
-from gaitopt.robot import ModelError, RobotModel, load_model
+from gaitopt.robot import ModelError, RobotModel, load_model, model_from_dict
 from gaitopt.robot.urdf import ContactSpec, model_from_urdf, urdf_from_model
 
 DATA = Path(__file__).parent / "data"
@@ -45,6 +47,58 @@ def test_five_link_round_trip_is_the_same_model() -> None:
     assert back == original  # masses, coms, inertias, limits, actuators, contacts, gravity...
     assert back.content_hash() == original.content_hash()
     assert [link.shape for link in back.links] == [link.shape for link in original.links]
+
+
+# names with characters XML must escape; contact names apart from link names (one namespace)
+names = st.text(st.sampled_from("ab_1 <&\"'é"), min_size=1, max_size=6).filter(
+    lambda s: s == s.strip() and s not in ("x", "y"))
+finite = st.floats(-5.0, 5.0, allow_nan=False, allow_infinity=False)
+positive = st.floats(1e-4, 1e2, allow_nan=False, allow_infinity=False)
+
+
+@st.composite
+def random_models(draw: st.DrawFn) -> RobotModel:
+    """A random valid model: a tree of 1 to 6 links in any directions, points anywhere,
+    contacts, actuators on joints and contacts with any bounds in any order, any gravity."""
+    n = draw(st.integers(1, 6))
+    k = draw(st.integers(0, 3))
+    every = draw(st.lists(names, min_size=2 * n - 1 + k, max_size=2 * n - 1 + k, unique=True))
+    link_names, joint_names, contact_names = every[:n], every[n:2 * n - 1], every[2 * n - 1:]
+
+    def pair() -> list[float]:
+        return [draw(finite), draw(finite)]
+
+    def sorted_pair() -> list[float]:
+        return sorted(pair())
+
+    links = []
+    for i, name in enumerate(link_names):
+        link = {"name": name, "parent": None if i == 0 else link_names[draw(st.integers(0, i - 1))],
+                "direction": draw(st.sampled_from(["up", "down"])), "length": draw(positive),
+                "mass": draw(positive), "com": pair()}
+        if i > 0:
+            link["joint"] = {"name": joint_names[i - 1], "at": pair(), "limits": sorted_pair()}
+        link.update(draw(st.sampled_from([{"inertia": draw(positive)}, {"shape": {"type": "rod"}},
+                                          {"shape": {"type": "ellipsoid",
+                                                     "radius": draw(positive)}}])))
+        links.append(link)
+    contacts = [{"name": c, "link": draw(st.sampled_from(link_names)), "at": pair()}
+                for c in contact_names]
+    targets = [("joint", j) for j in joint_names] + [("contact", c) for c in contact_names]
+    chosen = draw(st.permutations(targets).flatmap(
+        lambda ts: st.integers(0, len(ts)).map(lambda m: ts[:m])))
+    actuators = [{"name": f"u{i}", kind: target, "limits": sorted_pair()}
+                 for i, (kind, target) in enumerate(chosen)]
+    return model_from_dict({"name": draw(names), "links": links, "contacts": contacts,
+                            "actuators": actuators, "gravity": pair(),
+                            "description": draw(st.text(st.sampled_from("ab <&\n\t"),
+                                                        max_size=8))})
+
+
+@settings(deadline=None, max_examples=60, suppress_health_check=[HealthCheck.too_slow])
+@given(random_models())
+def test_any_model_round_trips_exactly(model: RobotModel) -> None:
+    assert model_from_urdf(urdf_from_model(model)) == model
 
 
 def strip_gaitopt_element(text: str) -> str:

@@ -54,7 +54,7 @@ from gaitopt.robot.urdf_xml import CONTACT_PREFIX, Extension, Reader, UJoint, UL
 __all__ = ["CONTACT_PREFIX", "ContactSpec", "model_from_urdf", "parse_contact_option",
            "urdf_from_model"]
 
-#: Coordinates smaller than this (m) after a frame rotation are taken as exactly 0.
+#: Coordinates smaller than this (m) computed through a frame rotation are taken as exactly 0.
 SNAP = 1e-12
 #: Tolerance on a joint axis being the common axis (a unit vector).
 AXIS_TOL = 1e-9
@@ -204,9 +204,11 @@ class _Importer:
         self.root = roots[0]
 
     # -- frames ------------------------------------------------------------------------------
-    def in_plane(self, v: np.ndarray) -> np.ndarray:
-        """gaitopt (x, y) of a URDF vector given in a body's (world-parallel) frame."""
-        return self.plane[:2] @ v
+    def in_plane(self, v: np.ndarray, exact: bool) -> np.ndarray:
+        """gaitopt (x, y) of a URDF vector given in a body's (world-parallel) frame; unless
+        ``exact`` (no rotation went into ``v``), rounding dust (``|x| < SNAP``) becomes 0."""
+        g = self.plane[:2] @ v + 0.0
+        return g if exact else np.where(np.abs(g) < SNAP, 0.0, g)
 
     def about_normal(self, where: str, v: np.ndarray) -> float:
         """+1 if the unit vector ``v`` is gaitopt's +z, -1 if -z; else a ModelError."""
@@ -258,7 +260,9 @@ class _Importer:
     def model(self, specs: list[ContactSpec], name: str | None) -> RobotModel:
         base, chain = self.base_chain()
         bodies = [_Body(base, -1, None)]
-        frame = {base: (0, self.base_rot, np.zeros(3))}  # link -> body, axes, origin (body)
+        # URDF link -> (its gaitopt link, its axes and origin in that link's frame, whether
+        # no rotation went into them: then points computed from them are exact)
+        frame = {base: (0, self.base_rot, np.zeros(3), _is_identity(self.base_rot))}
         contacts: list[tuple[str, int, np.ndarray]] = []
         done = {j.name for j in chain}
         pending = [j for j in self.joints if j.name not in done]
@@ -270,35 +274,36 @@ class _Importer:
                                   problem=f"a joint on the floating-base chain link {j.parent!r}")
             j = ready[0]
             pending.remove(j)
-            k, rot_p, pos_p = frame[j.parent]
+            k, rot_p, pos_p, exact_p = frame[j.parent]
             rot, pos = rot_p @ j.rot, pos_p + rot_p @ j.pos
             where = f"joint {j.name!r}"
             if j.type == "fixed":
                 child = self.links[j.child]
                 if (j.name.startswith(CONTACT_PREFIX) and child.mass == 0.0
                         and not self.children[j.child]):
-                    contacts.append((j.child, k, self.in_plane(pos)))
-                frame[j.child] = (k, rot, pos)
+                    contacts.append((j.child, k, self.in_plane(pos, exact_p)))
+                frame[j.child] = (k, rot, pos, exact_p and _is_identity(rot))
             elif j.type in ("revolute", "continuous"):
                 sign = self.about_normal(f"{where} axis", rot @ j.axis)
                 assert j.limits is not None
                 lo, hi = (j.limits if sign > 0 else (-j.limits[1] + 0.0, -j.limits[0] + 0.0))
-                at = self.in_plane(pos)
+                at = self.in_plane(pos, exact_p)
                 bodies[k].points.append(at)
                 bodies.append(_Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
                                     effort=j.effort or 0.0))
-                frame[j.child] = (len(bodies) - 1, rot, np.zeros(3))
+                frame[j.child] = (len(bodies) - 1, rot, np.zeros(3), _is_identity(rot))
             else:
                 raise self.r.fail(where, j.type, "revolute, continuous or fixed joints below "
                                   "the base (prismatic, planar and floating joints only in the "
                                   "floating-base chain at the root)",
                                   problem=f"a {j.type} joint outside the floating-base chain")
         normal = -self.plane[2]
-        for link_name, (k, rot, pos) in frame.items():
+        for link_name, (k, rot, pos, exact) in frame.items():
             link = self.links[link_name]
             if link.mass > 0.0:
                 inertia = float(normal @ rot @ link.inertia @ rot.T @ normal)
-                bodies[k].parts.append((link.mass, self.in_plane(pos + rot @ link.com), inertia))
+                com = self.in_plane(pos + rot @ link.com, exact)
+                bodies[k].parts.append((link.mass, com, inertia))
         taken = {c[0] for c in contacts}
         for spec in specs:
             if spec.name in taken:
@@ -309,11 +314,11 @@ class _Importer:
                                   "the name of a link at or below the base link "
                                   f"({', '.join(sorted(frame))})", problem=f"no link "
                                   f"{spec.link!r}")
-            k, rot, pos = frame[spec.link]
+            k, rot, pos, exact = frame[spec.link]
             local = np.zeros(3)
             i0, i1, _ = _IN_PLANE[self.axis]
             local[i0], local[i1] = spec.point
-            contacts.append((spec.name, k, self.in_plane(pos + rot @ local)))
+            contacts.append((spec.name, k, self.in_plane(pos + rot @ local, exact)))
             taken.add(spec.name)
         for _, k, p in contacts:
             bodies[k].points.append(p)
@@ -340,7 +345,9 @@ class _Importer:
             entry: dict[str, Any] = {"name": b.name,
                                      "parent": None if b.parent < 0 else bodies[b.parent].name}
             if b.joint is not None:
-                entry["joint"] = {**b.joint, "at": _point(b.joint["at"], direction)}
+                # the joint's position is a point on the parent (listed before its children)
+                entry["joint"] = {**b.joint, "at": _point(b.joint["at"],
+                                                          links[b.parent]["direction"])}
             entry.update({"direction": direction, "length": length, "mass": mass,
                           "com": _point(com, direction), "inertia": inertia})
             shape = ext.shapes.get(b.name)
@@ -370,15 +377,15 @@ class _Importer:
         return data
 
 
-def _clean(x: float) -> float:
-    """``x`` with ``-0.0`` and rounding dust (``|x| < SNAP``) made ``0.0``."""
-    return 0.0 if abs(x) < SNAP else float(x)
+def _is_identity(rot: np.ndarray) -> bool:
+    return bool(np.array_equal(rot, np.eye(3)))
 
 
 def _point(p: Sequence[float] | np.ndarray, direction: str) -> list[float]:
-    """gaitopt link-frame coordinates (x, y) as ``[along, across]`` for a link direction."""
+    """gaitopt link-frame coordinates (x, y) as ``[along, across]`` for a link direction
+    (``+ 0.0`` turns ``-0.0`` into ``0.0``)."""
     x, y = float(p[0]), float(p[1])
-    return [_clean(-y), _clean(x)] if direction == "down" else [_clean(y), _clean(-x)]
+    return [-y + 0.0, x + 0.0] if direction == "down" else [y + 0.0, -x + 0.0]
 
 
 def _direction_and_length(points: list[np.ndarray], com: np.ndarray,
@@ -393,9 +400,9 @@ def _direction_and_length(points: list[np.ndarray], com: np.ndarray,
     centre in the middle), at least reaching its points on that side; a link with nothing
     above or below its origin gets ``down`` and 1 m.
     """
-    below = max([-float(p[1]) for p in points if _clean(p[1]) < 0.0], default=0.0)
-    above = max([float(p[1]) for p in points if _clean(p[1]) > 0.0], default=0.0)
-    height = _clean(float(com[1]))
+    below = max([-float(p[1]) for p in points if p[1] < 0.0], default=0.0)
+    above = max([float(p[1]) for p in points if p[1] > 0.0], default=0.0)
+    height = float(com[1])
     if not base or height == 0.0:
         if below > 0.0:
             return "down", below
