@@ -377,6 +377,19 @@ def test_pinocchio_mass_matrix_and_gravity_match(which: str) -> None:
                                    s.T @ g_pin, rtol=1e-10, atol=1e-9)
 
 
+@settings(deadline=None, max_examples=25, suppress_health_check=[HealthCheck.too_slow])
+@given(random_models())
+def test_pinocchio_agrees_on_the_export_of_any_model(model: RobotModel) -> None:
+    pin = pytest.importorskip("pinocchio")
+    pm, q_pin, s = pinocchio_reference(urdf_from_model(model), model)
+    pd = pm.createData()
+    for q, _, _ in random_states(model, 3, seed=6):
+        m_pin = pin.crba(pm, pd, q_pin(q))
+        m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+        np.testing.assert_allclose(np.asarray(crba(model, q)), s.T @ m_pin @ s,
+                                   rtol=1e-9, atol=1e-9)
+
+
 # -- refusals ------------------------------------------------------------------------------------
 
 def edit_walker(old: str, new: str) -> str:
