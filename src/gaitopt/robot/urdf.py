@@ -63,7 +63,7 @@ AXIS_TOL = 1e-9
 _PLANE = {"y": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
           "x": np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])}
 #: Which URDF coordinates of a link frame a ``--contact`` point gives, for each common axis.
-_IN_PLANE = {"y": (0, 2, "X,Z"), "x": (1, 2, "Y,Z")}
+_IN_PLANE = {"y": (0, 2), "x": (1, 2)}
 
 
 @dataclass(frozen=True)
@@ -316,7 +316,7 @@ class _Importer:
                                   f"{spec.link!r}")
             k, rot, pos, exact = frame[spec.link]
             local = np.zeros(3)
-            i0, i1, _ = _IN_PLANE[self.axis]
+            i0, i1 = _IN_PLANE[self.axis]
             local[i0], local[i1] = spec.point
             contacts.append((spec.name, k, self.in_plane(pos + rot @ local, exact)))
             taken.add(spec.name)
