@@ -101,20 +101,37 @@ def test_any_model_round_trips_exactly(model: RobotModel) -> None:
     assert model_from_urdf(urdf_from_model(model)) == model
 
 
-def strip_gaitopt_element(text: str) -> str:
+def strip_gaitopt_element(text: str, contact_frames: bool = False) -> str:
+    """``text`` without the ``<gaitopt>`` element (and the contact frames if asked)."""
     root = ET.fromstring(text)
     ext = root.find("gaitopt")
     assert ext is not None
     root.remove(ext)
+    if contact_frames:
+        for joint in root.findall("joint"):
+            if (joint.get("name") or "").startswith("gaitopt_contact_"):
+                child = joint.find("child")
+                assert child is not None
+                root.remove(joint)
+                root.remove(next(e for e in root.findall("link")
+                                 if e.get("name") == child.get("link")))
     return ET.tostring(root, encoding="unicode")
 
 
-def test_without_the_gaitopt_element_only_what_urdf_cannot_hold_is_lost() -> None:
-    # The direction/length rule, the contact frames and the efforts alone give back every
-    # link, joint and contact; lost: the ankle (ground) torques, the shapes (the inertias
-    # stay), the description. Gravity is gaitopt's default anyway.
+FIVE_LINK_TIPS = [ContactSpec("tip_1", "shank_1", (0.0, -0.5)),
+                  ContactSpec("tip_2", "shank_2", (0.0, -0.5))]
+
+
+@pytest.mark.parametrize("contact_frames", [False, True])
+def test_without_the_gaitopt_element_only_what_urdf_cannot_hold_is_lost(
+        contact_frames: bool) -> None:
+    # The direction/length rule, the contact frames (or --contact) and the efforts alone give
+    # back every link, joint and contact; lost: the ankle (ground) torques, the shapes (the
+    # inertias stay), the description. Gravity is gaitopt's default anyway.
     original = five_link()
-    bare = model_from_urdf(strip_gaitopt_element(urdf_from_model(original)))
+    text = strip_gaitopt_element(urdf_from_model(original), contact_frames)
+    assert ("gaitopt_contact" in text) != contact_frames
+    bare = model_from_urdf(text, contacts=FIVE_LINK_TIPS if contact_frames else ())
     assert bare.links == tuple(dataclasses.replace(link, shape=None) for link in original.links)
     assert bare.contacts == original.contacts
     assert bare.gravity == original.gravity
