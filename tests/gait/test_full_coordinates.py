@@ -126,6 +126,36 @@ def test_single_support_gait_with_a_straight_knee(model: RobotModel, reference: 
     assert verify_gait(gait).passed
 
 
+def _biped_with_arms() -> RobotModel:
+    """Another topology: the five-link biped with a sixth link, an actuated arm hanging from
+    the top of the torso (4 kg taken from the torso); 8 coordinates."""
+    data = load_model("five-link").to_dict()
+    data["name"] = "six-link-arm"
+    data["links"][0]["mass"] = 16.0
+    del data["links"][0]["shape"]  # keep the torso's inertia (0.576 kg m^2)
+    data["links"].append({
+        "name": "arm", "parent": "torso", "direction": "down", "length": 0.6, "mass": 4.0,
+        "com": [0.3, 0.0], "inertia": 0.12,
+        "joint": {"name": "shoulder", "at": [0.72, 0.0], "limits": [-1.5, 1.5]}})
+    data["actuators"].append({"name": "shoulder", "joint": "shoulder", "limits": [-30.0, 30.0]})
+    return model_from_dict(data)
+
+
+def test_another_topology_walks_through_the_same_mechanism(reference: RefFn) -> None:
+    """A torso with an extra actuated link (which the reduced formulation cannot describe)
+    walks at 12 m/min from the naive start; its gait is physical and periodic, the arm's
+    coordinate and torque included."""
+    model = _biped_with_arms()
+    assert model.nq == 8
+    gait = solve_gait(model, FULL)
+    assert gait.success, gait.status
+    assert_physics(reference(model), gait)
+    state, control = periodicity_errors(
+        gait, controls=("hip_1", "knee_1", "hip_2", "knee_2", "shoulder"))
+    assert state < 1e-6 and control < 1e-6
+    assert verify_gait(gait).passed
+
+
 def test_warm_start_from_a_full_gait_file(solved: SolveFn, tmp_path) -> None:  # noqa: ANN001
     gait = solved(FULL).gait
     path = gait.save(tmp_path / "full.gait.json")

@@ -26,7 +26,10 @@ from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.reduced import checked_biped, leg_inverse_kinematics
 from gaitopt.dynamics.rnea import bias_forces
 from gaitopt.gait import walking
+from gaitopt.gait.full_coordinates import actuator_names
+from gaitopt.gait.full_coordinates import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -37,12 +40,15 @@ _FINE = 400
 
 @dataclass(frozen=True)
 class PhaseGuess:
-    """Knot values of one phase: ``t`` (K,), ``x`` (K, n), ``u`` (K, m)."""
+    """Knot values of one phase: ``t`` (K,), ``x`` (K, n) named by ``states``, ``u`` (K, m)
+    named by ``controls`` (the actuators acting in the phase)."""
 
     name: str
     t: Array
     x: Array
     u: Array
+    states: tuple[str, ...]
+    controls: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -81,14 +87,16 @@ def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple
 def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                 single_support_fraction: float, knots: tuple[int, int], ankle: bool,
                 r_max: float, clearance: float | None = None,
-                ankle_torques: bool | None = None) -> WalkingGuess:
+                ankle_torques: bool | None = None, full: bool = False) -> WalkingGuess:
     """The geometric guess described in the module docstring (knot values per phase).
 
     ``ankle`` says whether the controls include the ankle torques; ``ankle_torques`` (default:
     ``ankle``) whether the least-squares torques may use them (``False``: they are zero, the
-    guess of a stage that holds the ankles at zero)."""
+    guess of a stage that holds the ankles at zero). ``full``: the states are ``[q, qd]``
+    (the full-coordinate formulation; joints other than the legs' stay at 0), else the reduced
+    states of :mod:`gaitopt.gait.walking`."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
-    legs = checked_biped(model).legs
+    legs = (biped_structure(model) if full else checked_biped(model)).legs
     v, step, f = speed, step_length, single_support_fraction
     total = step / v
     t1, t2 = f * total, (1.0 - f) * total
@@ -114,7 +122,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
             q_fine[k, leg.hip_index] = float(joints.hip)
             q_fine[k, leg.knee_index] = float(joints.knee)
     phases.append(_phase_guess(model, SINGLE, t_fine, q_fine, _knots(0.0, t1, knots[0]),
-                               ankle, use_ankles, [legs[0].contact]))
+                               ankle, use_ankles, [legs[0].contact], full))
     if f < 1.0:
         t_fine = np.linspace(t1, t1 + t2, _FINE)
         p_hip = hip(t_fine)
@@ -128,24 +136,26 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                 q_fine[k, leg.knee_index] = float(joints.knee)
         phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
                                    _knots(t1, t2, knots[1]), ankle, use_ankles,
-                                   [legs[0].contact, legs[1].contact]))
+                                   [legs[0].contact, legs[1].contact], full))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
 
 def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_knots: Array,
-                 ankle: bool, use_ankles: bool, held: list[str]) -> PhaseGuess:
+                 ankle: bool, use_ankles: bool, held: list[str], full: bool) -> PhaseGuess:
     qd_fine = np.gradient(q_fine, t_fine, axis=0)
     qdd_fine = np.gradient(qd_fine, t_fine, axis=0)
-    controls = walking.control_names(model, phase, ankle=ankle)
-    acting = walking.control_names(model, phase, ankle=use_ankles)
+    controls = actuator_names(model, held, ankle=ankle)
+    acting = actuator_names(model, held, ankle=use_ankles)
     columns = [controls.index(name) for name in acting]
     xs, us = [], []
     for t in t_knots:
         q = np.array([np.interp(t, t_fine, q_fine[:, i]) for i in range(model.nq)])
         qd = np.array([np.interp(t, t_fine, qd_fine[:, i]) for i in range(model.nq)])
         qdd = np.array([np.interp(t, t_fine, qdd_fine[:, i]) for i in range(model.nq)])
-        if phase == SINGLE:
+        if full:
+            x = np.concatenate([q, qd])
+        elif phase == SINGLE:
             x = walking.full_to_single_support(model, q, qd)
         else:
             x = walking.full_to_double_support(model, q, qd)
@@ -153,4 +163,6 @@ def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_
         u = np.zeros(len(controls))
         u[columns] = _torques(model, q, qd, qdd, acting, held)
         us.append(u)
-    return PhaseGuess(name=phase, t=np.asarray(t_knots), x=np.array(xs), u=np.array(us))
+    states = full_state_names(model) if full else walking.state_names(model, phase)
+    return PhaseGuess(name=phase, t=np.asarray(t_knots), x=np.array(xs), u=np.array(us),
+                      states=states, controls=controls)

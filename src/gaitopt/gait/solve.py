@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.gait.formulation import biped_of, formulation_guess, problem_for, stage_bounds
+from gaitopt.gait.formulation import biped_of, problem_for, stage_bounds
 from gaitopt.gait.guess import WalkingGuess, default_step_length, naive_guess
 from gaitopt.gait.options import GaitOptions, validate_options
 from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
@@ -53,8 +53,6 @@ REFERENCE_SPEED = 0.2
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
-#: Smallest stance knee bend (rad) of the reduced solve that starts a full-coordinate one.
-REDUCED_START_FLEXION = 0.1
 #: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
 #: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
 #: the lower local optimum more often than the default monotone one: over 20 speeds with and
@@ -78,6 +76,13 @@ PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
 #: 2 s) to the same optimum and tolerance. Warm starts on a fine grid (a sweep's neighbours)
 #: use the exact Hessian, built once per process.
 FINE_STAGE_OPTIONS = {"ipopt.hessian_approximation": "limited-memory"}
+
+
+def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
+    """:data:`FINE_STAGE_OPTIONS` in the reduced formulation; the exact Hessian in the full
+    one, where the quasi-Newton stages took 365 + 228 iterations at 16 + 6 knots and ended
+    at IPOPT's acceptable level, against 23 + 13 with the exact Hessian (12 m/min)."""
+    return dict(FINE_STAGE_OPTIONS) if options.formulation == "reduced" else {}
 
 ProgressFn = Callable[["StageReport"], None]
 
@@ -174,7 +179,9 @@ def ocp_guess(guess: WalkingGuess) -> Guess:
     phases = {}
     for ph in guess.phases:
         span = ph.t[-1] - ph.t[0]
-        phases[ph.name] = PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / span)
+        phases[ph.name] = PhaseGuess(
+            x={n: ph.x[:, j] for j, n in enumerate(ph.states)},
+            u={n: ph.u[:, j] for j, n in enumerate(ph.controls)}, tau=(ph.t - ph.t[0]) / span)
     return Guess(phases=phases, parameters=dict(guess.parameters))
 
 
@@ -239,9 +246,8 @@ class _Run:
             guess = naive_guess(self.model, speed=speed, step_length=step0,
                                 single_support_fraction=o.single_support_fraction,
                                 knots=coarse, ankle=o.ankle, r_max=r_max,
-                                ankle_torques=False)
-            relaxed = self.stage("relaxed contact", coarse, RELAXED,
-                                 formulation_guess(self.model, o, ocp_guess(guess)), bounds,
+                                ankle_torques=False, full=o.formulation == "full")
+            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
                                  hold_ankles=o.ankle, solver_options=COLD_START_OPTIONS)
             if not relaxed.success:
                 continue
@@ -286,13 +292,13 @@ class _Run:
         for name in ("step_length", "speed"):
             held[name] = (result.parameters[name], result.parameters[name])
         fine = self.stage("target grid", o.knots, Relaxation(), result, held,
-                          solver_options={**PRIMAL_WARM_OPTIONS, **FINE_STAGE_OPTIONS})
+                          solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
         if not fine.success or all_fixed:
             return fine
         return self.stage("target grid, all free", o.knots, Relaxation(), fine,
-                          parameter_bounds(o), solver_options=FINE_STAGE_OPTIONS)
+                          parameter_bounds(o), solver_options=fine_stage_options(o))
 
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
@@ -313,34 +319,6 @@ class _Run:
                 return None
         return current
 
-    def from_reduced(self) -> Result | None:
-        """The full-coordinate solve started from the reduced formulation's optimum on the
-        coarse grid (its robust cold start; a knee bend of at least
-        :data:`REDUCED_START_FLEXION` there), then released and refined in full coordinates.
-        None if the reduced solve fails (the caller falls back to the full cold start)."""
-        o, coarse = self.options, coarse_knots(self.options)
-        reduced = o.replace(formulation="reduced", knots=coarse,
-                            min_stance_knee_flexion=max(o.min_stance_knee_flexion,
-                                                        REDUCED_START_FLEXION))
-
-        def report(stage: StageReport) -> None:
-            import dataclasses
-
-            stage = dataclasses.replace(stage, name=f"reduced: {stage.name}")
-            self.stages.append(stage)
-            if self.progress is not None:
-                self.progress(stage)
-
-        start = solve_walking(self.model, reduced, progress=report, compiled=self.compiled)
-        if not start.success:
-            return None
-        guess = formulation_guess(self.model, o, result_guess(start.result))
-        result = self.stage("full coordinates", coarse, Relaxation(), guess,
-                            parameter_bounds(o), solver_options=PRIMAL_WARM_OPTIONS)
-        if not result.success:
-            return result
-        return self.refine(result)
-
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
         the last stage whose values are, marked failed."""
@@ -350,24 +328,6 @@ class _Run:
                     return _as_failed(result, self.results[-1])
                 return result
         return self.results[-1]
-
-
-def reduced_start_possible(model: RobotModel) -> bool:
-    """Whether the reduced formulation can solve ``model`` (the five-link shape)."""
-    from gaitopt.robot.biped import BipedStructureError
-
-    try:
-        biped_of(model, GaitOptions())
-    except BipedStructureError:
-        return False
-    return True
-
-
-def result_guess(result: Result) -> Guess:
-    """An engine guess holding a result's knot values (normalised times) and parameters."""
-    phases = {ph.name: PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0]))
-              for ph in result.phases}
-    return Guess(phases=phases, parameters=dict(result.parameters))
 
 
 def best_of(results: Sequence[Result | None]) -> Result | None:
@@ -400,10 +360,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         if not result.success:
             result = None
     outcome: Result | None = result
-    if result is None and options.formulation == "full" and reduced_start_possible(model):
-        outcome = run.from_reduced()
-        result = outcome if outcome is not None and outcome.success else None
-    if result is None and outcome is None:
+    if result is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
         coarse = run.cold(speed, every_start=options.multistart)
         far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9
