@@ -20,6 +20,7 @@ from rich.text import Text
 from gaitopt import cli_gait, cli_study  # noqa: F401  (they register their subcommands)
 from gaitopt.cli_base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
 from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model, model_to_yaml
+from gaitopt.robot.symmetry import SymmetryError, model_symmetry
 
 # -- gaitopt model ---------------------------------------------------------------------------
 
@@ -42,6 +43,11 @@ def model_show(name_or_file: str) -> None:
     console.print(f"gravity [m/s^2]: ({_g(m.gravity[0])}, {_g(m.gravity[1])})")
     console.print(f"coordinates q: [{', '.join(m.coordinate_names)}]")
     console.print(f"controls u:    [{', '.join(a.name for a in m.actuators)}]")
+    try:
+        symmetry = model_symmetry(m).describe()
+    except SymmetryError as exc:
+        symmetry = f"none ({exc})"
+    console.print(f"symmetry:      {symmetry}")
 
 
 def model_tables(m: RobotModel) -> list[Table]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import full_coordinates as full
-from gaitopt.gait.contact_sequence import ContactSequence, walking_sequence
+from gaitopt.gait.contact_sequence import ContactSequence, running_sequence, walking_sequence
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
@@ -26,7 +26,10 @@ def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure:
 
 
 def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
-    """The contact sequence of ``options`` (the paper's walk, or the single-support walk)."""
+    """The contact sequence of ``options``: the paper's walk, the single-support walk or a
+    run."""
+    if options.gait == "run":
+        return running_sequence(model, options.single_support_fraction)
     return walking_sequence(model, options.single_support_fraction,
                             impulse=options.impulse and options.double_support)
 

@@ -49,7 +49,6 @@ from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.dynamics.impact import impact, liftoff_impulse
 from gaitopt.dynamics.kinematics import contact_jacobian, contact_position, contact_velocity
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, check_sequence
-from gaitopt.gait.gait_file import leg_swap_permutations
 from gaitopt.gait.options import GaitOptions
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
@@ -64,6 +63,7 @@ from gaitopt.ocp.problem import (
 )
 from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import swap_maps, swap_permutations
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 _L, _V, _P = range(3)
@@ -105,11 +105,11 @@ class Symmetry:
 
 
 def model_symmetry(model: RobotModel) -> Symmetry:
-    """The leg swap of a model with two legs (the chains to its first two contacts)."""
-    perm_q, perm_u = leg_swap_permutations(model)
-    c1, c2 = model.contacts[0].name, model.contacts[1].name
-    swap = {c.name: c.name for c in model.contacts} | {c1: c2, c2: c1}
-    return Symmetry(tuple(int(i) for i in perm_q), tuple(int(i) for i in perm_u), swap)
+    """The leg swap of a model (declared in its file or inferred:
+    :mod:`gaitopt.robot.symmetry`)."""
+    perm_q, perm_u = swap_permutations(model)
+    _, contacts = swap_maps(model)
+    return Symmetry(tuple(int(i) for i in perm_q), tuple(int(i) for i in perm_u), contacts)
 
 
 def state_names(model: RobotModel) -> tuple[str, ...]:

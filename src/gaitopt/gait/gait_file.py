@@ -632,40 +632,12 @@ def swap_leg_label(name: str) -> str:
 
 
 def leg_swap_permutations(model: RobotModel) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """Index permutations of ``q`` and ``u`` that exchange the two legs.
+    """Index permutations of ``q`` and ``u`` that exchange the two legs
+    (:func:`gaitopt.robot.symmetry.swap_permutations`: the declared symmetry or the one
+    inferred from the chains to the first two contacts). ``q_swapped = q[..., perm_q]``."""
+    from gaitopt.robot.symmetry import swap_permutations
 
-    Leg i is the chain of links from the base to the link carrying contact i (the model's
-    first two contacts); the joints of the two chains are paired in order, contact actuators
-    by their contact. ``q_swapped = q[..., perm_q]``; both permutations are involutions.
-    """
-    if len(model.contacts) != 2:
-        raise ValueError(f"model {model.name!r}: swapping legs needs exactly two contacts, "
-                         f"got {len(model.contacts)}")
-    legs = [model.chain(model.link_index(c.link))[1:] for c in model.contacts]
-    if len(legs[0]) != len(legs[1]) or set(legs[0]) & set(legs[1]):
-        raise ValueError(f"model {model.name!r}: the two legs must be separate chains of "
-                         "equal length from the base")
-    perm_q = np.arange(model.nq)
-    joint_pair: dict[str, str] = {}
-    for a, b in zip(legs[0], legs[1], strict=True):
-        ia, ib = model.coordinate_of_link(a), model.coordinate_of_link(b)
-        perm_q[ia], perm_q[ib] = ib, ia
-        ja, jb = model.links[a].joint, model.links[b].joint
-        assert ja is not None and jb is not None
-        joint_pair[ja.name], joint_pair[jb.name] = jb.name, ja.name
-    c0, c1 = (c.name for c in model.contacts)
-    contact_pair = {c0: c1, c1: c0}
-    perm_u = np.arange(model.nu)
-    for i, act in enumerate(model.actuators):
-        other = (joint_pair.get(act.joint, act.joint) if act.joint is not None
-                 else contact_pair[act.contact or ""])
-        matches = [j for j, b in enumerate(model.actuators)
-                   if (b.joint if act.joint is not None else b.contact) == other]
-        if len(matches) != 1:
-            raise ValueError(f"model {model.name!r}: actuator {act.name!r} has no unique "
-                             "counterpart on the other leg")
-        perm_u[i] = matches[0]
-    return perm_q, perm_u
+    return swap_permutations(model)
 
 
 # -- interpolation between knots ---------------------------------------------------------------

@@ -77,9 +77,12 @@ def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple
     h = np.asarray(bias_forces(model, q, qd), dtype=float).reshape(-1)
     b_full = np.asarray(actuation_matrix(model, q, held), dtype=float)
     cols = [model.actuator_index(n) for n in controls]
-    j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(2 * len(held), -1)
     force_scale = 100.0  # forces are cheap in the least-squares norm
-    a = np.hstack([b_full[:, cols], force_scale * j.T])
+    a = b_full[:, cols]
+    if held:
+        j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(2 * len(held),
+                                                                               -1)
+        a = np.hstack([a, force_scale * j.T])
     sol, *_ = np.linalg.lstsq(a, m_q @ qdd + h, rcond=None)
     return np.asarray(sol[: len(cols)], dtype=float)
 
@@ -137,6 +140,59 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
         phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
                                    _knots(t1, t2, knots[1]), ankle, use_ankles,
                                    [legs[0].contact, legs[1].contact], full))
+    return WalkingGuess(phases=tuple(phases),
+                        parameters={"step_length": step, "speed": v, "impulse": 0.0})
+
+
+def default_running_step(speed: float) -> float:
+    """A plausible running step length (m) for a speed (m/s) to start from."""
+    return float(np.clip(0.35 * speed, 0.3, 1.2))
+
+
+def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
+                        stance_fraction: float, knots: tuple[int, int], ankle: bool,
+                        r_max: float, ankle_torques: bool | None = None) -> WalkingGuess:
+    """A geometric guess of a run in full coordinates (phases ``stance`` and ``flight``).
+
+    The hip moves at constant speed at the height where the stance leg reaches its tip at the
+    origin over the whole stance; tip 1 stands during the stance, then flies to ``(L + xb,
+    yb)``; tip 2 travels over the whole step from ``(xb, yb)`` to its landing point ``(L, 0)``
+    (``xb = -0.6 L``, ``yb = 0.1 m``: the swap of legs maps tip 1's end onto tip 2's start),
+    both on smooth arcs; torques by least squares as for the walk."""
+    use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
+    legs = biped_structure(model).legs
+    v, step, f = speed, step_length, stance_fraction
+    total = step / v
+    t1 = f * total
+    s_hip = v * t1
+    height = 0.97 * float(np.sqrt(max(r_max**2 - (s_hip / 2.0) ** 2, 1e-4)))
+    xb, yb, bump = -0.6 * step, 0.1, 0.05
+    phases = []
+    for name, (ta, tb), held in (("stance", (0.0, t1), [legs[0].contact]),
+                                 ("flight", (t1, total), [])):
+        t = np.linspace(ta, tb, _FINE)
+        p_hip = np.stack([-s_hip / 2.0 + v * t, np.full_like(t, height)], axis=1)
+        sig2 = _smoothstep(t / total)
+        tip2 = np.stack([xb + (step - xb) * sig2,
+                         yb * (1.0 - sig2) + bump * np.sin(np.pi * t / total)], axis=1)
+        if name == "stance":
+            tip1 = np.zeros_like(tip2)
+        else:
+            sig1 = _smoothstep((t - t1) / (total - t1))
+            tip1 = np.stack([(step + xb) * sig1,
+                             yb * sig1 + bump * np.sin(np.pi * (t - t1) / (total - t1))],
+                            axis=1)
+        q_fine = np.zeros((_FINE, model.nq))
+        q_fine[:, 0:2] = p_hip
+        for k in range(_FINE):
+            for leg, tip in ((legs[0], tip1[k]), (legs[1], tip2[k])):
+                joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),
+                                                0.0, 0.0)
+                q_fine[k, leg.hip_index] = float(joints.hip)
+                q_fine[k, leg.knee_index] = float(joints.knee)
+        count = knots[0] if name == "stance" else knots[1]
+        phases.append(_phase_guess(model, name, t, q_fine, _knots(ta, tb - ta, count), ankle,
+                                   use_ankles, held, True))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 

@@ -18,6 +18,7 @@ from gaitopt.units import format_speed
 
 Transcription = Literal["hermite-simpson", "trapezoidal"]
 Formulation = Literal["reduced", "full"]
+GaitKind = Literal["walk", "run"]
 FORMULATIONS: tuple[str, ...] = ("reduced", "full")
 
 
@@ -63,6 +64,10 @@ class GaitOptions:
             kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
             with the held contact points as constraints: any model with two legs; a knee may
             straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md.
+        gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
+            walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
+            ``single_support_fraction`` of the step, then flight; full formulation only, no
+            liftoff impulse).
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, and keep the lowest optimum (slower; a cold solve can
             otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
@@ -90,6 +95,7 @@ class GaitOptions:
     continuation: bool = True
     multistart: bool = False
     formulation: Formulation = "reduced"
+    gait: GaitKind = "walk"
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -160,6 +166,13 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
     if o.formulation not in FORMULATIONS:
         raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
                                f"{', '.join(FORMULATIONS)}")
+    if o.gait not in ("walk", "run"):
+        raise GaitOptionsError(f"gait = {o.gait!r}: must be 'walk' or 'run'")
+    if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0
+                            or o.impulse):
+        raise GaitOptionsError(
+            "gait = 'run': needs formulation 'full', single_support_fraction < 1 (the stance "
+            "share of the step) and impulse off (no liftoff impulse in a run)")
     flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
     if o.formulation == "full" and not 0.0 <= flex < 1.5:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in [0, 1.5) "

@@ -41,7 +41,13 @@ from typing import Any
 import numpy as np
 
 from gaitopt.gait.formulation import biped_of, problem_for, stage_bounds
-from gaitopt.gait.guess import WalkingGuess, default_step_length, naive_guess
+from gaitopt.gait.guess import (
+    WalkingGuess,
+    default_running_step,
+    default_step_length,
+    naive_guess,
+    naive_running_guess,
+)
 from gaitopt.gait.options import GaitOptions, validate_options
 from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
 from gaitopt.ocp import Bounds, Guess, PhaseGuess, Result, Transcription, transcribe
@@ -240,13 +246,20 @@ class _Run:
         elif o.step_time is not None:
             steps = [o.step_time * speed]
         else:
-            steps = [default_step_length(speed) * f for f in (1.0, 0.7, 1.4)]
+            default = default_running_step if o.gait == "run" else default_step_length
+            steps = [default(speed) * f for f in (1.0, 0.7, 1.4)]
         found: list[Result] = []
         for step0 in steps:
-            guess = naive_guess(self.model, speed=speed, step_length=step0,
-                                single_support_fraction=o.single_support_fraction,
-                                knots=coarse, ankle=o.ankle, r_max=r_max,
-                                ankle_torques=False, full=o.formulation == "full")
+            if o.gait == "run":
+                guess = naive_running_guess(
+                    self.model, speed=speed, step_length=step0,
+                    stance_fraction=o.single_support_fraction, knots=coarse, ankle=o.ankle,
+                    r_max=r_max, ankle_torques=False)
+            else:
+                guess = naive_guess(self.model, speed=speed, step_length=step0,
+                                    single_support_fraction=o.single_support_fraction,
+                                    knots=coarse, ankle=o.ankle, r_max=r_max,
+                                    ankle_torques=False, full=o.formulation == "full")
             relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
                                  hold_ankles=o.ankle, solver_options=COLD_START_OPTIONS)
             if not relaxed.success:
