@@ -48,6 +48,7 @@ from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.dynamics.impact import impact, liftoff_impulse
 from gaitopt.dynamics.kinematics import contact_jacobian, contact_position, contact_velocity
+from gaitopt.gait import cost
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, check_sequence
 from gaitopt.gait.options import GaitOptions
 from gaitopt.ocp.bounds import Bounds
@@ -330,8 +331,14 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         def dynamics(x: Any, u: Any, p: Any, t: Any, point: Any = point) -> Any:
             return point(x, u).xdot
 
-        def lagrange(x: Any, u: Any, p: Any, t: Any, n_act: int = len(acts)) -> Any:
-            return ca.sumsqr(u[:n_act]) if n_act else ca.SX(0.0)
+        def lagrange(x: Any, u: Any, p: Any, t: Any, acts: tuple[str, ...] = acts,
+                     n_u: int = len(controls)) -> Any:
+            n_act = len(acts)
+            if options.cost == "paper" and options.cost_regularization == 0.0:
+                return ca.sumsqr(u[:n_act]) if n_act else ca.SX(0.0)
+            qd = vector(as_scalars(x, 2 * nq, "x")[nq:])
+            u_act = as_scalars(u, n_u, "u")[:n_act] if n_act else []
+            return cost.running_cost(model, options, qd, full_controls(model, acts, u_act), p)
 
         control_bounds = {a: model.actuators[model.actuator_index(a)].limits for a in acts}
         control_bounds |= {n: (-PROJECTION_BOUND, PROJECTION_BOUND) for n in proj}
@@ -432,9 +439,32 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
                   Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
     return Problem(
         phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
-        parameter_cost=lambda p: p[_P] ** 2,
-        cost_denominator=lambda ends, p: p[_L],
-        objective_scale=1000.0)
+        parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
+        (lambda p: cost.parameter_cost(model, options, p)),
+        mayer=None if options.cost == "paper" else _impulse_cost(model, options, seq, split),
+        cost_denominator=lambda ends, p: cost.denominator(model, options, p),
+        objective_scale=cost.objective_scale(options))
+
+
+def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
+                  split: Callable[[Any], tuple[Any, Any]]) -> Callable[..., Any] | None:
+    """The Mayer term of the costs of transport: the liftoff impulse's work, if any."""
+    events = [i for i, ev in enumerate(seq.events) if ev.impulse]
+    if not events:
+        return None
+
+    def mayer(ends: Mapping[str, Any], p: Any) -> Any:
+        total: Any = 0.0
+        for i in events:
+            ev = seq.events[i]
+            q, qd = split(ends[seq.phases[i].name].xf)
+            jump = event_map(model, seq, i, q, qd, p[_P])
+            v_after = contact_velocity(model, q, jump.qd_after, ev.release[0])
+            total = total + cost.impulse_cost(model, options, jump.impulses[ev.release[0]],
+                                              v_after, p[_P])
+        return total
+
+    return mayer
 
 
 def _step_share(fraction: float) -> Callable[[Any], Any]:

@@ -19,6 +19,7 @@ from gaitopt.units import format_speed
 Transcription = Literal["hermite-simpson", "trapezoidal"]
 Formulation = Literal["reduced", "full"]
 GaitKind = Literal["walk", "run"]
+CostName = Literal["paper", "work", "metabolic"]
 FORMULATIONS: tuple[str, ...] = ("reduced", "full")
 
 
@@ -68,6 +69,14 @@ class GaitOptions:
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no
             liftoff impulse).
+        cost: ``"paper"`` (torque squared per metre), ``"work"`` (mechanical cost of
+            transport) or ``"metabolic"`` (with efficiencies and a resting power); formulas in
+            :mod:`gaitopt.gait.cost` and docs/costs.md.
+        efficiency_positive, efficiency_negative: muscle efficiencies of positive and negative
+            work (> 0; 0.25 and 1.2) of the metabolic cost.
+        resting_power: resting metabolic power (W/kg, >= 0) of the metabolic cost.
+        cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs.
+        cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, and keep the lowest optimum (slower; a cold solve can
             otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
@@ -96,6 +105,12 @@ class GaitOptions:
     multistart: bool = False
     formulation: Formulation = "reduced"
     gait: GaitKind = "walk"
+    cost: CostName = "paper"
+    efficiency_positive: float = 0.25
+    efficiency_negative: float = 1.2
+    resting_power: float = 1.2
+    cost_smoothing: float = 0.01
+    cost_regularization: float = 0.0
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -166,6 +181,16 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
     if o.formulation not in FORMULATIONS:
         raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
                                f"{', '.join(FORMULATIONS)}")
+    if o.cost not in ("paper", "work", "metabolic"):
+        raise GaitOptionsError(f"cost = {o.cost!r}: must be one of paper, work, metabolic")
+    for name, value, lo, strict in (("efficiency_positive", o.efficiency_positive, 0.0, True),
+                                    ("efficiency_negative", o.efficiency_negative, 0.0, True),
+                                    ("resting_power", o.resting_power, 0.0, False),
+                                    ("cost_smoothing", o.cost_smoothing, 0.0, True),
+                                    ("cost_regularization", o.cost_regularization, 0.0, False)):
+        v = _finite(name, value)
+        if v < lo or (strict and v == lo):
+            raise GaitOptionsError(f"{name} = {v:g}: must be {'>' if strict else '>='} {lo:g}")
     if o.gait not in ("walk", "run"):
         raise GaitOptionsError(f"gait = {o.gait!r}: must be 'walk' or 'run'")
     if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0

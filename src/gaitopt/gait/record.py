@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.kinematics import point_position
 from gaitopt.dynamics.reduced import checked_biped
-from gaitopt.gait import walking
+from gaitopt.gait import cost, walking
 from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution
@@ -29,8 +29,8 @@ from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
 
-COST_FORMULA = ("energy per metre (paper eq. 5): (integral over the step of u'u dt + "
-                "liftoff_impulse^2) / step_length, in N^2 m s (torques in N m, impulse in N s)")
+#: The paper's cost in words (the default cost; :mod:`gaitopt.gait.cost` has all of them).
+COST_FORMULA = cost.FORMULAS["paper"]
 #: Samples per second of step time in the dense grid (at least 101 samples per step).
 SAMPLE_RATE = 200.0
 
@@ -147,7 +147,8 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
         model_data=model.to_dict(), options=options.to_dict(),
         parameters={"step_length": step, "speed": speed, "step_time": step / speed,
                     "single_support_time": t1, "liftoff_impulse": impulse},
-        cost={"value": float(res.objective), "formula": COST_FORMULA},
+        cost={"value": float(res.objective), "name": options.cost,
+              "formula": cost.formula(options)},
         solver=solver, phases=phases, events=events, samples=samples)
 
 

@@ -33,6 +33,7 @@ and reused: speed, step length and impulse enter through parameter bounds only.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -59,6 +60,9 @@ REFERENCE_SPEED = 0.2
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
+#: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
+#: cost's optimum, when the requested one is finer.
+COST_SMOOTHING_START = 1.0
 #: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
 #: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
 #: the lower local optimum more often than the default monotone one: over 20 speeds with and
@@ -143,15 +147,20 @@ class WalkingSolution:
 _CACHE: dict[tuple[Any, ...], Transcription] = {}
 
 
+#: Options that enter a solve only through bounds or the solve's own logic, never the NLP's
+#: structure: problems that differ only in these share one transcription.
+BOUNDS_ONLY_OPTIONS = frozenset({"speed", "step_length", "step_time", "knots", "multistart",
+                                 "continuation"})
+
+
 def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, int],
                    compiled: str | None) -> tuple[Any, ...]:
-    o = options
-    return (model.content_hash(), o.formulation, o.ankle, o.single_support_fraction, tuple(knots),
-            o.step_time is not None,
-            o.transcription, o.periodic_controls, o.friction, o.unilateral_impulses,
-            o.min_stance_knee_flexion,
-            tuple(o.torso_bounds), o.rate_bound, o.max_impulse, o.tol, o.max_iter,
-            tuple(o.speed_bounds), tuple(o.step_length_bounds), compiled)
+    """Every option that shapes the NLP (all but :data:`BOUNDS_ONLY_OPTIONS`), the model,
+    the grid, whether a step-time row exists, and the compilation mode."""
+    shaping = sorted((k, repr(v)) for k, v in dataclasses.asdict(options).items()
+                     if k not in BOUNDS_ONLY_OPTIONS)
+    return (model.content_hash(), tuple(knots), options.step_time is not None, compiled,
+            tuple(shaping))
 
 
 def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int, int], *,
@@ -208,12 +217,14 @@ class _Run:
 
     def stage(self, name: str, knots: tuple[int, int], relax: Relaxation,
               guess: Guess | Result, bounds: dict[str, Any], *,
-              hold_ankles: bool = False, solver_options: dict[str, Any] | None = None
-              ) -> Result:
+              hold_ankles: bool = False, solver_options: dict[str, Any] | None = None,
+              problem: GaitOptions | None = None) -> Result:
         """Solve one stage; a Result guess also passes its multipliers to IPOPT.
         ``hold_ankles`` bounds the ankle torques to zero (the no-ankle gait);
-        ``solver_options`` are merged over the transcription's."""
-        tr = transcription_for(self.model, self.options, knots, compiled=self.compiled)
+        ``solver_options`` are merged over the transcription's; ``problem`` replaces the
+        run's options for this stage's NLP (another cost, say)."""
+        tr = transcription_for(self.model, problem or self.options, knots,
+                               compiled=self.compiled)
         start = time.perf_counter()
         nlp_bounds = with_step_time(stage_bounds(tr, relax, self.options), self.options)
         if hold_ankles:
@@ -332,6 +343,36 @@ class _Run:
                 return None
         return current
 
+    def other_cost(self) -> Result | None:
+        """A cost other than the paper's, by continuation: the whole solve with the paper's
+        cost first (its stages reported with the prefix ``paper cost:``), then the cost
+        asked for from that optimum, first with a coarse smoothing of the positive parts
+        (:data:`COST_SMOOTHING_START`) when it is finer. None if the paper solve fails."""
+        o = self.options
+        paper = o.replace(cost="paper", cost_regularization=0.0)
+
+        def report(stage: StageReport) -> None:
+            stage = dataclasses.replace(stage, name=f"paper cost: {stage.name}")
+            self.stages.append(stage)
+            if self.progress is not None:
+                self.progress(stage)
+
+        start = solve_walking(self.model, paper, progress=report, compiled=self.compiled)
+        if not start.success:
+            self.results.append(start.result)
+            return None
+        guess: Guess | Result = result_guess(start.result)
+        if o.cost != "paper" and o.cost_smoothing < COST_SMOOTHING_START:
+            smooth = o.replace(cost_smoothing=COST_SMOOTHING_START)
+            guess = self.stage(f"{o.cost} cost, eps {COST_SMOOTHING_START:g} W", o.knots,
+                               Relaxation(), guess, parameter_bounds(o),
+                               solver_options=PRIMAL_WARM_OPTIONS, problem=smooth)
+            if not guess.success:
+                return guess
+            guess = result_guess(guess)
+        return self.stage(f"{o.cost} cost", o.knots, Relaxation(), guess, parameter_bounds(o),
+                          solver_options=PRIMAL_WARM_OPTIONS)
+
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
         the last stage whose values are, marked failed."""
@@ -343,6 +384,13 @@ class _Run:
         return self.results[-1]
 
 
+def result_guess(result: Result) -> Guess:
+    """A result's knot values and parameters as a guess (values only, no multipliers)."""
+    phases = {ph.name: PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0]))
+              for ph in result.phases}
+    return Guess(phases=phases, parameters=dict(result.parameters))
+
+
 def best_of(results: Sequence[Result | None]) -> Result | None:
     """The converged result with the lowest objective (None if none converged)."""
     ok = [r for r in results if r is not None and r.success]
@@ -351,8 +399,6 @@ def best_of(results: Sequence[Result | None]) -> Result | None:
 
 def _as_failed(result: Result, failed: Result) -> Result:
     """``result``'s values with the failed stage's status (never reported as converged)."""
-    import dataclasses
-
     return dataclasses.replace(result, success=False, status=failed.status,
                                message=f"{failed.message} (values of an earlier stage)")
 
@@ -373,7 +419,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         if not result.success:
             result = None
     outcome: Result | None = result
-    if result is None:
+    if result is None and (options.cost != "paper" or options.cost_regularization > 0.0):
+        outcome = run.other_cost()
+        result = outcome if outcome is not None and outcome.success else None
+    elif result is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
         coarse = run.cold(speed, every_start=options.multistart)
         far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9
