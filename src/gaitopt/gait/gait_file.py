@@ -161,6 +161,9 @@ class GaitPhase:
     x: Array
     xdot: Array
     interpolation: Mapping[str, str] = field(default_factory=lambda: dict(DEFAULT_INTERPOLATION))
+    #: Optional (K-1,) per-interval error estimate of the transcription (relative, >= 0; see
+    #: :mod:`gaitopt.ocp.estimate`); ``None`` in files written before it existed.
+    error_estimate: Array | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -189,6 +192,11 @@ class GaitPhase:
             {c: _array(f"contact_forces.{c}", forces[c], (k, 2)) for c in self.contacts}))
         interp = _mapping("interpolation", self.interpolation, required=("states", "controls"))
         set_(self, "interpolation", MappingProxyType({str(a): str(b) for a, b in interp.items()}))
+        if self.error_estimate is not None:
+            est = _array("error_estimate", self.error_estimate, (k - 1,))
+            if np.any(est < 0.0):
+                raise _fail("error_estimate", "expected numbers >= 0")
+            set_(self, "error_estimate", est)
 
     @property
     def duration(self) -> float:
@@ -600,7 +608,8 @@ def _phase_to_dict(p: GaitPhase) -> dict[str, Any]:
             "qd": p.qd.tolist(), "qdd": p.qdd.tolist(), "u": p.u.tolist(),
             "contact_forces": {c: v.tolist() for c, v in p.contact_forces.items()},
             "state_names": list(p.state_names), "x": p.x.tolist(), "xdot": p.xdot.tolist(),
-            "interpolation": dict(p.interpolation)}
+            "interpolation": dict(p.interpolation),
+            **({} if p.error_estimate is None else {"error_estimate": p.error_estimate.tolist()})}
 
 
 def _dumps(value: Any, indent: int = 0) -> str:
