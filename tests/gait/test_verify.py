@@ -272,3 +272,34 @@ def test_verify_passes_on_the_fast_gait(solved: SolveFn) -> None:
     report = verify_gait(solved(FAST).gait)
     assert report.passed, [(c.id, c.value, c.where) for c in report.checks if not c.passed]
     assert report.check("samples.normal_force").value == 0.0
+
+
+# -- the ids are documented and used ------------------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_every_check_id_is_documented() -> None:
+    text = (ROOT / "docs" / "outputs.md").read_text(encoding="utf-8")
+    section = text.split("## 5. Verify", 1)[1]
+    documented = [line.split("`")[1] for line in section.splitlines()
+                  if line.startswith("| `")]
+    assert documented == list(CHECKS)
+
+
+def test_the_benchmark_looks_checks_up_by_known_ids() -> None:
+    """bench/gait_grid.py labels checks by id: a renamed or removed id fails here instead of
+    silently disabling a branch of the benchmark."""
+    import importlib.util
+    import sys
+
+    spec = importlib.util.spec_from_file_location("gait_grid", ROOT / "bench" / "gait_grid.py")
+    assert spec and spec.loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclass needs its module registered
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        del sys.modules[spec.name]
+    assert set(module.SHORT) <= set(CHECKS)
+    assert "samples.normal_force" in module.SHORT  # the force@strike branch's check

@@ -1,7 +1,7 @@
 """The gait file: one solved gait as a self-describing JSON document (``*.gait.json``).
 
-Format ``gaitopt.gait``, version 1 (``DESIGN.md`` section 2, field by field in
-``docs/outputs.md``). A :class:`Gait` holds one *step* of a symmetric periodic gait:
+Format ``gaitopt.gait``, version 1 (field by field in ``docs/outputs.md``; units, frames and the
+step in ``docs/conventions.md``). A :class:`Gait` holds one *step* of a symmetric periodic gait:
 
 * phase 1 (single support on leg 1, contact ``tip_1``) starts when leg 2 lifts off and ends
   when leg 2 strikes the ground at x = step length; phase 2 (double support) ends when leg 1
