@@ -33,7 +33,7 @@ from datetime import UTC, datetime
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,6 +41,11 @@ from numpy.typing import NDArray
 from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
 from gaitopt.robot import ModelError, RobotModel, model_from_dict
+
+if TYPE_CHECKING:  # for annotations only: no viz import at run time
+    from matplotlib.figure import Figure
+
+    from gaitopt.viz.notebook import GifAnimation
 
 FORMAT = "gaitopt.gait"
 VERSION = 1
@@ -447,6 +452,29 @@ class Gait:
             raise GaitFileError(source, f"line {exc.lineno}, column {exc.colno}",
                                 f"not valid JSON ({exc.msg})") from None
         return cls.from_dict(data, source=source)
+
+    # -- notebook use (gaitopt.viz.notebook, imported on first use) -------------------------
+    def _repr_html_(self) -> str:
+        """Jupyter's view: a table of speed, step length and time, cost, solver status, largest
+        violation and the verify verdict (:func:`gaitopt.viz.notebook.summary_html`)."""
+        from gaitopt.viz.notebook import summary_html
+
+        return summary_html(self)
+
+    def plot(self, kind: str = "overview") -> Figure:
+        """A Matplotlib figure: ``overview`` (angles, hip, torques over the step), ``torques``,
+        ``hip``, ``heights`` or ``poses`` (:func:`gaitopt.viz.notebook.gait_figure`)."""
+        from gaitopt.viz.notebook import gait_figure
+
+        return gait_figure(self, kind)
+
+    def animate(self, path: str | os.PathLike[str] | None = None, *, steps: int = 4,
+                fps: int = 30) -> Path | GifAnimation:
+        """``steps`` steps of the walk in real time: written to ``path`` (.gif or .mp4; returns
+        the path) or, without a path, an animated GIF that Jupyter shows inline."""
+        from gaitopt.viz.notebook import animate
+
+        return animate(self, path, steps=steps, fps=fps)
 
 
 # -- validation helpers ------------------------------------------------------------------------
