@@ -10,8 +10,8 @@ heel strike holds the pre-impact velocity: it belongs to the phase that ends the
   the same);
 * ``samples.controls``: the sample's ``u`` equals the phase's piecewise-linear controls at t;
 * ``samples.points``: each named point equals the forward kinematics of the sample's ``q``
-  (``hip``: the base origin; ``knee_i``: the origin of the link carrying tip i; ``tip_i``: the
-  contact point; ``torso_top``: the base link's far end);
+  (``hip``: the base origin; ``knee_i``: the origin of leg i's shank; ``tip_i``: leg i's
+  contact point; ``torso_top``: the base link's far end; leg 1 stands in the step);
 * ``samples.normal_force``: normal forces recomputed from the sample's ``q, qd, u`` with the
   phase's contacts held, negative part (between knots a coarse grid may dip a little);
 * ``bounds.*``: torques (samples) and joint limits (knots; samples, where the interpolant may
@@ -51,7 +51,7 @@ def phase_of_samples(gait: Gait) -> list[NDArray[np.bool_]]:
 @functools.lru_cache(maxsize=16)
 def points_function(model: RobotModel, names: tuple[str, ...]) -> ca.Function:
     """``q -> (2, len(names))`` world positions of the named sample points (see the module)."""
-    legs = {leg.contact[-2:]: leg for leg in biped_structure(model).legs}  # "_1", "_2"
+    legs = dict(zip(("_1", "_2"), biped_structure(model).legs, strict=True))  # leg 1, leg 2
     q = ca.SX.sym("q", model.nq)
     cols = []
     for name in names:
@@ -68,9 +68,9 @@ def points_function(model: RobotModel, names: tuple[str, ...]) -> ca.Function:
 
 
 def _known_points(gait: Gait) -> tuple[str, ...]:
-    legs = {leg.contact[-2:] for leg in biped_structure(gait.model).legs}
+    """The sample points this check knows (others are allowed and not checked)."""
     return tuple(n for n in gait.samples.points
-                 if n in ("hip", "torso_top") or (n[-2:] in legs and
+                 if n in ("hip", "torso_top") or (n[-2:] in ("_1", "_2") and
                                                   n[:-2] in ("knee", "tip")))
 
 
@@ -140,9 +140,7 @@ def _bound_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
         k = int(np.argmax(excess))
         between = between.update(excess[k], f"{joint.name} sample {k}")
     t1 = gait.parameters["single_support_time"]
-    swing_leg = biped_structure(model).legs[1].contact
-    tip = s.points[swing_leg] if swing_leg in s.points else s.points["tip_2"]
-    swing = tip[s.t <= s.t[0] + t1 + 1e-12, 1]
+    swing = s.points["tip_2"][s.t <= s.t[0] + t1 + 1e-12, 1]  # leg 2 swings in phase 1
     k = int(np.argmin(swing))
     return [Check("bounds.torque", max(0.0, torque.value), lim["bounds.torque"], torque.where),
             Check("bounds.joints_knots", max(0.0, knots.value), lim["bounds.joints_knots"],
