@@ -268,6 +268,19 @@ def test_fast_gait_forces_between_knots_are_non_negative(solved: SolveFn,
     assert {ph.name for ph in gait.phases} == {SINGLE, DOUBLE}
 
 
+def test_a_sample_a_rounding_error_after_the_heel_strike_is_in_double_support(
+        solved: SolveFn) -> None:
+    """At 54 m/min (ankle + impulse) a dense sample lies 6e-17 s after the heel strike: the
+    record evaluated it in double support (post-impact velocity), and verify must too."""
+    gait = solved(GaitOptions(speed=0.9)).gait
+    s, strike = gait.samples, gait.phases[0].t[-1]
+    k = int(np.argmin(np.abs(s.t - strike)))
+    assert 0.0 < s.t[k] - strike < 1e-12
+    np.testing.assert_allclose(s.qd[k], gait.events[0].qd_after, atol=1e-9)
+    report = verify_gait(gait)
+    assert report.passed, [(c.id, c.value, c.where) for c in report.checks if not c.passed]
+
+
 def test_verify_passes_on_the_fast_gait(solved: SolveFn) -> None:
     report = verify_gait(solved(FAST).gait)
     assert report.passed, [(c.id, c.value, c.where) for c in report.checks if not c.passed]

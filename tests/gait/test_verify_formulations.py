@@ -50,7 +50,7 @@ def full_coordinate_copy(gait: Gait) -> dict[str, Any]:
         raw["xdot"] = np.hstack([ph.qd, ph.qdd]).tolist()
         del raw["error_estimate"]  # the reduced grid's estimate; not one of these states
         full = GaitPhase(**{k: v for k, v in raw.items() if k != "error_estimate"})
-        mask = (s.t <= ph.t[-1] + 1e-12) & ~taken
+        mask = (s.t <= ph.t[-1]) & ~taken
         taken |= mask
         x = phase_states_at(full, s.t[mask])
         q_s[mask], qd_s[mask] = x[:, :gait.model.nq], x[:, gait.model.nq:]

@@ -1,7 +1,8 @@
 """Checks of the dense samples and of the constraints between knots.
 
-A sample at time t belongs to the first phase whose end is at or after t (the sample at a
-heel strike holds the pre-impact velocity: it belongs to the phase that ends there).
+A sample at time t belongs to the first phase whose last knot time is >= t, compared exactly
+(a sample at a heel strike holds the pre-impact velocity: it belongs to the phase that ends
+there; one a rounding error after it belongs to the next phase).
 
 * ``samples.states``: the sample's ``(q, qd)`` equal the full state
   (:func:`.knots.full_state_function`) of the phase's state interpolant at t (the file's
@@ -42,7 +43,7 @@ def phase_of_samples(gait: Gait) -> list[NDArray[np.bool_]]:
     t = gait.samples.t
     masks, taken = [], np.zeros(t.size, dtype=bool)
     for ph in gait.phases:
-        mask = (t <= ph.t[-1] + 1e-12) & ~taken
+        mask = (t <= ph.t[-1]) & ~taken  # exact: a sample a rounding error later is not
         masks.append(mask)
         taken |= mask
     return masks
