@@ -316,3 +316,16 @@ def test_the_benchmark_looks_checks_up_by_known_ids() -> None:
         del sys.modules[spec.name]
     assert set(module.SHORT) <= set(CHECKS)
     assert "samples.normal_force" in module.SHORT  # the force@strike branch's check
+
+
+def test_a_check_passes_only_within_its_limit() -> None:
+    from gaitopt.analysis.verify import Check
+
+    assert Check("eom.residual", 1e-7, 1e-6).passed
+    assert not Check("eom.residual", 2e-6, 1e-6).passed
+    assert not Check("eom.residual", float("nan"), 1e-6).passed  # NaN never passes
+    assert Check("integration.phase", 5.0, 0.05).passed  # information only
+    assert Check("integration.phase", 5.0, 0.05).limit_text.endswith("information)")
+    with pytest.raises(KeyError, match="unknown check id 'eom'"):
+        Check("eom", 0.0, 1.0)
+    assert Check("eom.residual", float("inf"), 1.0).to_dict()["value"] is None  # valid JSON
