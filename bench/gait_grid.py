@@ -8,8 +8,9 @@ pass rate, median and largest time per variant), with the load average before an
 machine is shared, so times are noisy. The first point of each variant also builds its NLP
 (a few seconds); the later points of the variant reuse it (the process-wide cache).
 
-Verify column: ``pass``, or the failed checks (``interval`` re-integration per interval,
-``limits`` joint limits between knots, ``force`` normal force on the dense samples,
+Verify column: ``pass``, or the failed checks, looked up by stable id (:data:`SHORT`:
+``interval`` re-integration per interval, ``limits`` joint limits between knots, ``force``
+normal force on the dense samples; other checks by their id),
 ``force@strike`` the force check failed only because of the dense sample at the heel-strike
 instant, the verify bug recorded in tests/gait/test_verify.py: recomputed with each sample in
 its own phase, no normal force is negative).
@@ -43,18 +44,20 @@ VARIANTS = {
     "plain": {"ankle": False, "impulse": False},
 }
 SPEEDS_M_MIN = tuple(range(3, 61, 3))
+#: Short labels of the verify checks by stable id (``gaitopt.analysis.verify.CHECKS``); a
+#: check without a label here is shown by its id.
 SHORT = {
-    "re-integration per interval": "interval",
-    "normal contact force (negative part)": "force",
-    "held tips on the ground": "tips",
-    "impact and liftoff maps": "events",
-    "periodicity of states (legs relabelled)": "periodic",
-    "periodicity of controls": "periodic-u",
-    "torque bounds (excess)": "torque",
-    "joint limits at knots (excess)": "limits@knots",
-    "joint limits between knots (excess)": "limits",
-    "swing tip above ground (penetration)": "clearance",
-    "cost recomputed from the controls (relative)": "cost",
+    "integration.interval": "interval",
+    "samples.normal_force": "force",
+    "contacts.position": "tips",
+    "events.maps": "events",
+    "events.periodicity": "periodic",
+    "events.periodic_controls": "periodic-u",
+    "bounds.torque": "torque",
+    "bounds.joints_knots": "limits@knots",
+    "bounds.joints_samples": "limits",
+    "swing.clearance": "clearance",
+    "cost.recomputed": "cost",
 }
 
 
@@ -83,12 +86,14 @@ def load_average() -> str:
 
 def verify_summary(gait: Gait) -> str:
     report = verify_gait(gait)
-    failed = [c.name for c in report.checks if not c.passed]
+    failed = report.failed_ids
     if not failed:
         return "pass"
     names = [SHORT.get(n, n) for n in failed]
-    if "force" in names and lowest_force_by_phase(gait) >= -LIMITS["force"]:
-        names[names.index("force")] = "force@strike"
+    weight = gait.model.total_mass * float(np.hypot(*gait.model.gravity))
+    if ("samples.normal_force" in failed
+            and lowest_force_by_phase(gait) >= -LIMITS["samples.normal_force"] * weight):
+        names[failed.index("samples.normal_force")] = "force@strike"
     return " ".join(names)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -198,26 +199,38 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
 @click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--tolerance", type=float, default=None,
               help="Scale every check's tolerance by this factor (default 1).")
-def verify_command(file: Path, tolerance: float | None) -> None:
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the report as JSON (checks by stable id) instead of a table.")
+def verify_command(file: Path, tolerance: float | None, as_json: bool) -> None:
     """Check a saved gait independently of the solver (exit status 1 if a check fails)."""
-    from gaitopt.analysis.verify import verify_gait
+    import json
 
+    from gaitopt.analysis.verify import UnknownStatesError, verify_gait
+
+    if tolerance is not None and not (math.isfinite(tolerance) and tolerance > 0):
+        raise UserError(f"--tolerance: got {tolerance:g}; allowed: a number > 0")
     console = make_console()
     try:
         gait = Gait.load(file)
-    except GaitFileError as exc:
+        report = verify_gait(gait, tolerance_scale=tolerance or 1.0)
+    except (GaitFileError, UnknownStatesError) as exc:
         raise UserError(str(exc)) from None
-    report = verify_gait(gait, tolerance_scale=tolerance or 1.0)
+    if as_json:
+        click.echo(json.dumps({"file": str(file), **report.to_dict()}, indent=1))
+        if not report.passed:
+            sys.exit(1)
+        return
     table = Table(title=f"verify {file}")
-    for col in ("check", "value", "limit", "result"):
+    for col in ("id", "check", "value", "limit", "result", "worst at"):
         table.add_column(col)
     for c in report.checks:
-        table.add_row(c.name, f"{c.value:.3g}", c.limit_text, "ok" if c.passed else "FAIL")
+        table.add_row(c.id, c.name, f"{c.value:.3g}", c.limit_text, "ok" if c.passed else "FAIL",
+                      c.where)
     console.print(table)
     if report.passed:
         console.print(f"all {len(report.checks)} checks passed")
     else:
-        failed = [c.name for c in report.checks if not c.passed]
+        failed = report.failed_ids
         console.print(f"{len(failed)} check(s) FAILED: {', '.join(failed)}")
         sys.exit(1)
 

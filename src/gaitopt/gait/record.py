@@ -117,7 +117,8 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
         phases.append(GaitPhase(
             name=name, contacts=contacts, t=ph.t, q=q, qd=qd, qdd=qdd, u=u_full,
             contact_forces={c: forces[:, 2 * i:2 * i + 2] for i, c in enumerate(contacts)},
-            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot))
+            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot,
+            error_estimate=ph.error if np.all(np.isfinite(ph.error)) else None))
     events = _events(model, options, traj, step, impulse)
     samples = _samples(model, options, res, step)
     return _gait(solution, tuple(phases), events, samples)
