@@ -93,6 +93,18 @@ def _knots(text: str) -> tuple[int, int]:
 @click.option("--min-knee-flexion", type=float, default=None,
               help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
                    "stance knee straighten, with --formulation full].")
+@click.option("--gait", "gait_kind", type=click.Choice(["walk", "run"]), default="walk",
+              show_default=True, help="The contact sequence: walk, or run (stance then flight; "
+                                      "needs --formulation full --no-impulse).")
+@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
+              show_default=True,
+              help="paper: torque squared per metre; work: mechanical cost of transport; "
+                   "metabolic: positive/negative work efficiencies and a resting power "
+                   "(docs/costs.md).")
+@click.option("--resting-power", type=float, default=None,
+              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
+@click.option("--regularization", type=float, default=0.0, show_default=True,
+              help="Weight of an added mean squared torque (u / u_max)^2 term.")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("--multistart", is_flag=True,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "
@@ -107,7 +119,9 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str,
-                  min_knee_flexion: float | None, compiled: bool, multistart: bool,
+                  min_knee_flexion: float | None, gait_kind: str, cost: str,
+                  resting_power: float | None, regularization: float, compiled: bool,
+                  multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
@@ -129,7 +143,11 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
-        formulation=formulation)  # type: ignore[arg-type]
+        formulation=formulation,  # type: ignore[arg-type]
+        gait=gait_kind, cost=cost,  # type: ignore[arg-type]
+        cost_regularization=regularization)
+    if resting_power is not None:
+        options = options.replace(resting_power=resting_power)
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     console.print(f"solving {options.variant} on model {model.name}: speed "
@@ -175,7 +193,11 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     table.add_row("step time", f"{p['step_time']:.4f} s (single support "
                   f"{p['single_support_time']:.4f} s)")
     table.add_row("liftoff impulse", f"{p['liftoff_impulse']:.4f} N s")
-    table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
+    if gait.options.get("cost", "paper") == "paper":
+        table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
+    else:
+        table.add_row(f"cost ({gait.options['cost']} cost of transport)",
+                      f"{gait.cost_value:.6g} (dimensionless)")
     for name, peak in metrics.peak_torques.items():
         bound = metrics.torque_bounds[name]
         table.add_row(f"peak torque {name}", f"{peak:8.2f} / {bound:g} N m "

@@ -17,8 +17,9 @@ The checks (stable ids, see :data:`CHECKS` and ``docs/outputs.md``, section "Ver
   periodicity with the legs relabelled;
 * the dense samples (:mod:`.checks.samples`): on the phases' interpolants, points at the
   kinematics, normal forces between knots, torque bounds, joint limits, swing clearance;
-* the cost recomputed from the controls: the exact integral of the squared piecewise-linear
-  controls plus the impulse squared, over the step length.
+* the cost recomputed from the file (:func:`gaitopt.gait.cost.recompute_cost`): for the
+  paper's cost the exact integral of the squared piecewise-linear controls plus the impulse
+  squared, over the step length; the costs of transport by the transcription's quadrature.
 
 What the transcription imposes exactly (knots, events, periodicity, cost) is checked to about
 1e-6 (relative where it says so); what it cannot impose between knots against the accuracy of
@@ -91,13 +92,9 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
 
 
 def _cost_check(gait: Gait, lim: dict[str, float]) -> Check:
-    total = 0.0
-    for ph in gait.phases:
-        h = np.diff(ph.t)
-        a, b = ph.u[:-1], ph.u[1:]
-        total += float(np.sum(h[:, None] * (a * a + a * b + b * b) / 3.0))
-    p = gait.parameters["liftoff_impulse"]
-    cost = (total + p * p) / gait.parameters["step_length"]
+    from gaitopt.gait.cost import recompute_cost
+
+    cost = recompute_cost(gait)
     saved = gait.cost_value
     rel = abs(cost - saved) / max(abs(saved), 1e-12)
     # The trapezoidal transcription integrates u'u by the trapezoidal rule, not exactly.

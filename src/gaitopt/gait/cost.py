@@ -147,3 +147,57 @@ def denominator(model: RobotModel, options: GaitOptions, p: Any) -> Scalar:
 def objective_scale(options: GaitOptions) -> float:
     """The NLP minimises ``J / objective_scale``: about the size of the optimum."""
     return 1000.0 if options.cost == "paper" else 0.1
+
+
+def recompute_cost(gait: Any) -> float:
+    """The cost of a saved gait from its file alone, as the transcription defines it:
+    Simpson's rule per interval on the knots and the interval midpoints (states from the
+    phase's cubic Hermite interpolant, controls linear), plus the impulse and resting terms,
+    over the denominator. For the paper's cost this is the exact integral of the squared
+    piecewise-linear torques."""
+    import numpy as np
+
+    from gaitopt.dynamics.kinematics import contact_velocity
+    from gaitopt.gait import walking
+    from gaitopt.gait.gait_file import phase_states_at
+
+    model = gait.model
+    options = GaitOptions.from_dict(dict(gait.options))
+    nq = model.nq
+    step, speed = gait.parameters["step_length"], gait.parameters["speed"]
+    p = [step, speed, gait.parameters["liftoff_impulse"]]
+    total = 0.0
+    for ph in gait.phases:
+        t_mid = 0.5 * (ph.t[:-1] + ph.t[1:])
+        x_mid = phase_states_at(ph, t_mid)
+        full = tuple(ph.state_names) == tuple(model.coordinate_names) + tuple(
+            f"{n}_rate" for n in model.coordinate_names)
+        for k in range(ph.t.size - 1):
+            if full:
+                qd_mid = x_mid[k, nq:]
+            elif ph.name == walking.SINGLE:
+                qd_mid = np.asarray(walking.single_support_to_full(model, x_mid[k])[1], float)
+            else:
+                from gaitopt.dynamics.reduced import double_support_state
+
+                z, zd = walking.split_state(x_mid[k], len(ph.state_names) // 2)
+                qd_mid = np.asarray(double_support_state(model, 0, z, zd, walking.ORIGIN,
+                                                         (step, 0.0))[1], float)
+            values = [running_cost(model, options, ph.qd[k], list(ph.u[k]), p),
+                      running_cost(model, options, qd_mid, list(0.5 * (ph.u[k] + ph.u[k + 1])),
+                                   p),
+                      running_cost(model, options, ph.qd[k + 1], list(ph.u[k + 1]), p)]
+            h = ph.t[k + 1] - ph.t[k]
+            total += h / 6.0 * (values[0] + 4.0 * values[1] + values[2])
+    impulse = p[2]
+    if options.cost == "paper":
+        total += impulse * impulse
+    else:
+        for ev in gait.events:
+            lift = ev.impulses.get(ev.leg)
+            if ev.name == "liftoff" and lift is not None and impulse > 0.0:
+                phase = next(ph for ph in gait.phases if abs(ph.t[-1] - ev.t) < 1e-12)
+                v_after = contact_velocity(model, phase.q[-1], ev.qd_after, ev.leg)
+                total += impulse_cost(model, options, lift, v_after, impulse)
+        total += parameter_cost(model, options, p)
+    return float(total / denominator(model, options, p))
