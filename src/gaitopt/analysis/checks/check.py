@@ -36,7 +36,8 @@ _SPECS = (
               "body weight)", "", 1e-6),
     CheckSpec("contacts.friction", "friction cone (excess at knots and events)", "N|N s", 1e-3),
     CheckSpec("states.values", "phase states x equal to those of q, qd", "m|rad|m/s|rad/s", 1e-8),
-    CheckSpec("states.rates", "phase state rates xdot equal to those of qd, qdd",
+    CheckSpec("states.rates", "phase state rates xdot equal to those of qd, qdd (full "
+              "coordinates: up to the projection along the held points' normals)",
               "m/s|rad/s|m/s^2|rad/s^2", 1e-6),
     CheckSpec("parameters.consistency", "parameters agree with the phases and events "
               "(relative)", "", 1e-9),
