@@ -10,7 +10,7 @@ from rich.table import Table
 
 from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError
 from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
@@ -75,7 +75,7 @@ def _knots(text: str) -> tuple[int, int]:
               help="Single-support fraction of the step time; 1 = no double support.")
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
-@click.option("--transcription", type=click.Choice(["hermite-simpson", "trapezoidal"]),
+@click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
               default="hermite-simpson", show_default=True)
 @click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,
               help="Controls periodic as well as states (the paper), or states only.")

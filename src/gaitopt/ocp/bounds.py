@@ -52,7 +52,9 @@ class Bounds:
 
     def with_state(self, phase: str, name: str, lower: float, upper: float | None = None,
                    knot: int | None = None) -> Bounds:
-        """Bound state ``name`` of ``phase`` at one knot or (``knot=None``) at all knots."""
+        """Bound state ``name`` of ``phase`` at one knot or (``knot=None``) at all knots.
+        Midpoint states (separated Hermite-Simpson) stay unbounded, as the compressed form's
+        midpoints, which are no variables."""
         lo, hi = _pair(lower, upper, f"phase {phase!r} state {name!r}")
         pl = self.layout.phase(phase)
         idx = pl.across_knots("state", name) if knot is None else pl.index("state", name, knot)
@@ -100,6 +102,9 @@ def describe(layout: Layout, index: int) -> str:
     for pl in layout.phases:
         if pl.duration_index == index:
             return f"phase {pl.name!r} duration"
+        if pl.midpoint_start <= index < pl.end:
+            k, j = divmod(index - pl.midpoint_start, len(pl.states))
+            return f"phase {pl.name!r} state {pl.states[j]!r} midpoint {k}"
         if pl.start <= index < pl.end:
             k, j = divmod(index - pl.start, pl.stride)
             if j < len(pl.states):
@@ -109,7 +114,12 @@ def describe(layout: Layout, index: int) -> str:
 
 
 def variable_bounds(problem: Problem, layout: Layout) -> tuple[Array, Array]:
-    """Default ``(lbw, ubw)`` from the statement: path bounds, then end-knot bounds on top."""
+    """Default ``(lbw, ubw)`` from the statement: path bounds, then end-knot bounds on top.
+
+    Box bounds hold at the knots only, in every method: the midpoint states of the separated
+    Hermite-Simpson form are unbounded like the compressed form's midpoints (which are no
+    variables), so both forms have the same feasible set and optimum. Impose a bound between
+    knots with a :class:`~gaitopt.ocp.problem.PathConstraint` (at knots and midpoints)."""
     lbw, ubw = np.full(layout.size, -math.inf), np.full(layout.size, math.inf)
     for ph, pl in zip(problem.phases, layout.phases, strict=True):
         where = f"phase {ph.name!r}"
