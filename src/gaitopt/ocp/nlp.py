@@ -7,8 +7,8 @@ phase's point function is mapped over the K knots (and, when needed, over the N 
 the path constraints and the quadrature of the Lagrange integrand. For a method with midpoint
 variables (separated Hermite-Simpson) the midpoint state is the variable ``x_m``, the point
 function is mapped once over the K + N points, and the midpoint defects
-``x_m - midpoint_state(x_k, x_{k+1}, f_k, f_{k+1}, h)`` are added after the defects. The ends function adds the
-linkages, boundary constraints and the end/parameter costs::
+``x_m - midpoint_state(x_k, x_{k+1}, f_k, f_{k+1}, h)`` are added after the defects. The
+ends function adds the linkages, boundary constraints and the end/parameter costs::
 
     J = (sum_i quad_i(L_i) + M(ends, p) + P(p)) / D(ends, p)
 
