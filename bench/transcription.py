@@ -21,7 +21,9 @@ fresh worker processes of this run (so each starts with empty CasADi and NLP cac
 
 The last column is the ratio separated / compressed (< 1: the separated form is faster).
 
-Run: ``python bench/transcription.py [--grids 8,5 40,10] [--repeat 3]``
+Run: ``python bench/transcription.py [--grids 8,5 40,10] [--repeat 3]``, or
+``python bench/transcription.py --costs 8,5 16,6 40,10 80,20`` for the cold solves of both
+forms on each grid only (cost J and step length: the two forms' optima agree on every grid).
 """
 
 from __future__ import annotations
@@ -166,11 +168,35 @@ def table(results: dict[tuple[str, tuple[int, int], str], dict[str, Any]],
     return "\n".join(lines)
 
 
+def cost_table(grids: list[str]) -> dict[tuple[str, tuple[int, int], str], Any]:
+    """Cold solves of both forms on each grid (fresh processes): cost and step length."""
+    results: dict[tuple[str, tuple[int, int], str], Any] = {}
+    lines = ["| grid | form | converged | cost J | step length (m) | IPOPT iterations | "
+             "wall (s) |", "|:---|:---|:---|---:|---:|---:|---:|"]
+    for g in grids:
+        knots = (int(g.split(",")[0]), int(g.split(",")[1]))
+        for form in FORMS:
+            r = run_worker(["cold", form, g])
+            results[(form, knots, "cold")] = r
+            line = (f"| {knots[0]}+{knots[1]} | {form} | {'yes' if r['success'] else 'NO'} | "
+                    f"{r['cost']:.6f} | {r['step_length']:.6f} | {r['iterations']} | "
+                    f"{r['wall']:.2f} |")
+            print(line, flush=True)
+            lines.append(line)
+    print()
+    print("\n".join(lines))
+    print(f"\nload average after: {load_average()}")
+    return results
+
+
 def main(argv: list[str] | None = None) -> dict[tuple[str, tuple[int, int], str], Any]:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--grids", nargs="+", default=["8,5", "40,10"],
                         help="knots per phase, single,double")
     parser.add_argument("--repeat", type=int, default=3, help="best of N warm solves")
+    parser.add_argument("--costs", nargs="+", metavar="GRID",
+                        help="instead: only the cold solves of both forms on these grids, as a "
+                             "table of cost and step length (e.g. 8,5 16,6 40,10 80,20)")
     parser.add_argument("--worker", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
@@ -184,6 +210,8 @@ def main(argv: list[str] | None = None) -> dict[tuple[str, tuple[int, int], str]
         return {}
     grids = [(int(g.split(",")[0]), int(g.split(",")[1])) for g in args.grids]
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
+    if args.costs:
+        return cost_table(args.costs)
     results: dict[tuple[str, tuple[int, int], str], Any] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for knots in grids:
