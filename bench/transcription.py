@@ -66,7 +66,7 @@ def worker_cold(form: str, knots: tuple[int, int], exact_fine: bool, out: str) -
     r = sol.result
     return {"wall": wall, "success": sol.success, "stages": len(sol.stages),
             "iterations": sum(s.iterations for s in sol.stages), "cost": r.objective,
-            "step_length": r.parameters["step_length"],
+            "step_length": r.parameters["step_length"], "errors": r.errors_by_phase(),
             "fine_iterations": sum(s.iterations for s in sol.stages if s.knots == knots)
             if knots != (8, 5) else None}
 
@@ -169,17 +169,21 @@ def table(results: dict[tuple[str, tuple[int, int], str], dict[str, Any]],
 
 
 def cost_table(grids: list[str]) -> dict[tuple[str, tuple[int, int], str], Any]:
-    """Cold solves of both forms on each grid (fresh processes): cost and step length."""
+    """Cold solves of both forms on each grid (fresh processes): cost, step length and the
+    largest interval error estimate of each phase (``Result.errors_by_phase``)."""
     results: dict[tuple[str, tuple[int, int], str], Any] = {}
-    lines = ["| grid | form | converged | cost J | step length (m) | IPOPT iterations | "
-             "wall (s) |", "|:---|:---|:---|---:|---:|---:|---:|"]
+    lines = ["| grid | form | converged | cost J | step length (m) | largest interval error "
+             "by phase | IPOPT iterations | wall (s) |",
+             "|:---|:---|:---|---:|---:|:---|---:|---:|"]
     for g in grids:
         knots = (int(g.split(",")[0]), int(g.split(",")[1]))
         for form in FORMS:
             r = run_worker(["cold", form, g])
             results[(form, knots, "cold")] = r
             line = (f"| {knots[0]}+{knots[1]} | {form} | {'yes' if r['success'] else 'NO'} | "
-                    f"{r['cost']:.6f} | {r['step_length']:.6f} | {r['iterations']} | "
+                    f"{r['cost']:.6f} | {r['step_length']:.6f} | "
+                    f"{', '.join(f'{k} {v:.1e}' for k, v in r['errors'].items())} | "
+                    f"{r['iterations']} | "
                     f"{r['wall']:.2f} |")
             print(line, flush=True)
             lines.append(line)
