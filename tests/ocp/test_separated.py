@@ -61,12 +61,49 @@ def test_constraint_blocks_and_nlp_size_add_one_midpoint_defect_per_state_and_in
     assert a.variables == b.variables + extra
     assert a.equality_constraints == b.equality_constraints + extra
     assert a.inequality_constraints == b.inequality_constraints
-    # Box bounds hold at the knots only: the midpoint states are free (as the compressed
-    # form's midpoints, which are no variables), even after a whole-phase state bound.
-    bounds = sep.bounds().with_state("first", "v", -3.0, 3.0)
-    idx = sep.layout.phase("first").midpoint_indices()
-    assert np.all(np.isinf(bounds.lbw[idx])) and np.all(np.isinf(bounds.ubw[idx]))
-    assert a.box_bounded_variables == b.box_bounded_variables
+
+
+def test_state_bounds_hold_at_the_midpoints_unless_midpoint_bounds_is_off() -> None:
+    bounded = transcribe(P.periodic_ratio(intervals=4), method=SEPARATED)
+    free = transcribe(P.periodic_ratio(intervals=4), method=SEPARATED, midpoint_bounds=False)
+    com = transcribe(P.periodic_ratio(intervals=4))
+    s_bound = P.periodic_ratio().phases[0].state_bounds["v"]
+    for phase in ("first", "second"):
+        pl = bounded.layout.phase(phase)
+        v_mid, v_knots = pl.across_midpoints("v"), pl.across_knots("state", "v")
+        assert np.all(bounded.bounds().lbw[v_mid] == s_bound[0])
+        assert np.all(bounded.bounds().ubw[v_mid] == s_bound[1])
+        assert np.all(np.isinf(free.bounds().lbw[v_mid]))
+        # Initial/final knot bounds stay at the knots.
+        np.testing.assert_array_equal(free.bounds().lbw[v_knots], bounded.bounds().lbw[v_knots])
+    # A whole-phase bound follows the same rule; a bound at one knot touches no midpoint.
+    idx = free.layout.phase("first").midpoint_indices()[:, 1]
+    assert np.all(np.isinf(free.bounds().with_state("first", "v", -3.0, 3.0).lbw[idx]))
+    assert np.all(bounded.bounds().with_state("first", "v", -3.0, 3.0).lbw[idx] == -3.0)
+    assert np.all(bounded.bounds().with_state("first", "v", -3.0, 3.0, knot=2).lbw[idx]
+                  == s_bound[0])
+    assert free.nlp_size().box_bounded_variables == com.nlp_size().box_bounded_variables
+    assert bounded.nlp_size().box_bounded_variables == (
+        com.nlp_size().box_bounded_variables + 2 * 4)  # v bounded at 4 midpoints, 2 phases
+
+
+def test_midpoint_bounds_keep_the_interpolated_state_within_its_bounds() -> None:
+    """A state bound active between knots only: on 3 intervals the rest-to-rest speed
+    v = 6t - 6t^2 is 4/3 at the knots and 1.5 at the middle midpoint, above the bound 1.45.
+    With midpoint bounds the cubic Hermite state respects it at the midpoints; the compressed
+    form (and midpoint_bounds=False) only at the knots, with a lower cost (J = 12)."""
+    problem = P.with_state_bound(3, 1.45)
+    com = transcribe(problem).solve()
+    free = transcribe(problem, method=SEPARATED, midpoint_bounds=False).solve()
+    bounded = transcribe(problem, method=SEPARATED).solve()
+    assert com.success and free.success and bounded.success
+    assert free.objective == pytest.approx(com.objective, rel=1e-8)
+    mid = midpoints(com)
+    assert com.objective == pytest.approx(12.0, rel=1e-9)
+    assert com.phase(0).x_at(mid)[1, 1] == pytest.approx(1.5, abs=1e-9)
+    assert bounded.phase(0).x_at(mid)[:, 1].max() == pytest.approx(1.45, abs=1e-7)
+    assert bounded.phase(0).x_mid[:, 1].max() == pytest.approx(1.45, abs=1e-7)  # type: ignore[index]
+    assert bounded.objective > com.objective + 1e-3
 
 
 @pytest.mark.parametrize(("problem", "guess"), [
@@ -81,7 +118,7 @@ def test_both_forms_reach_the_same_optimum_on_the_same_mesh(problem, guess) -> N
     agree to the solver's tolerance on every mesh, coarse or fine: objective, knot values,
     interval error estimates."""
     com = transcribe(problem(), method=COMPRESSED).solve(guess())
-    sep = transcribe(problem(), method=SEPARATED).solve(guess())
+    sep = transcribe(problem(), method=SEPARATED, midpoint_bounds=False).solve(guess())
     assert com.success and sep.success, (com.summary(), sep.summary())
     assert sep.objective == pytest.approx(com.objective, rel=1e-8, abs=1e-10)
     for a, b in zip(com.phases, sep.phases, strict=True):

@@ -1,8 +1,10 @@
 """The walking problem (the engine's largest user) with both Hermite-Simpson forms.
 
-The separated form must converge where the compressed one does and reach the same optimum:
-eliminating its midpoint states gives the compressed NLP back, so on every grid the costs agree
-to the solver's tolerance (docs/benchmarks-gait.md has the table at 8+5 ... 80+20 knots).
+The separated form must converge where the compressed one does. Without midpoint bounds it is
+the compressed NLP with the midpoint states as variables (the same optimum); with them (the
+default) its states also respect their bounds at the midpoints, which costs a little on a
+coarse grid, and the costs of the two forms converge to the same limit as the grid is refined
+(docs/benchmarks-gait.md has the table at 8+5 ... 80+20 knots).
 """
 
 from __future__ import annotations
@@ -13,13 +15,22 @@ from click.testing import CliRunner
 
 from gaitopt.cli import cli
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.problem import parameter_bounds
+from gaitopt.gait.problem import (
+    Relaxation,
+    parameter_bounds,
+    relaxed_bounds,
+    walking_problem,
+    with_step_time,
+)
 from gaitopt.gait.solve import WalkingSolution, solve_walking, transcription_for
+from gaitopt.ocp import transcribe
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import biped_structure
 
 SEPARATED = "hermite-simpson-separated"
 MODEL = load_model("five-link")
+#: Largest relative cost difference of the two forms at 40 + 10 knots (measured: see docs).
+FINE_GAP = 2e-3
 
 
 def walk(knots: tuple[int, int], form: str, **changes: object) -> WalkingSolution:
@@ -40,39 +51,56 @@ def test_options_and_cli_accept_the_separated_form_and_name_the_choices() -> Non
 
 
 @pytest.mark.slow
-def test_separated_walk_at_8_plus_5_converges_to_a_point_of_the_compressed_nlp() -> None:
-    """The separated optimum's knots, put into the compressed form's NLP (built, not
-    solved), satisfy its constraints and give the same cost: the same discretisation."""
+def test_separated_walk_at_8_plus_5_respects_the_state_bounds_between_knots() -> None:
     sep = walk((8, 5), SEPARATED)
     assert sep.success, [s.line() for s in sep.stages]
     res = sep.result
     assert res.method == SEPARATED
-    options = sep.options.replace(transcription="hermite-simpson")
-    tr = transcription_for(MODEL, options, (8, 5))
-    w = tr.initial_guess(res)
-    g, num, den, _ = (np.asarray(v, dtype=float).ravel() for v in tr.nlp.evaluate(w))
-    b = tr.bounds()
-    for name, (lo, hi) in parameter_bounds(options).items():
-        b = b.with_parameter(name, lo, hi)
-    scale = tr.nlp.d_g
-    violation = np.max(np.maximum(b.lbg - g, g - b.ubg) / scale)
-    assert violation < 1e-6
-    assert float(num[0] / den[0]) == pytest.approx(res.objective, rel=1e-9)
-    # The midpoint variables are the compressed form's cubic Hermite midpoints.
-    for ph in res.phases:
+    problem = transcription_for(MODEL, sep.options, (8, 5)).problem
+    for ph, spec in zip(res.phases, problem.phases, strict=True):
         assert ph.x_mid is not None
-        mid = 0.5 * (ph.t[:-1] + ph.t[1:])
-        np.testing.assert_allclose(ph.x_mid, ph.x_at(mid), atol=1e-6)
+        # The midpoint variables are the cubic Hermite midpoints of the knots ...
+        np.testing.assert_allclose(ph.x_mid, ph.x_at(0.5 * (ph.t[:-1] + ph.t[1:])), atol=1e-6)
+        # ... and they respect the state bounds (the compressed optimum's swing knee does not).
+        for name, (lo, hi) in spec.state_bounds.items():
+            j = ph.states.index(name)
+            assert np.all(ph.x_mid[:, j] >= lo - 1e-7) and np.all(ph.x_mid[:, j] <= hi + 1e-7)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("knots", [(8, 5), (40, 10)])
-def test_both_forms_reach_the_same_walking_optimum(knots: tuple[int, int]) -> None:
-    com, sep = walk(knots, "hermite-simpson"), walk(knots, SEPARATED)
-    assert com.success and sep.success
-    assert sep.result.objective == pytest.approx(com.result.objective, rel=1e-6)
-    assert sep.result.parameters["step_length"] == pytest.approx(
-        com.result.parameters["step_length"], rel=1e-5)
+def test_without_midpoint_bounds_the_separated_nlp_has_the_compressed_optimum() -> None:
+    """``midpoint_bounds=False``: eliminating the midpoint states gives the compressed NLP, so
+    the compressed optimum (knots and Hermite midpoints) is optimal for it too."""
+    com = walk((8, 5), "hermite-simpson")
+    assert com.success
+    options = com.options.replace(transcription=SEPARATED)
+    problem = walking_problem(MODEL, options)
+    tr = transcribe(problem, method=SEPARATED, midpoint_bounds=False,
+                    intervals={problem.phases[0].name: 7, problem.phases[1].name: 4},
+                    options={"ipopt.tol": options.tol})
+    bounds = with_step_time(relaxed_bounds(tr, Relaxation()), options)
+    res = tr.solve(com.result, bounds=bounds, parameters=parameter_bounds(options))
+    assert res.success, res.summary()
+    assert res.iterations <= 15
+    assert res.objective == pytest.approx(com.result.objective, rel=1e-7)
+    for a, b in zip(com.result.phases, res.phases, strict=True):
+        np.testing.assert_allclose(b.x, a.x, atol=1e-4)
+
+
+@pytest.mark.slow
+def test_both_forms_converge_to_the_same_fine_grid_cost() -> None:
+    """With midpoint bounds the separated form is more constrained on a coarse grid (its
+    states respect their bounds between knots), so it costs a little more; the difference
+    vanishes as the grid is refined (docs/benchmarks-gait.md: 8+5 ... 80+20 knots)."""
+    gaps = []
+    for knots in ((8, 5), (40, 10)):
+        com, sep = walk(knots, "hermite-simpson"), walk(knots, SEPARATED)
+        assert com.success and sep.success
+        gap = sep.result.objective / com.result.objective - 1.0
+        assert gap > -1e-6  # never cheaper: a subset of the compressed feasible set
+        gaps.append(gap)
+    assert gaps[1] < 0.2 * gaps[0]
+    assert gaps[1] < FINE_GAP
 
 
 @pytest.mark.slow
