@@ -14,9 +14,12 @@ constraint row touches one dynamics evaluation per grid point, never ``f`` of an
 containing ``f``: the exact Hessian of the Lagrangian is a sum of one small block per knot and
 per midpoint instead of the dense composition of the compressed form.
 
-Eliminating ``x_m`` with the midpoint defect gives back the compressed NLP, so both forms have
-the same optimum on every mesh (the same objective, the same knot values); they differ in the
-number of variables and constraints (n N more of each) and in the cost of the derivatives.
+The midpoint states take the path state bounds by default (``transcribe(...,
+midpoint_bounds=True)``), so the states respect them between knots too. Without those bounds,
+eliminating ``x_m`` with the midpoint defect gives back the compressed NLP, and both forms have
+the same optimum on every mesh (the same objective, the same knot values); with them, the
+optima differ only where a state bound would be violated between knots, by an amount that
+vanishes as the mesh is refined. The NLP has n N more variables and equality constraints.
 """
 
 from __future__ import annotations
