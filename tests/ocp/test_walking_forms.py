@@ -22,7 +22,12 @@ from gaitopt.gait.problem import (
     walking_problem,
     with_step_time,
 )
-from gaitopt.gait.solve import WalkingSolution, solve_walking, transcription_for
+from gaitopt.gait.solve import (
+    PRIMAL_WARM_OPTIONS,
+    WalkingSolution,
+    solve_walking,
+    transcription_for,
+)
 from gaitopt.ocp import transcribe
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import biped_structure
@@ -80,10 +85,12 @@ def test_without_midpoint_bounds_the_separated_nlp_has_the_compressed_optimum() 
                     intervals={problem.phases[0].name: 7, problem.phases[1].name: 4},
                     options={"ipopt.tol": options.tol})
     bounds = with_step_time(relaxed_bounds(tr, Relaxation()), options)
-    res = tr.solve(com.result, bounds=bounds, parameters=parameter_bounds(options))
+    # Started from the values only (the multipliers belong to another layout), with a small
+    # barrier as the walking solve's primal warm starts.
+    res = tr.solve(com.result, bounds=bounds, parameters=parameter_bounds(options),
+                   options=PRIMAL_WARM_OPTIONS)
     assert res.success, res.summary()
-    assert res.iterations <= 15
-    assert res.objective == pytest.approx(com.result.objective, rel=1e-7)
+    assert res.objective == pytest.approx(com.result.objective, rel=1e-9)
     for a, b in zip(com.result.phases, res.phases, strict=True):
         np.testing.assert_allclose(b.x, a.x, atol=1e-4)
 
