@@ -76,7 +76,10 @@ def _knots(text: str) -> tuple[int, int]:
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
-              default="hermite-simpson", show_default=True)
+              default=GaitOptions().transcription, show_default=True,
+              help="hermite-simpson-separated: the same scheme with the midpoint states as "
+                   "variables (bounded like the knots), faster per iteration; see "
+                   "docs/benchmarks-gait.md.")
 @click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,
               help="Controls periodic as well as states (the paper), or states only.")
 @click.option("--friction", type=float, default=None,
