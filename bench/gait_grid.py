@@ -15,7 +15,8 @@ normal force on the dense samples; other checks by their id),
 instant, the verify bug recorded in tests/gait/test_verify.py: recomputed with each sample in
 its own phase, no normal force is negative).
 
-Run: ``python bench/gait_grid.py [--speeds 3 6 ...] [--variants plain ankle] [--json FILE]``
+Run: ``python bench/gait_grid.py [--speeds 3 6 ...] [--variants plain ankle] [--json FILE]
+[--transcription hermite-simpson-separated]``
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from gaitopt.analysis.verify import LIMITS, verify_gait
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 
 VARIANTS = {
@@ -114,8 +115,10 @@ def lowest_force_by_phase(gait: Gait) -> float:
     return lowest
 
 
-def solve_point(variant: str, speed_m_min: float, *, check: bool) -> Point:
-    options = GaitOptions(speed=speed_m_min / 60.0, **VARIANTS[variant])
+def solve_point(variant: str, speed_m_min: float, *, check: bool,
+                transcription: str = "hermite-simpson") -> Point:
+    options = GaitOptions(speed=speed_m_min / 60.0, transcription=transcription,  # type: ignore[arg-type]
+                          **VARIANTS[variant])
     start = time.perf_counter()
     solution = solve_gait_solution("five-link", options)
     wall = time.perf_counter() - start
@@ -172,6 +175,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     parser.add_argument("--no-verify", action="store_true", help="skip the verify column")
     parser.add_argument("--json", type=Path, help="also write the points as JSON")
+    parser.add_argument("--transcription", default="hermite-simpson", choices=TRANSCRIPTIONS,
+                        help="GaitOptions.transcription of every point")
     args = parser.parse_args(argv)
 
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
@@ -179,7 +184,8 @@ def main(argv: list[str] | None = None) -> None:
     for variant in args.variants:
         rows = []
         for speed in args.speeds:
-            point = solve_point(variant, speed, check=not args.no_verify)
+            point = solve_point(variant, speed, check=not args.no_verify,
+                                transcription=args.transcription)
             rows.append(point)
             print(f"  {variant:<14} {speed:5.1f} m/min  {'ok ' if point.success else 'FAIL'}"
                   f" {point.wall_time_s:6.2f} s  verify {point.verify}", flush=True)

@@ -11,7 +11,7 @@ from rich.table import Table
 
 from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError
 from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
@@ -76,8 +76,11 @@ def _knots(text: str) -> tuple[int, int]:
               help="Single-support fraction of the step time; 1 = no double support.")
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
-@click.option("--transcription", type=click.Choice(["hermite-simpson", "trapezoidal"]),
-              default="hermite-simpson", show_default=True)
+@click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
+              default=GaitOptions().transcription, show_default=True,
+              help="hermite-simpson-separated: the same scheme with the midpoint states as "
+                   "variables (bounded like the knots), faster per iteration; see "
+                   "docs/benchmarks-gait.md.")
 @click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,
               help="Controls periodic as well as states (the paper), or states only.")
 @click.option("--friction", type=float, default=None,

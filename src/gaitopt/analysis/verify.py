@@ -98,6 +98,6 @@ def _cost_check(gait: Gait, lim: dict[str, float]) -> Check:
     saved = gait.cost_value
     rel = abs(cost - saved) / max(abs(saved), 1e-12)
     # The trapezoidal transcription integrates u'u by the trapezoidal rule, not exactly.
-    trapezoidal = gait.options.get("transcription", "hermite-simpson") != "hermite-simpson"
+    trapezoidal = gait.options.get("transcription", "hermite-simpson") == "trapezoidal"
     limit = 5e-2 if trapezoidal else lim["cost.recomputed"]
     return Check("cost.recomputed", rel, limit)

@@ -16,7 +16,10 @@ from typing import Any, Literal
 from gaitopt.robot.biped import BipedStructure
 from gaitopt.units import format_speed
 
-Transcription = Literal["hermite-simpson", "trapezoidal"]
+Transcription = Literal["hermite-simpson", "hermite-simpson-separated", "trapezoidal"]
+#: The accepted values of ``GaitOptions.transcription`` (the literal above, for validation).
+TRANSCRIPTIONS: tuple[str, ...] = ("hermite-simpson", "hermite-simpson-separated",
+                                   "trapezoidal")
 Formulation = Literal["reduced", "full"]
 GaitKind = Literal["walk", "run"]
 CostName = Literal["paper", "work", "metabolic"]
@@ -44,7 +47,9 @@ class GaitOptions:
         single_support_fraction: phase-1 share of the step time, in (0, 1]; 1 gives the
             single-support gait (no double support, the trailing leg leaves at heel strike).
         knots: grid points per phase (single support, double support), as in the paper.
-        transcription: ``"hermite-simpson"`` (DIRCOL's) or ``"trapezoidal"``.
+        transcription: ``"hermite-simpson"`` (DIRCOL's compressed form),
+            ``"hermite-simpson-separated"`` (the same scheme and optimum with the midpoint
+            states as NLP variables; cheaper derivatives) or ``"trapezoidal"``.
         periodic_controls: controls periodic (paper) as well as the states.
         friction: a friction coefficient for an optional friction-cone constraint, or None.
         unilateral_impulses: the ground only pushes at the heel strike and the liftoff (normal
@@ -252,9 +257,9 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
                                "and >= 2 in double support")
     if max(o.knots) > 400:
         raise GaitOptionsError(f"knots = {tuple(o.knots)}: at most 400 per phase")
-    if o.transcription not in ("hermite-simpson", "trapezoidal"):
-        raise GaitOptionsError(f"transcription = {o.transcription!r}: must be "
-                               "'hermite-simpson' or 'trapezoidal'")
+    if o.transcription not in TRANSCRIPTIONS:
+        raise GaitOptionsError(f"transcription = {o.transcription!r}: must be one of "
+                               f"{', '.join(repr(t) for t in TRANSCRIPTIONS)}")
     if o.friction is not None and not _finite("friction", o.friction) > 0.0:
         raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 "
                                "(leave it unset for no friction cone)")
