@@ -195,46 +195,28 @@ def test_option_errors_name_the_formulation() -> None:
         validate_options(FULL.replace(min_stance_knee_flexion=-0.1), legs)
 
 
-def test_a_run_converges_and_is_physical(reference: RefFn) -> None:
+def test_a_run_converges_and_is_physical(reference: RefFn, tmp_path) -> None:  # noqa: ANN001
     """Running is one more contact sequence (stance, flight): at 60 m/min it converges from
-    its naive guess; checked with Pinocchio at the knots: the stance tip stays at the origin
-    and the ground only pushes it, both tips are above the ground in flight, tip 2 lands one
-    step ahead, and the step is periodic with the legs swapped."""
-    from gaitopt.gait.full_coordinates import swap_state
-    from gaitopt.gait.solve import solve_walking
-    from tests.gait.conftest import contact_forces
-
-    model = load_model("five-link")
+    its naive guess, is written as a gait file (format version 2, with its contact sequence)
+    and read back; checked with Pinocchio at the knots (equations of motion, the stance tip
+    at the origin, tip 2 landing one step ahead) and by verify; the feet are off the ground
+    during the flight."""
     options = GaitOptions(formulation="full", gait="run", impulse=False, speed=1.0,
-                          single_support_fraction=0.5, step_length_bounds=(0.2, 1.5),
-                          min_stance_knee_flexion=0.0)
-    sol = solve_walking(model, options)
-    assert sol.success, sol.result.status
-    res, ref, nq = sol.result, reference(model), model.nq
-    step = res.parameters["step_length"]
-    stance, flight = res.phases
-    assert (stance.name, flight.name) == ("stance", "flight")
-    assert stance.duration == pytest.approx(flight.duration)
-    acts = [a.name for a in model.actuators]
-    for k in range(stance.t.size):
-        q, qd = stance.x[k, :nq], stance.x[k, nq:]
-        p, v, _ = ref.tip_kinematics(q, qd, np.zeros(nq), "tip_1")
-        assert np.abs(p).max() < 1e-6 and np.abs(v).max() < 1e-6
-        u = np.zeros(model.nu)
-        for j, name in enumerate(stance.controls):
-            if name in acts:
-                u[model.actuator_index(name)] = stance.u[k, j]
-        assert contact_forces(ref, q, qd, u, ("tip_1",))[0, 1] > -1e-6
+                          single_support_fraction=0.5, min_stance_knee_flexion=0.0)
+    gait = Gait.load(solve_gait("five-link", options).save(tmp_path / "run.gait.json"))
+    assert gait.success and gait.version == 2
+    assert gait.contact_sequence is not None and gait.contact_sequence["name"] == "run"
+    assert [ph.name for ph in gait.phases] == ["stance", "flight"]
+    assert [ph.contacts for ph in gait.phases] == [("tip_1",), ()]
+    assert [e.name for e in gait.events] == ["toe_off", "touchdown"]
+    assert_physics(reference(gait.model), gait)
+    flight, nq = gait.phases[1], gait.model.nq
+    ref = reference(gait.model)
     for k in range(1, flight.t.size - 1):
         for tip in ("tip_1", "tip_2"):
-            assert ref.tip_kinematics(flight.x[k, :nq], flight.x[k, nq:], np.zeros(nq),
-                                      tip)[0][1] > -1e-6
-    landing = ref.tip_kinematics(flight.x[-1, :nq], flight.x[-1, nq:], np.zeros(nq),
-                                 "tip_2")[0]
-    np.testing.assert_allclose(landing, [step, 0.0], atol=1e-6)
-    # After the landing impact and the leg swap the step starts again.
-    from gaitopt.dynamics.impact import impact
-
-    qd_plus = impact(model, flight.x[-1, :nq], flight.x[-1, nq:], ["tip_2"]).qd_plus
-    q_next, qd_next = swap_state(model, model_symmetry(model), flight.x[-1, :nq], qd_plus, step)
-    np.testing.assert_allclose(np.concatenate([q_next, qd_next]), stance.x[0], atol=1e-6)
+            height = ref.tip_kinematics(flight.q[k], flight.qd[k], np.zeros(nq), tip)[0][1]
+            assert height > -1e-6
+    landing = ref.tip_kinematics(flight.q[-1], flight.qd[-1], np.zeros(nq), "tip_2")[0]
+    np.testing.assert_allclose(landing, [gait.step_length, 0.0], atol=1e-6)
+    report = verify_gait(gait)
+    assert report.passed, report.failed_ids

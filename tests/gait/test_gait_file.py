@@ -57,7 +57,7 @@ def test_file_is_readable_json_with_numbers_rows_on_one_line(gait: Gait, tmp_pat
     path = gait.save(tmp_path / "g.gait.json")
     text = path.read_text()
     data = json.loads(text)
-    assert data["format"] == "gaitopt.gait" and data["version"] == 1
+    assert data["format"] == "gaitopt.gait" and data["version"] == 2
     assert set(data["parameters"]) >= {"step_length", "speed", "step_time",
                                        "single_support_time", "liftoff_impulse"}
     n_samples = len(data["samples"]["t"])
@@ -97,8 +97,8 @@ def _corrupt(gait: Gait, tmp_path: Path, edit: object) -> Path:
 
 @pytest.mark.parametrize(("edit", "field", "words"), [
     (lambda d: d.update(format="gaitopt.model"), "format", "not a gait file"),
-    (lambda d: d.update(version=2), "version", "major version 2 is not supported"),
-    (lambda d: d.update(version="2.1"), "version", "not supported"),
+    (lambda d: d.update(version=3), "version", "major version 3 is not supported"),
+    (lambda d: d.update(version="3.1"), "version", "not supported"),
     (lambda d: d.pop("samples"), "", "missing required key 'samples'"),
     (lambda d: d["phases"][1].update(q=d["phases"][1]["q"][:-1]), "phases[1].q", "shape"),
     (lambda d: d["phases"][0].update(contacts=["tip_1", "tip_2"]),
@@ -147,6 +147,16 @@ def test_not_json_and_truncated_and_missing_files(gait: Gait, tmp_path: Path) ->
     arr.write_text("[1, 2]")
     with pytest.raises(GaitFileError, match="expected an object"):
         Gait.load(arr)
+
+
+def test_version_1_files_still_load(gait: Gait) -> None:
+    """A file written before contact sequences (version 1: no contact_sequence) loads."""
+    data = gait.to_dict()
+    data["version"] = 1
+    data.pop("contact_sequence", None)
+    old = Gait.from_dict(data)
+    assert old.version == 1 and old.contact_sequence is None
+    assert old.cost_value == gait.cost_value
 
 
 def test_minor_version_string_of_major_1_is_read(gait: Gait) -> None:

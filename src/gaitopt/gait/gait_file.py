@@ -48,7 +48,9 @@ if TYPE_CHECKING:  # for annotations only: no viz import at run time
     from gaitopt.viz.notebook import GifAnimation
 
 FORMAT = "gaitopt.gait"
-VERSION = 1
+VERSION = 2
+#: Versions this module reads: 1 (walks only, no contact sequence) and 2.
+READABLE_VERSIONS: tuple[int, ...] = (1, 2)
 
 #: World points every gait's samples carry (leg numbers as in the step: leg 1 stands).
 POINT_NAMES: tuple[str, ...] = ("hip", "knee_1", "knee_2", "tip_1", "tip_2", "torso_top")
@@ -57,7 +59,9 @@ PARAMETER_KEYS: tuple[str, ...] = ("step_length", "speed", "step_time", "single_
 SOLVER_KEYS: tuple[str, ...] = ("status", "success", "iterations", "wall_time_s", "variables",
                                 "equality_constraints", "inequality_constraints", "evaluations",
                                 "max_violation")
-EVENT_NAMES: tuple[str, ...] = ("heel_strike", "liftoff")
+#: Events of the built-in contact sequences: a walk's heel strike (touchdown) and liftoff
+#: (release, with the liftoff impulse); a run's toe-off (release) and touchdown.
+EVENT_NAMES: tuple[str, ...] = ("heel_strike", "liftoff", "toe_off", "touchdown")
 #: Interpolation rules this module can evaluate (see :func:`phase_states_at`).
 STATE_INTERPOLATIONS: tuple[str, ...] = ("cubic_hermite",)
 CONTROL_INTERPOLATIONS: tuple[str, ...] = ("piecewise_linear",)
@@ -287,6 +291,7 @@ class Gait:
     gaitopt_version: str = __version__
     format: str = FORMAT
     version: int = VERSION
+    contact_sequence: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -296,9 +301,13 @@ class Gait:
                         f"{exc.value!r} is invalid: {exc.allowed}") from None
         if self.format != FORMAT:
             raise _fail("format", f"expected {FORMAT!r}, got {self.format!r}")
-        if self.version != VERSION:
-            raise _fail("version", f"expected {VERSION}, got {self.version!r}")
+        if self.version not in READABLE_VERSIONS:
+            raise _fail("version", f"expected one of {READABLE_VERSIONS}, got {self.version!r}")
         set_ = object.__setattr__
+        if self.contact_sequence is not None:
+            seq = _mapping("contact_sequence", self.contact_sequence,
+                           required=("name", "phases", "events"))
+            set_(self, "contact_sequence", _frozen(_plain_json("contact_sequence", seq)))
         set_(self, "model_data", _frozen(self.model_data))
         set_(self, "options", _frozen(_plain_json("options", _mapping("options", self.options))))
         params = _mapping("parameters", self.parameters, required=PARAMETER_KEYS)
@@ -413,6 +422,8 @@ class Gait:
                         "qd": self.samples.qd.tolist(), "u": self.samples.u.tolist(),
                         "points": {p: v.tolist() for p, v in self.samples.points.items()}},
         })
+        if self.contact_sequence is not None:
+            out["contact_sequence"] = copy.deepcopy(dict(self.contact_sequence))
         return out
 
     @classmethod
@@ -576,9 +587,10 @@ def _gait_from_dict(data: Any) -> Gait:
         raise _fail("format", f"expected {FORMAT!r}, got {top['format']!r} (not a gait file)")
     version = top["version"]
     major = _major_version(version)
-    if major != VERSION:
+    if major not in READABLE_VERSIONS:
         raise _fail("version", f"major version {version!r} is not supported: this gaitopt "
-                    f"({__version__}) reads {FORMAT} version {VERSION}")
+                    f"({__version__}) reads {FORMAT} versions "
+                    f"{', '.join(map(str, READABLE_VERSIONS))}")
     for key in ("created", "gaitopt_version", "model", "options", "parameters", "cost",
                 "solver", "phases", "events", "samples"):
         if key not in top:
@@ -603,7 +615,8 @@ def _gait_from_dict(data: Any) -> Gait:
     return Gait(model_data=_mapping("model", top["model"]), options=top["options"],
                 parameters=top["parameters"], cost=top["cost"], solver=top["solver"],
                 phases=tuple(phases), events=tuple(events), samples=samples,
-                created=str(top["created"]), gaitopt_version=str(top["gaitopt_version"]))
+                created=str(top["created"]), gaitopt_version=str(top["gaitopt_version"]),
+                version=int(major), contact_sequence=top.get("contact_sequence"))
 
 
 def _major_version(version: Any) -> int | None:

@@ -20,6 +20,7 @@ from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.kinematics import point_position
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import cost, walking
+from gaitopt.gait.formulation import contact_sequence
 from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution
@@ -98,7 +99,6 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
     impulse = max(impulse, 0.0)
     traj = {ph.name: ph for ph in res.phases}
     if options.formulation == "full":
-        from gaitopt.gait.formulation import contact_sequence
         from gaitopt.gait.record_full import full_phases_and_events, full_samples
 
         total = sum(ph.duration for ph in res.phases)
@@ -150,7 +150,8 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
                     "single_support_time": t1, "liftoff_impulse": impulse},
         cost={"value": float(res.objective), "name": options.cost,
               "formula": cost.formula(options)},
-        solver=solver, phases=phases, events=events, samples=samples)
+        solver=solver, phases=phases, events=events, samples=samples,
+        contact_sequence=contact_sequence(model, options).to_dict())
 
 
 def _vec(value: Any, n: int) -> Array:

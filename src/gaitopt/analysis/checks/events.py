@@ -27,6 +27,11 @@ from gaitopt.gait.gait_file import Gait, GaitEvent, leg_swap_permutations, swap_
 
 Array = NDArray[np.float64]
 
+#: Events that are touchdowns (impacts), and releases with the liftoff impulse; any other
+#: event (a run's ``toe_off``) releases its point with the velocities unchanged.
+TOUCHDOWNS = frozenset({"heel_strike", "touchdown"})
+IMPULSE_RELEASES = frozenset({"liftoff"})
+
 
 def _phase_ending_at(gait: Gait, t: float) -> int | None:
     """Index of the last phase whose end time is ``t`` (within 1e-9 s)."""
@@ -45,12 +50,14 @@ def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...]
            ) -> tuple[Array, dict[str, Array], tuple[str, ...]]:
     """``(qd_after, impulses, contacts held after)`` of ``event`` from ``(q, qd_before)``."""
     model = gait.model
-    if event.name == "heel_strike":
+    if event.name in TOUCHDOWNS:
         qd, imp = impact_function(model, held)(q, event.qd_before)
         flat = np.asarray(imp, dtype=float).ravel()
         impulses = {c: flat[2 * j:2 * j + 2] for j, c in enumerate(held)}
         return np.asarray(qd, dtype=float).ravel(), impulses, held
     stay = tuple(c for c in held if c != event.leg)
+    if event.name not in IMPULSE_RELEASES:  # a release without impulse: velocities continue
+        return np.array(event.qd_before, dtype=float), {}, stay
     p = gait.parameters["liftoff_impulse"]
     qd, lifting, on_held = liftoff_function(model, event.leg, list(stay))(q, event.qd_before, p)
     flat = np.asarray(on_held, dtype=float).ravel()
@@ -62,7 +69,7 @@ def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...]
 def _events_of_phase(gait: Gait, i: int) -> list[GaitEvent]:
     """The events at the end of phase i in order (a heel strike before a liftoff)."""
     return sorted((e for e in gait.events if _phase_ending_at(gait, e.t) == i),
-                  key=lambda e: (e.t, e.name != "heel_strike"))
+                  key=lambda e: (e.t, e.name not in TOUCHDOWNS))
 
 
 def event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
@@ -82,7 +89,7 @@ def event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
             where = f"events[{gait.events.index(e)}] ({e.name})"
             worst["events.continuity"] = worst["events.continuity"].update(
                 float(np.max(np.abs(e.qd_before - qd))), where)
-            if e.name == "heel_strike":
+            if e.name in TOUCHDOWNS:
                 held = _held_after_strike(gait, i, e.leg)
             qd_after, impulses, held = _apply(gait, e, q, held)
             worst["events.maps"] = worst["events.maps"].update(
