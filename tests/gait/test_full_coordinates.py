@@ -19,7 +19,7 @@ from gaitopt.gait.contact_sequence import (
     running_sequence,
     walking_sequence,
 )
-from gaitopt.gait.full_coordinates import model_symmetry, state_names
+from gaitopt.gait.full_physics import model_symmetry, state_names
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import load_model, model_from_dict

@@ -40,7 +40,7 @@ def as_model(model: RobotModel | str | os.PathLike[str]) -> RobotModel:
 def guess_from_gait(gait: Gait) -> Guess:
     """An engine guess from a saved gait: its phase states (reduced or full, by name) and
     actuator torques at its knots (normalised times), and its parameters."""
-    from gaitopt.gait.full_coordinates import actuator_names
+    from gaitopt.gait.full_physics import actuator_names
 
     model = gait.model
     phases = {}

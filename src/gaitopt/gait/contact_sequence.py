@@ -27,7 +27,6 @@ The three built-in sequences (:data:`SEQUENCES`) are instances of this one mecha
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 from gaitopt.robot.model import RobotModel
@@ -177,15 +176,3 @@ def check_sequence(model: RobotModel, seq: ContactSequence,
             raise ContactSequenceError(
                 f"sequence {seq.name!r}: after event {ev.name!r} the points "
                 f"{sorted(after)} are held, but the next phase holds {sorted(nxt)}")
-
-
-def phase_index(seq: ContactSequence, name: str) -> int:
-    """Position of the phase called ``name``."""
-    for i, ph in enumerate(seq.phases):
-        if ph.name == name:
-            return i
-    raise KeyError(name)
-
-
-def sequence_phase_names(seq: ContactSequence) -> Sequence[str]:
-    return tuple(ph.name for ph in seq.phases)

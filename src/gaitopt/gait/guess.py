@@ -26,8 +26,8 @@ from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.reduced import checked_biped, leg_inverse_kinematics
 from gaitopt.dynamics.rnea import bias_forces
 from gaitopt.gait import walking
-from gaitopt.gait.full_coordinates import actuator_names
-from gaitopt.gait.full_coordinates import state_names as full_state_names
+from gaitopt.gait.full_physics import actuator_names
+from gaitopt.gait.full_physics import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel

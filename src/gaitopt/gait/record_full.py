@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.dynamics.backend import as_scalars
-from gaitopt.gait import full_coordinates as full
+from gaitopt.gait import full_physics as full
 from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.gait_file import GaitEvent, GaitPhase, GaitSamples
 from gaitopt.robot.model import RobotModel

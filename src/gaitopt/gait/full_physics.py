@@ -1,0 +1,155 @@
+"""The physics of one step in full coordinates: phase dynamics, events and the leg swap.
+
+One code path for numbers and CasADi symbols (like :mod:`gaitopt.gait.walking` for the
+reduced coordinates): the full-coordinate problem (:mod:`gaitopt.gait.full_coordinates`)
+calls these on symbols, the gait record (:mod:`gaitopt.gait.record_full`) on numbers.
+States ``x = [q, qd]`` (``2 nq``); a phase's controls are its actuator torques followed by
+the projection controls ``gamma, nu`` of its held points (docs/formulations.md §1).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from gaitopt.dynamics.actuation import generalized_forces
+from gaitopt.dynamics.backend import as_scalars, vector
+from gaitopt.dynamics.contact import contact_dynamics
+from gaitopt.dynamics.impact import impact, liftoff_impulse
+from gaitopt.dynamics.kinematics import contact_jacobian
+from gaitopt.gait.contact_sequence import ContactSequence, EventSpec
+from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import swap_maps, swap_permutations
+
+
+@dataclass(frozen=True)
+class Symmetry:
+    """How the legs swap after a step: permutations of ``q`` (nq,) and ``u`` (nu,), and the
+    contact names."""
+
+    perm_q: tuple[int, ...]
+    perm_u: tuple[int, ...]
+    contacts: Mapping[str, str]
+
+
+def model_symmetry(model: RobotModel) -> Symmetry:
+    """The leg swap of a model (declared in its file or inferred:
+    :mod:`gaitopt.robot.symmetry`)."""
+    perm_q, perm_u = swap_permutations(model)
+    _, contacts = swap_maps(model)
+    return Symmetry(tuple(int(i) for i in perm_q), tuple(int(i) for i in perm_u), contacts)
+
+
+def state_names(model: RobotModel) -> tuple[str, ...]:
+    """``[q, qd]`` names: the coordinates, then ``<coordinate>_rate``."""
+    names = model.coordinate_names
+    return names + tuple(f"{n}_rate" for n in names)
+
+
+def projection_names(held: Sequence[str]) -> tuple[str, ...]:
+    """Names of the projection controls of the held points."""
+    return tuple(f"{kind}_{c}_{axis}" for kind in ("gamma", "nu") for c in held
+                 for axis in ("x", "y"))
+
+
+def actuator_names(model: RobotModel, held: Sequence[str], *, ankle: bool) -> tuple[str, ...]:
+    """Actuators acting in a phase, in model order: the joint actuators, and the contact
+    actuators of held points when ``ankle``."""
+    return tuple(a.name for a in model.actuators
+                 if a.joint is not None or (ankle and a.contact in held))
+
+
+def full_controls(model: RobotModel, names: Sequence[str], u: Any) -> list[Any]:
+    """The model's actuator vector (nu,) from the first ``len(names)`` entries of ``u``."""
+    values = as_scalars(u, len(names), "u") if len(names) else []
+    out: list[Any] = [0.0] * model.nu
+    for name, value in zip(names, values, strict=True):
+        out[model.actuator_index(name)] = value
+    return out
+
+
+@dataclass(frozen=True)
+class PointValues:
+    """What the phase dynamics computes at one point."""
+
+    xdot: Any
+    qdd: Any
+    forces: Any
+
+
+def phase_point(model: RobotModel, held: Sequence[str], actuators: Sequence[str], x: Any,
+                u: Any) -> PointValues:
+    """``xdot = [qd + J^T gamma, qdd + J^T nu]`` with ``qdd, f`` from the Contact Algorithm
+    (``u`` = actuator torques then projection controls)."""
+    nq, na = model.nq, len(actuators)
+    xs = as_scalars(x, 2 * nq, "x")
+    q, qd = xs[:nq], xs[nq:]
+    us = as_scalars(u, na + 4 * len(held), "u")
+    tau = generalized_forces(model, vector(q), vector(full_controls(model, actuators,
+                                                                    us[:na])), held)
+    sol = contact_dynamics(model, vector(q), vector(qd), tau, held)
+    qdd = as_scalars(sol.qdd, nq, "qdd")
+    dq, dqd = list(qd), list(qdd)
+    if held:
+        m = 2 * len(held)
+        gamma, nu = us[na:na + m], us[na + m:na + 2 * m]
+        jac = contact_jacobian(model, vector(q), held)
+        for r in range(m):
+            for j in range(nq):
+                dq[j] = dq[j] + jac[r, j] * gamma[r]
+                dqd[j] = dqd[j] + jac[r, j] * nu[r]
+    return PointValues(xdot=vector(dq + dqd), qdd=sol.qdd, forces=sol.forces)
+
+
+@dataclass(frozen=True)
+class EventValues:
+    """A velocity jump: ``qd_after`` (nq,) and the impulses on each point by name (2,)."""
+
+    qd_after: Any
+    impulses: dict[str, Any]
+
+
+def event_map(model: RobotModel, seq: ContactSequence, i: int, q: Any, qd: Any,
+              impulse: Any) -> EventValues:
+    """Event ``i``: impact of the points held afterwards if any touch down; else the
+    liftoff impulse of magnitude ``impulse`` (N s) on the released point; else nothing."""
+    ev: EventSpec = seq.events[i]
+    after = seq.held_after(i)
+    if ev.touchdown:
+        sol = impact(model, q, qd, after)
+        flat = as_scalars(sol.impulses, 2 * len(after), "impulses")
+        return EventValues(sol.qd_plus, {c: vector(flat[2 * k:2 * k + 2])
+                                         for k, c in enumerate(after)})
+    if ev.impulse:
+        lift = liftoff_impulse(model, q, qd, ev.release[0], impulse, after)
+        flat = as_scalars(lift.impulses_held, 2 * len(after), "impulses") if after else []
+        out = {ev.release[0]: lift.impulse_lifting}
+        out |= {c: vector(flat[2 * k:2 * k + 2]) for k, c in enumerate(after)}
+        return EventValues(lift.qd_plus, out)
+    return EventValues(qd, {})
+
+
+def event_impulses(model: RobotModel, seq: ContactSequence, i: int, x: Any, impulse: Any
+                   ) -> dict[str, Any]:
+    """The impulses of event ``i`` as the constraints see them (N s, by point).
+
+    A touchdown's impact impulses come from the state ``x = [q, qd]`` before it. A release's
+    impulses on the held points are evaluated with ``qd = 0``: the held points stand still
+    before the release (``J qd = 0``, enforced at the phase's last knot), so this is the same
+    value, written without the dependence on those rows (which would make the constraint a
+    combination of them, a degenerate NLP when the impulse is 0)."""
+    nq = model.nq
+    xs = as_scalars(x, 2 * nq, "x")
+    q = vector(xs[:nq])
+    qd = vector(xs[nq:]) if seq.events[i].touchdown else vector([0.0] * nq)
+    return event_map(model, seq, i, q, qd, impulse).impulses
+
+
+def swap_state(model: RobotModel, symmetry: Symmetry, q: Any, qd: Any, step: Any
+               ) -> tuple[list[Any], list[Any]]:
+    """The next step's ``(q, qd)``: legs swapped, moved back by one step length."""
+    qs, qds = as_scalars(q, model.nq, "q"), as_scalars(qd, model.nq, "qd")
+    q_next = [qs[j] for j in symmetry.perm_q]
+    q_next[0] = q_next[0] - step
+    return q_next, [qds[j] for j in symmetry.perm_q]
