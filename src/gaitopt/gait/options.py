@@ -17,6 +17,9 @@ from gaitopt.robot.biped import BipedStructure
 from gaitopt.units import format_speed
 
 Transcription = Literal["hermite-simpson", "trapezoidal"]
+ControlModel = Literal["paper", "jumps"]
+#: The control models (see ``docs/walking.md``, "Control model").
+CONTROL_MODELS = ("paper", "jumps")
 
 
 class GaitOptionsError(ValueError):
@@ -58,6 +61,14 @@ class GaitOptions:
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, and keep the lowest optimum (slower; a cold solve can
             otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
+        mesh_tol: refine the mesh after the fixed-grid stages until every interval's
+            collocation error estimate is <= mesh_tol (``None``: the fixed grid ``knots``).
+        control_model: ``"paper"`` (controls continuous at the heel strike and, with
+            ``periodic_controls``, periodic at the liftoff) or ``"jumps"`` (no control
+            linkages: the torques may jump at both events).
+        swing_clearance: ``c`` (m) of the swing-tip height profile ``y >= c 4 s (1 - s)``
+            over single support (``s`` the normalised phase time), or ``None`` (the paper:
+            ``y >= 0``).
     """
 
     speed: float | None = 0.2
@@ -81,6 +92,9 @@ class GaitOptions:
     max_iter: int = 1000
     continuation: bool = True
     multistart: bool = False
+    mesh_tol: float | None = None
+    control_model: ControlModel = "paper"
+    swing_clearance: float | None = None
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -215,3 +229,14 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         raise GaitOptionsError(f"tol = {o.tol!r}: must lie in (0, 1)")
     if not isinstance(o.max_iter, int) or o.max_iter < 1:
         raise GaitOptionsError(f"max_iter = {o.max_iter!r}: must be a positive integer")
+    if o.mesh_tol is not None and not 0.0 < _finite("mesh_tol", o.mesh_tol) < 1.0:
+        raise GaitOptionsError(f"mesh_tol = {o.mesh_tol!r}: must lie in (0, 1) "
+                               "(or None for the fixed grid)")
+    if o.control_model not in CONTROL_MODELS:
+        raise GaitOptionsError(f"control_model = {o.control_model!r}: must be one of "
+                               f"{', '.join(repr(m) for m in CONTROL_MODELS)}")
+    if o.swing_clearance is not None:
+        c = _finite("swing_clearance", o.swing_clearance)
+        if not 0.0 < c < reach:
+            raise GaitOptionsError(f"swing_clearance = {c:g} m: must lie in (0, {reach:.3f}) m "
+                                   "(above the ground, below the leg's reach; or None)")
