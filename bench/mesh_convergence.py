@@ -45,13 +45,16 @@ def worst_interval(result: Result) -> str:
     return f"{name}[{k}/{ph.error.size}] tau {ph.tau[k]:.2f}"
 
 
-def row(model: str, grid: tuple[int, int], clearance: float | None) -> dict[str, Any]:
+def row(model: str, grid: tuple[int, int], clearance: float | None,
+        profile: str = "parabola") -> dict[str, Any]:
     robot = load_model("five-link")
-    options = GaitOptions(knots=grid, swing_clearance=clearance, **MODELS[model])
+    options = GaitOptions(knots=grid, swing_clearance=clearance,
+                          clearance_profile=profile,  # type: ignore[arg-type]
+                          **MODELS[model])
     start = time.perf_counter()
     fixed = solve_walking(robot, options)
     out: dict[str, Any] = {"model": model, "grid": list(grid), "clearance": clearance,
-                           "success": fixed.success}
+                           "profile": profile, "success": fixed.success}
     if fixed.success:
         r = fixed.result
         out.update(cost=r.objective, step=r.parameters["step_length"],
@@ -82,16 +85,18 @@ def main() -> None:
     ap.add_argument("--models", nargs="+", default=list(MODELS), choices=list(MODELS))
     ap.add_argument("--grids", nargs="+", default=[f"{a},{b}" for a, b in GRIDS])
     ap.add_argument("--clearance", type=float, default=None)
+    ap.add_argument("--profile", default="parabola", choices=["parabola", "quartic"])
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
     grids = [tuple(int(v) for v in g.split(",")) for g in args.grids]
-    print(f"load average {os.getloadavg()[0]:.2f}; clearance {args.clearance}")
+    print(f"load average {os.getloadavg()[0]:.2f}; clearance {args.clearance} "
+          f"({args.profile})")
     print("| controls | knots | cost @ 12 m/min | step (m) | free: speed (m/min) | free: step "
           "(m) | free: cost | max error | largest error at | wall (s) |")
     print("|:--|--:|--:|--:|--:|--:|--:|--:|:--|--:|")
     for model in args.models:
         for grid in grids:
-            r = row(model, (grid[0], grid[1]), args.clearance)
+            r = row(model, (grid[0], grid[1]), args.clearance, args.profile)
             print(line(r), flush=True)
             if args.json:
                 with open(args.json, "a") as fh:

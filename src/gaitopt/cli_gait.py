@@ -11,8 +11,8 @@ import click
 from rich.table import Table
 
 from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
-from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
@@ -97,6 +97,10 @@ def _knots(text: str) -> tuple[int, int]:
 @click.option("--clearance", type=float, default=None,
               help="Swing-tip clearance c in m: height >= c 4 s (1 - s) over single support "
                    "(default: >= 0, the paper).")
+@click.option("--clearance-profile", type=click.Choice(["parabola", "quartic"]),
+              default="parabola", show_default=True,
+              help="Clearance profile: c 4 s (1 - s), or c (4 s (1 - s))^2 (no least tip "
+                   "velocity at the events).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("--multistart", is_flag=True,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "
@@ -111,7 +115,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, control_model: str, mesh_tol: float | None,
-                  clearance: float | None, compiled: bool, multistart: bool,
+                  clearance: float | None, clearance_profile: str, compiled: bool, multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
@@ -134,7 +138,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
         control_model=control_model,  # type: ignore[arg-type]
-        mesh_tol=mesh_tol, swing_clearance=clearance)
+        mesh_tol=mesh_tol, swing_clearance=clearance,
+        clearance_profile=clearance_profile)  # type: ignore[arg-type]
     try:
         validate_options(options, checked_biped(model))
     except (GaitOptionsError, BipedStructureError) as exc:

@@ -11,7 +11,8 @@ solver used, and SciPy's adaptive Runge-Kutta integrator (DOP853):
 * the heel-strike impact and the liftoff impulse applied to the saved pre-event states,
   compared with the saved post-event velocities and with the next phase's first knot;
 * periodicity: the state after liftoff, legs relabelled and shifted back one step, equals the
-  first knot; and the controls, if the gait was solved with periodic controls;
+  first knot; and the controls, if the gait was solved with periodic controls (and the
+  paper's control model);
 * every constraint on the dense samples: normal contact forces recomputed from the saved
   states and controls, swing clearance, torque bounds, joint limits, tips on the ground;
 * the cost recomputed from the saved controls: the exact integral of the squared piecewise-
@@ -218,7 +219,9 @@ def _event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
               float(np.max(np.abs(qd_next - first.qd[0]))))
     checks = [Check("impact and liftoff maps", event_err, lim["event"], "m/s|rad/s"),
               Check("periodicity of states (legs relabelled)", per, lim["periodicity"])]
-    if gait.options.get("periodic_controls", True):
+    # The "jumps" control model has no control linkages (docs/walking.md, "Control model").
+    if (gait.options.get("periodic_controls", True)
+            and gait.options.get("control_model", "paper") == "paper"):
         u_next = last.u[-1][perm_u]
         active = np.abs(first.u[0]) > 0  # actuators that act at the start of the step
         both = active & (np.abs(u_next) > 0)

@@ -20,6 +20,9 @@ Transcription = Literal["hermite-simpson", "trapezoidal"]
 ControlModel = Literal["paper", "jumps"]
 #: The control models (see ``docs/walking.md``, "Control model").
 CONTROL_MODELS = ("paper", "jumps")
+ClearanceProfile = Literal["parabola", "quartic"]
+#: The swing clearance profiles (see ``docs/walking.md``, "Swing clearance").
+CLEARANCE_PROFILES = ("parabola", "quartic")
 
 
 class GaitOptionsError(ValueError):
@@ -66,9 +69,11 @@ class GaitOptions:
         control_model: ``"paper"`` (controls continuous at the heel strike and, with
             ``periodic_controls``, periodic at the liftoff) or ``"jumps"`` (no control
             linkages: the torques may jump at both events).
-        swing_clearance: ``c`` (m) of the swing-tip height profile ``y >= c 4 s (1 - s)``
-            over single support (``s`` the normalised phase time), or ``None`` (the paper:
-            ``y >= 0``).
+        swing_clearance: ``c`` (m), the least mid-swing height of the swing tip: over single
+            support ``y >= c 4 s (1 - s)`` (``clearance_profile="parabola"``) or
+            ``y >= c (4 s (1 - s))^2`` (``"quartic"``), ``s`` the normalised phase time; or
+            ``None`` (the paper: ``y >= 0``).
+        clearance_profile: ``"parabola"`` or ``"quartic"`` (see ``swing_clearance``).
     """
 
     speed: float | None = 0.2
@@ -95,6 +100,7 @@ class GaitOptions:
     mesh_tol: float | None = None
     control_model: ControlModel = "paper"
     swing_clearance: float | None = None
+    clearance_profile: ClearanceProfile = "parabola"
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -240,3 +246,6 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         if not 0.0 < c < reach:
             raise GaitOptionsError(f"swing_clearance = {c:g} m: must lie in (0, {reach:.3f}) m "
                                    "(above the ground, below the leg's reach; or None)")
+    if o.clearance_profile not in CLEARANCE_PROFILES:
+        raise GaitOptionsError(f"clearance_profile = {o.clearance_profile!r}: must be one of "
+                               f"{', '.join(repr(m) for m in CLEARANCE_PROFILES)}")

@@ -220,7 +220,8 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
                        lower=[0.0, hip_lo], upper=[ca.inf, hip_hi], scale=[0.1, 1.0]),
     ]
     if options.swing_clearance is not None:
-        ss_path.append(_clearance_constraint(model, swing, options.swing_clearance, f,
+        ss_path.append(_clearance_constraint(model, swing, options.swing_clearance,
+                                             options.clearance_profile, f,
                                              lambda x, u, p: ss(x, u, p).solution.q))
     phase1 = Phase(
         name=SINGLE, states=ss_states, controls=ss_controls, dynamics=ss_dynamics,
@@ -395,20 +396,25 @@ def _periodic_controls(model: RobotModel, from_phase: str, from_controls: Sequen
 CLEARANCE = "swing clearance profile"
 
 
-def clearance_profile(clearance: float, s: Any) -> Any:
-    """The smallest swing-tip height (m) at normalised single-support time ``s`` in [0, 1]:
-    ``c 4 s (1 - s)``, 0 at liftoff and heel strike and ``c`` at mid-swing."""
-    return clearance * 4.0 * s * (1.0 - s)
+def clearance_profile(clearance: float, s: Any, profile: str = "parabola") -> Any:
+    """The least swing-tip height (m) at normalised single-support time ``s`` in [0, 1]:
+    ``c 4 s (1 - s)`` (``"parabola"``) or ``c (4 s (1 - s))^2`` (``"quartic"``); both are 0
+    at the liftoff and the heel strike and ``c`` at mid-swing. The parabola's slope at the
+    ends, ``4 c / T1``, is a least vertical tip velocity at both events; the quartic's is
+    zero."""
+    bump = 4.0 * s * (1.0 - s)
+    return clearance * (bump if profile == "parabola" else bump * bump)
 
 
-def _clearance_constraint(model: RobotModel, swing: Any, clearance: float, fraction: float,
+def _clearance_constraint(model: RobotModel, swing: Any, clearance: float, profile: str,
+                          fraction: float,
                           configuration: Callable[[Any, Any, Any], Any]) -> PathConstraint:
-    """``y_tip(q) - c 4 s (1 - s) >= 0`` over single support, with ``s = t / T1`` and
+    """``y_tip(q) - profile(s) >= 0`` over single support, with ``s = t / T1`` and
     ``T1 = f L / v`` (single support starts the step at ``t = 0``)."""
 
     def fn(x: Any, u: Any, p: Any, t: Any) -> Any:
         s = t * p[_V] / (fraction * p[_L])
         return walking.tip_height(model, configuration(x, u, p), swing) \
-            - clearance_profile(clearance, s)
+            - clearance_profile(clearance, s, profile)
 
     return PathConstraint(CLEARANCE, fn, lower=0.0, upper=ca.inf, scale=0.1)

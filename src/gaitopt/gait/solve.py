@@ -171,14 +171,14 @@ def is_mesh(grid: Grid) -> bool:
 def grid_knots(grid: Grid, options: GaitOptions) -> tuple[int, int]:
     """Knots per phase of a grid (a phase the problem lacks keeps ``options.knots``)."""
     if not is_mesh(grid):
-        return (int(grid[0]), int(grid[1]))  # type: ignore[arg-type]
+        return (int(grid[0]), int(grid[1]))
     sizes = [np.asarray(m).size for m in grid]
     return (sizes[0], sizes[1] if len(sizes) > 1 else options.knots[1])
 
 
 def _grid_key(grid: Grid) -> tuple[Any, ...]:
     if not is_mesh(grid):
-        return tuple(int(k) for k in grid)  # type: ignore[arg-type]
+        return tuple(int(k) for k in grid)
     return tuple(tuple(float(v) for v in np.asarray(m)) for m in grid)
 
 
@@ -191,7 +191,7 @@ def _structure_key(model: RobotModel, options: GaitOptions, grid: Grid,
             o.min_stance_knee_flexion,
             tuple(o.torso_bounds), o.rate_bound, o.max_impulse, o.tol, o.max_iter,
             tuple(o.speed_bounds), tuple(o.step_length_bounds), o.control_model,
-            o.swing_clearance, compiled)
+            o.swing_clearance, o.clearance_profile, compiled)
 
 
 def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
@@ -361,29 +361,29 @@ class _Run:
 
     def refine_mesh(self, result: Result) -> Result:
         """Refinement rounds (``mesh_tol``): split the intervals whose error estimate exceeds
-        the tolerance and solve again from ``result``, until every estimate is within it
-        (at most :data:`MAX_REFINEMENTS` rounds and :data:`MAX_REFINED_KNOTS` knots per
-        phase). If the first grid already meets the tolerance, one round on the grid with
-        every interval halved gives the cost a second grid to be compared with."""
+        the tolerance and solve again from ``result`` until every estimate is within it (at
+        most :data:`MAX_REFINEMENTS` rounds and :data:`MAX_REFINED_KNOTS` knots per phase);
+        then one round on that mesh with every interval halved, whose solution is the
+        answer and whose cost change from the mesh before is the cost error estimate
+        (:mod:`gaitopt.gait.accuracy`). Successive adaptive meshes differ by a few knots
+        only, so their cost change says little about the remaining error."""
         tol = self.options.mesh_tol
         if tol is None:
             return result
         for round_ in range(1, MAX_REFINEMENTS + 1):
-            converged = result.max_error <= tol
-            if converged and len(self.grid_costs) >= 2 and \
-                    self.grid_costs[-2][0] != self.grid_costs[-1][0]:
-                return result
-            mesh = (refined_mesh(result, tol) if not converged else
-                    tuple(split_intervals(m, np.full(m.size - 1, 2, dtype=np.int64))
-                          for m in result.mesh))
+            if result.max_error <= tol:
+                break
+            mesh = refined_mesh(result, tol)
             if max(m.size for m in mesh) > MAX_REFINED_KNOTS:
+                break
+            result = self.on_grid(f"mesh refinement {round_}", mesh, result)
+            if not result.success:
                 return result
-            name = f"mesh refinement {round_}" if not converged else "mesh check (halved)"
-            nxt = self.on_grid(name, mesh, result)
-            if not nxt.success:
-                return nxt
-            result = nxt
-        return result
+        halved = tuple(split_intervals(m, np.full(m.size - 1, 2, dtype=np.int64))
+                       for m in result.mesh)
+        if max(m.size for m in halved) > MAX_REFINED_KNOTS:
+            return result
+        return self.on_grid("mesh check (halved)", halved, result)
 
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
