@@ -5,7 +5,7 @@ For every control model and grid it solves the default problem (ankle+impulse, f
 Markdown row per grid: cost and step length at 12 m/min, the speed-free speed, step length
 and cost, the largest collocation error estimate and where it sits (phase, interval, and the
 interval's position in the phase), and the wall time. ``--clearance`` adds a swing-clearance
-profile (m). ``--json FILE`` appends the rows as JSON lines.
+profile (m), ``--profile`` its shape. ``--json FILE`` appends the rows as JSON lines.
 
 Models: ``paper`` (controls continuous at the heel strike and periodic), ``states-only``
 (the paper's model with ``periodic_controls=False``), ``jumps`` (no control linkages).
@@ -46,7 +46,7 @@ def worst_interval(result: Result) -> str:
 
 
 def row(model: str, grid: tuple[int, int], clearance: float | None,
-        profile: str = "parabola") -> dict[str, Any]:
+        profile: str = "quartic") -> dict[str, Any]:
     robot = load_model("five-link")
     options = GaitOptions(knots=grid, swing_clearance=clearance,
                           clearance_profile=profile,  # type: ignore[arg-type]
@@ -85,7 +85,7 @@ def main() -> None:
     ap.add_argument("--models", nargs="+", default=list(MODELS), choices=list(MODELS))
     ap.add_argument("--grids", nargs="+", default=[f"{a},{b}" for a, b in GRIDS])
     ap.add_argument("--clearance", type=float, default=None)
-    ap.add_argument("--profile", default="parabola", choices=["parabola", "quartic"])
+    ap.add_argument("--profile", default="quartic", choices=["quartic", "parabola"])
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
     grids = [tuple(int(v) for v in g.split(",")) for g in args.grids]

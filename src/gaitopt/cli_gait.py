@@ -98,9 +98,9 @@ def _knots(text: str) -> tuple[int, int]:
               help="Swing-tip clearance c in m: height >= c 4 s (1 - s) over single support "
                    "(default: >= 0, the paper).")
 @click.option("--clearance-profile", type=click.Choice(["parabola", "quartic"]),
-              default="parabola", show_default=True,
-              help="Clearance profile: c 4 s (1 - s), or c (4 s (1 - s))^2 (no least tip "
-                   "velocity at the events).")
+              default="quartic", show_default=True,
+              help="Clearance profile: c (4 s (1 - s))^2, or c 4 s (1 - s) (which also asks "
+                   "for a least vertical tip velocity 4 c / T1 at liftoff and heel strike).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("--multistart", is_flag=True,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "

@@ -70,10 +70,13 @@ class GaitOptions:
             ``periodic_controls``, periodic at the liftoff) or ``"jumps"`` (no control
             linkages: the torques may jump at both events).
         swing_clearance: ``c`` (m), the least mid-swing height of the swing tip: over single
-            support ``y >= c 4 s (1 - s)`` (``clearance_profile="parabola"``) or
-            ``y >= c (4 s (1 - s))^2`` (``"quartic"``), ``s`` the normalised phase time; or
+            support ``y >= c (4 s (1 - s))^2`` (``clearance_profile="quartic"``) or
+            ``y >= c 4 s (1 - s)`` (``"parabola"``), ``s`` the normalised phase time; or
             ``None`` (the paper: ``y >= 0``).
-        clearance_profile: ``"parabola"`` or ``"quartic"`` (see ``swing_clearance``).
+        clearance_profile: ``"quartic"`` or ``"parabola"`` (see ``swing_clearance``). The
+            parabola's slope at the ends is a least vertical tip velocity ``4 c / T1`` at the
+            liftoff and the heel strike, which makes its cost grow with the grid (measured in
+            docs/walking.md); the quartic has zero slope there.
     """
 
     speed: float | None = 0.2
@@ -100,7 +103,7 @@ class GaitOptions:
     mesh_tol: float | None = None
     control_model: ControlModel = "paper"
     swing_clearance: float | None = None
-    clearance_profile: ClearanceProfile = "parabola"
+    clearance_profile: ClearanceProfile = "quartic"
 
     # -- derived -------------------------------------------------------------------------------
     @property
