@@ -18,8 +18,9 @@ itself, in stages that each warm-start the next (primal values and multipliers):
    limited-memory Hessian, :data:`FINE_STAGE_OPTIONS`);
 5. ``mesh refinement N`` (with ``mesh_tol``): every interval whose collocation error estimate
    exceeds ``mesh_tol`` is split (:func:`gaitopt.ocp.refined_mesh`) and the problem solved
-   again from the last solution, until every estimate is within ``mesh_tol``; the rounds work
-   on the :class:`~gaitopt.ocp.Transcription` and :class:`~gaitopt.ocp.Result` only.
+   again from the last solution, until every estimate is within ``mesh_tol``; then ``mesh
+   check (halved)``: every interval halved, for the cost error estimate. The rounds work on
+   the :class:`~gaitopt.ocp.Transcription` and :class:`~gaitopt.ocp.Result` only.
 
 If stage 1 or 2 fails, the same is tried from guesses with shorter and longer steps, then by
 continuation in speed from the reference speed (12 m/min). With ``multistart`` all three
@@ -465,15 +466,20 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
 
 
 def warm_start_grid(options: GaitOptions, warm_start: Guess | Result) -> Grid:
-    """The grid of a warm start: ``options.knots``, or with ``mesh_tol`` the warm start's own
-    mesh (a refined gait's non-uniform knots) when it has one for every phase."""
+    """The grid of a warm start: ``options.knots``; with ``mesh_tol``, the warm start's own
+    mesh (a refined gait's non-uniform knots), every other knot of it when each phase has an
+    odd number >= 5: the mesh before the halving that ended its refinement, so that a chain
+    of warm starts (a sweep) does not double the grid at every point."""
     if options.mesh_tol is None:
         return options.knots
     if isinstance(warm_start, Result):
-        return tuple(warm_start.mesh)
-    taus = [None if g.tau is None else np.asarray(g.tau, dtype=float)
-            for g in warm_start.phases.values()]
+        taus = [np.asarray(m, dtype=float) for m in warm_start.mesh]
+    else:
+        taus = [np.asarray(g.tau, dtype=float) for g in warm_start.phases.values()
+                if g.tau is not None]
     phases = 2 if options.double_support else 1
-    if len(taus) != phases or any(t is None or t.size < 2 for t in taus):
+    if len(taus) != phases or any(t.size < 2 for t in taus):
         return options.knots
-    return tuple(t for t in taus if t is not None)
+    if all(t.size % 2 == 1 and t.size >= 5 for t in taus):
+        taus = [t[::2] for t in taus]
+    return tuple(taus)
