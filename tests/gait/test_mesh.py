@@ -119,13 +119,15 @@ def test_a_warm_start_keeps_the_refined_mesh(refined: Solved) -> None:
 
 @pytest.mark.slow
 def test_the_cost_error_estimate_bounds_the_difference_to_a_fine_grid() -> None:
-    """The refined cost (mesh_tol 1e-4) is within twice its reported estimate, and within
-    0.1 % of the cost on a uniform 160 + 40 grid."""
+    """The refined cost (mesh_tol 1e-4) differs from the cost on a uniform 160 + 40 grid by
+    less than its reported estimate."""
     options = GaitOptions(control_model="jumps", mesh_tol=1e-4)
     refined = solve_gait_solution("five-link", options)
     fine = solve_gait_solution("five-link", options.replace(mesh_tol=None, knots=(160, 40)))
     assert refined.success and fine.success
     acc = gait_from_solution(refined).solver["accuracy"]
     gap = abs(refined.result.objective - fine.result.objective)
-    assert gap <= max(2.0 * abs(acc["cost_error"]), 1e-3 * fine.result.objective)
+    print(f"refined {refined.result.objective:.4f} (estimate {acc['cost_error']:+.4f}), "
+          f"160 + 40: {fine.result.objective:.4f}")
     assert math.isfinite(acc["cost_error"])
+    assert gap <= abs(acc["cost_error"])

@@ -10,9 +10,9 @@ Constraints (``docs/walking.md`` lists each with its reason): torque bounds, joi
 polar box ``r_min <= r <= r_max`` on the stance leg, the swing tip above the ground, normal
 contact forces ``>= 0`` at knots and midpoints, normal impulses ``>= 0`` at the heel
 strike and the liftoff, the lifting tip moving up after liftoff, tip 2 landing at ``(L, 0)``,
-the front leg's reach in double support, optional friction cones, continuity of controls
-between the phases and periodicity of states (through the liftoff map) and controls with the
-legs relabelled.
+the front leg's reach in double support, optional friction cones, an optional swing clearance
+profile, periodicity of states (through the liftoff map) and, with the paper's control model,
+continuity of controls between the phases and their periodicity with the legs relabelled.
 """
 
 from __future__ import annotations
@@ -396,7 +396,7 @@ def _periodic_controls(model: RobotModel, from_phase: str, from_controls: Sequen
 CLEARANCE = "swing clearance profile"
 
 
-def clearance_profile(clearance: float, s: Any, profile: str = "parabola") -> Any:
+def clearance_profile(clearance: float, s: Any, profile: str) -> Any:
     """The least swing-tip height (m) at normalised single-support time ``s`` in [0, 1]:
     ``c 4 s (1 - s)`` (``"parabola"``) or ``c (4 s (1 - s))^2`` (``"quartic"``); both are 0
     at the liftoff and the heel strike and ``c`` at mid-swing. The parabola's slope at the
