@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import click
 from rich.table import Table
 
 from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
+from gaitopt.gait.formulation import biped_of
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError
+from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
@@ -108,6 +111,20 @@ def _knots(text: str) -> tuple[int, int]:
               help="Resting power of the metabolic cost, W/kg [default: 1.2].")
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="Weight of an added mean squared torque (u / u_max)^2 term.")
+@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
+              show_default=True,
+              help="Controls continuous at the heel strike and periodic (paper), or free to "
+                   "jump at both events (jumps).")
+@click.option("--mesh-tol", type=float, default=None,
+              help="Refine the mesh until every interval's collocation error estimate is "
+                   "<= TOL (e.g. 1e-4); default: the fixed grid --knots.")
+@click.option("--clearance", type=float, default=None,
+              help="Swing-tip clearance c in m: height >= c 4 s (1 - s) over single support "
+                   "(default: >= 0, the paper).")
+@click.option("--clearance-profile", type=click.Choice(["parabola", "quartic"]),
+              default="quartic", show_default=True,
+              help="Clearance profile: c (4 s (1 - s))^2, or c 4 s (1 - s) (which also asks "
+                   "for a least vertical tip velocity 4 c / T1 at liftoff and heel strike).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("--multistart", is_flag=True,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "
@@ -123,7 +140,9 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str,
                   min_knee_flexion: float | None, gait_kind: str, cost: str,
-                  resting_power: float | None, regularization: float, compiled: bool,
+                  resting_power: float | None, regularization: float,
+                  control_model: str, mesh_tol: float | None,
+                  clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
@@ -148,11 +167,18 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
         formulation=formulation,  # type: ignore[arg-type]
         gait=gait_kind, cost=cost,  # type: ignore[arg-type]
-        cost_regularization=regularization)
+        cost_regularization=regularization,
+        control_model=control_model,  # type: ignore[arg-type]
+        mesh_tol=mesh_tol, swing_clearance=clearance,
+        clearance_profile=clearance_profile)  # type: ignore[arg-type]
     if resting_power is not None:
         options = options.replace(resting_power=resting_power)
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
+    try:
+        validate_options(options, biped_of(model, options))
+    except (GaitOptionsError, BipedStructureError) as exc:
+        raise UserError(str(exc)) from None
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
@@ -214,10 +240,31 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
                   f"equality, {s['inequality_constraints']} inequality constraints")
     table.add_row("iterations (last stage)", str(s["iterations"]))
+    for row in accuracy_rows(s["accuracy"]):
+        table.add_row(*row)
     table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
     console.print(table)
     gait.save(output)
     console.print(f"wrote {output}")
+
+
+def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase and
+    the cost's discretization error estimate."""
+    errors = ", ".join(f"{name} {'n/a' if e is None else f'{e:.1e}'} "
+                       f"({accuracy['knots'][name]} knots)"
+                       for name, e in accuracy["collocation_error"].items())
+    tol = accuracy["mesh_tol"]
+    if tol is not None:
+        errors += f"; mesh_tol {tol:g} {'met' if accuracy['mesh_converged'] else 'NOT met'}"
+    rows = [("collocation error (largest per interval)", errors)]
+    if accuracy["cost_error"] is None:
+        rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
+    else:
+        prev = "+".join(str(k) for k in accuracy["previous_knots"].values())
+        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s (change "
+                     f"from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+    return rows
 
 
 @cli.command("verify")

@@ -86,6 +86,8 @@ CLEARANCE = "free points above the ground"
 #: The same for the points that touch down at the end of the phase (not at its last knot,
 #: where the touchdown constraint puts them on the ground).
 LANDING_CLEARANCE = "landing points above the ground"
+#: The optional swing clearance profile of the first phase (the reduced problem's name).
+CLEARANCE_PROFILE = "swing clearance profile"
 #: Boundary constraints of the events (suffixes of ``<event>: ...``).
 TOUCHDOWN = "touchdown at the anchor"
 IMPULSES = "normal impulses"
@@ -203,6 +205,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
                                for c in points])
 
             path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf, scale=0.1))
+        if options.swing_clearance is not None and not phases and landing:
+            path.append(_clearance_profile(model, options, landing, ph.fraction))
 
         def dynamics(x: Any, u: Any, p: Any, t: Any, point: Any = point) -> Any:
             return point(x, u).xdot
@@ -294,12 +298,12 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
 
             events.append(BoundaryConstraint(f"{ev.name}: {RISE}", rise, lower=0.0,
                                              upper=ca.inf, scale=0.1))
-        if not last:
+        if not last and options.control_model == "paper":
             shared = [a for a in actuators_of[src] if a in actuators_of[dst]]
             if shared:
                 linkages.append(ControlLinkage(src, dst, controls=shared,
                                                name=f"controls continuous at {ev.name}"))
-    if options.periodic_controls:
+    if options.periodic_controls and options.control_model == "paper":
         linkages.append(_periodic_controls(model, symmetry, seq, actuators_of))
     if options.step_time is not None:
         events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
@@ -341,6 +345,26 @@ def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
         return total
 
     return mayer
+
+
+def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence[str],
+                       fraction: float) -> PathConstraint:
+    """The swing clearance of the first phase (:func:`gaitopt.gait.problem.clearance_profile`):
+    each point landing at its end stays above ``profile(s)``, ``s = t v / (f L)``."""
+    from gaitopt.gait.problem import clearance_profile
+
+    assert options.swing_clearance is not None
+    height = options.swing_clearance
+    nq = model.nq
+
+    def fn(x: Any, u: Any, p: Any, t: Any) -> Any:
+        q = vector(as_scalars(x, 2 * nq, "x")[:nq])
+        s = t * p[_V] / (fraction * p[_L])
+        low = clearance_profile(height, s, options.clearance_profile)
+        return vector([as_scalars(contact_position(model, q, c), 2, "p")[1] - low
+                       for c in points])
+
+    return PathConstraint(CLEARANCE_PROFILE, fn, lower=0.0, upper=ca.inf, scale=0.1)
 
 
 def _step_share(fraction: float) -> Callable[[Any], Any]:
@@ -385,7 +409,9 @@ def full_stage_bounds(tr: Transcription, force: float, impulse: float) -> Bounds
             bounds = bounds.with_rows(first, -ca.inf, ca.inf)
         # Heights at the first knot repeat the previous phase's last knot (events keep q);
         # landing points are on the ground at the last knot by the touchdown constraint.
-        for label, knots in ((CLEARANCE, (0,)), (LANDING_CLEARANCE, (0, block.shape[0] - 1))):
+        last = block.shape[0] - 1
+        for label, knots in ((CLEARANCE, (0,)), (LANDING_CLEARANCE, (0, last)),
+                             (CLEARANCE_PROFILE, (0, last))):
             if label in rows_of:
                 pr = rows_of[label]
                 for k in knots:

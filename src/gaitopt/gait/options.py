@@ -24,6 +24,12 @@ Formulation = Literal["reduced", "full"]
 GaitKind = Literal["walk", "run"]
 CostName = Literal["paper", "work", "metabolic"]
 FORMULATIONS: tuple[str, ...] = ("reduced", "full")
+ControlModel = Literal["paper", "jumps"]
+#: The control models (see ``docs/walking.md``, "Control model").
+CONTROL_MODELS = ("paper", "jumps")
+ClearanceProfile = Literal["parabola", "quartic"]
+#: The swing clearance profiles (see ``docs/walking.md``, "Swing clearance").
+CLEARANCE_PROFILES = ("parabola", "quartic")
 
 
 class GaitOptionsError(ValueError):
@@ -85,6 +91,19 @@ class GaitOptions:
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, and keep the lowest optimum (slower; a cold solve can
             otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
+        mesh_tol: refine the mesh after the fixed-grid stages until every interval's
+            collocation error estimate is <= mesh_tol (``None``: the fixed grid ``knots``).
+        control_model: ``"paper"`` (controls continuous at the heel strike and, with
+            ``periodic_controls``, periodic at the liftoff) or ``"jumps"`` (no control
+            linkages: the torques may jump at both events).
+        swing_clearance: ``c`` (m), the least mid-swing height of the swing tip: over single
+            support ``y >= c (4 s (1 - s))^2`` (``clearance_profile="quartic"``) or
+            ``y >= c 4 s (1 - s)`` (``"parabola"``), ``s`` the normalised phase time; or
+            ``None`` (the paper: ``y >= 0``).
+        clearance_profile: ``"quartic"`` or ``"parabola"`` (see ``swing_clearance``). The
+            parabola's slope at the ends is a least vertical tip velocity ``4 c / T1`` at the
+            liftoff and the heel strike, which makes its cost grow with the grid (measured in
+            docs/walking.md); the quartic has zero slope there.
     """
 
     speed: float | None = 0.2
@@ -116,6 +135,10 @@ class GaitOptions:
     resting_power: float = 1.2
     cost_smoothing: float = 0.01
     cost_regularization: float = 0.0
+    mesh_tol: float | None = None
+    control_model: ControlModel = "paper"
+    swing_clearance: float | None = None
+    clearance_profile: ClearanceProfile = "quartic"
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -275,3 +298,17 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         raise GaitOptionsError(f"tol = {o.tol!r}: must lie in (0, 1)")
     if not isinstance(o.max_iter, int) or o.max_iter < 1:
         raise GaitOptionsError(f"max_iter = {o.max_iter!r}: must be a positive integer")
+    if o.mesh_tol is not None and not 0.0 < _finite("mesh_tol", o.mesh_tol) < 1.0:
+        raise GaitOptionsError(f"mesh_tol = {o.mesh_tol!r}: must lie in (0, 1) "
+                               "(or None for the fixed grid)")
+    if o.control_model not in CONTROL_MODELS:
+        raise GaitOptionsError(f"control_model = {o.control_model!r}: must be one of "
+                               f"{', '.join(repr(m) for m in CONTROL_MODELS)}")
+    if o.swing_clearance is not None:
+        c = _finite("swing_clearance", o.swing_clearance)
+        if not 0.0 < c < reach:
+            raise GaitOptionsError(f"swing_clearance = {c:g} m: must lie in (0, {reach:.3f}) m "
+                                   "(above the ground, below the leg's reach; or None)")
+    if o.clearance_profile not in CLEARANCE_PROFILES:
+        raise GaitOptionsError(f"clearance_profile = {o.clearance_profile!r}: must be one of "
+                               f"{', '.join(repr(m) for m in CLEARANCE_PROFILES)}")

@@ -10,9 +10,9 @@ Constraints (``docs/walking.md`` lists each with its reason): torque bounds, joi
 polar box ``r_min <= r <= r_max`` on the stance leg, the swing tip above the ground, normal
 contact forces ``>= 0`` at knots and midpoints, normal impulses ``>= 0`` at the heel
 strike and the liftoff, the lifting tip moving up after liftoff, tip 2 landing at ``(L, 0)``,
-the front leg's reach in double support, optional friction cones, continuity of controls
-between the phases and periodicity of states (through the liftoff map) and controls with the
-legs relabelled.
+the front leg's reach in double support, optional friction cones, an optional swing clearance
+profile, periodicity of states (through the liftoff map) and, with the paper's control model,
+continuity of controls between the phases and their periodicity with the legs relabelled.
 """
 
 from __future__ import annotations
@@ -228,6 +228,10 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         PathConstraint("swing clearance and stance hip limit", ss_geometry,
                        lower=[0.0, hip_lo], upper=[ca.inf, hip_hi], scale=[0.1, 1.0]),
     ]
+    if options.swing_clearance is not None:
+        ss_path.append(_clearance_constraint(model, swing, options.swing_clearance,
+                                             options.clearance_profile, f,
+                                             lambda x, u, p: ss(x, u, p).solution.q))
     phase1 = Phase(
         name=SINGLE, states=ss_states, controls=ss_controls, dynamics=ss_dynamics,
         duration=Duration.of_parameters(lambda p: f * p[_L] / p[_V]),
@@ -337,11 +341,13 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
                                          lambda ends, p: departure(lift(ends, p)),
                                          lower=[impulse_floor, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
-        # Controls: continuous across the heel strike, periodic with legs relabelled.
-        shared = [n for n in ss_controls if n in ds_controls]
-        linkages.append(ControlLinkage(SINGLE, DOUBLE, controls=shared,
-                                       name="controls continuous at heel strike"))
-        if options.periodic_controls:
+        # Controls (paper model): continuous across the heel strike, periodic with legs
+        # relabelled. The "jumps" model has no control linkages.
+        if options.control_model == "paper":
+            shared = [n for n in ss_controls if n in ds_controls]
+            linkages.append(ControlLinkage(SINGLE, DOUBLE, controls=shared,
+                                           name="controls continuous at heel strike"))
+        if options.periodic_controls and options.control_model == "paper":
             linkages.append(_periodic_controls(model, DOUBLE, ds_controls, ss_controls))
     else:
         linkages.append(Linkage(
@@ -353,7 +359,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
                                          lambda ends, p: departure(strike(ends, p)),
                                          lower=[impulse_floor, 0.0],
                                          upper=ca.inf, scale=[1.0, 0.1]))
-        if options.periodic_controls:
+        if options.periodic_controls and options.control_model == "paper":
             linkages.append(_periodic_controls(model, SINGLE, ss_controls, ss_controls))
 
     bounds = parameter_bounds(options)
@@ -406,3 +412,31 @@ def _periodic_controls(model: RobotModel, from_phase: str, from_controls: Sequen
 
     return ControlLinkage(from_phase, SINGLE, fn=fn, controls=targets,
                           name="controls periodic (legs relabelled)")
+
+
+#: Name of the swing clearance profile constraint (see :func:`clearance_profile`).
+CLEARANCE = "swing clearance profile"
+
+
+def clearance_profile(clearance: float, s: Any, profile: str) -> Any:
+    """The least swing-tip height (m) at normalised single-support time ``s`` in [0, 1]:
+    ``c 4 s (1 - s)`` (``"parabola"``) or ``c (4 s (1 - s))^2`` (``"quartic"``); both are 0
+    at the liftoff and the heel strike and ``c`` at mid-swing. The parabola's slope at the
+    ends, ``4 c / T1``, is a least vertical tip velocity at both events; the quartic's is
+    zero."""
+    bump = 4.0 * s * (1.0 - s)
+    return clearance * (bump if profile == "parabola" else bump * bump)
+
+
+def _clearance_constraint(model: RobotModel, swing: Any, clearance: float, profile: str,
+                          fraction: float,
+                          configuration: Callable[[Any, Any, Any], Any]) -> PathConstraint:
+    """``y_tip(q) - profile(s) >= 0`` over single support, with ``s = t / T1`` and
+    ``T1 = f L / v`` (single support starts the step at ``t = 0``)."""
+
+    def fn(x: Any, u: Any, p: Any, t: Any) -> Any:
+        s = t * p[_V] / (fraction * p[_L])
+        return walking.tip_height(model, configuration(x, u, p), swing) \
+            - clearance_profile(clearance, s, profile)
+
+    return PathConstraint(CLEARANCE, fn, lower=0.0, upper=ca.inf, scale=0.1)

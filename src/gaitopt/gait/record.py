@@ -20,6 +20,7 @@ from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.kinematics import point_position
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import cost, walking
+from gaitopt.gait.accuracy import accuracy_record
 from gaitopt.gait.formulation import contact_sequence
 from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
@@ -143,6 +144,7 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
                     "success": s.success, "iterations": s.iterations,
                     "objective": s.objective, "wall_time_s": s.wall_time_s}
                    for s in solution.stages],
+        "accuracy": accuracy_record(solution),
     }
     return Gait(
         model_data=model.to_dict(), options=options.to_dict(),

@@ -15,7 +15,12 @@ itself, in stages that each warm-start the next (primal values and multipliers):
    keeps the impulse variants from stopping in worse local minima than the no-impulse gait;
 4. ``target grid``: the requested grid, if finer, from the coarse solution interpolated
    (started with a small barrier, :data:`PRIMAL_WARM_OPTIONS`, and solved with a
-   limited-memory Hessian, :data:`FINE_STAGE_OPTIONS`).
+   limited-memory Hessian, :data:`FINE_STAGE_OPTIONS`);
+5. ``mesh refinement N`` (with ``mesh_tol``): every interval whose collocation error estimate
+   exceeds ``mesh_tol`` is split (:func:`gaitopt.ocp.refined_mesh`) and the problem solved
+   again from the last solution, until every estimate is within ``mesh_tol``; then ``mesh
+   check (halved)``: every interval halved, for the cost error estimate. The rounds work on
+   the :class:`~gaitopt.ocp.Transcription` and :class:`~gaitopt.ocp.Result` only.
 
 If stage 1 or 2 fails, the same is tried from guesses with shorter and longer steps, then by
 continuation in speed from the reference speed (12 m/min). With ``multistart`` all three
@@ -51,7 +56,16 @@ from gaitopt.gait.guess import (
 )
 from gaitopt.gait.options import GaitOptions, validate_options
 from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
-from gaitopt.ocp import Bounds, Guess, PhaseGuess, Result, Transcription, transcribe
+from gaitopt.ocp import (
+    Bounds,
+    Guess,
+    PhaseGuess,
+    Result,
+    Transcription,
+    refined_mesh,
+    transcribe,
+)
+from gaitopt.ocp.mesh import split_intervals
 from gaitopt.robot.model import RobotModel
 
 #: Reference speed (m/s) for the continuation fallback: the paper's optimal 12 m/min.
@@ -94,7 +108,16 @@ def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
     at IPOPT's acceptable level, against 23 + 13 with the exact Hessian (12 m/min)."""
     return dict(FINE_STAGE_OPTIONS) if options.formulation == "reduced" else {}
 
+
+#: Most refinement rounds after the fixed-grid stages, and most knots per phase they may make
+#: (the bound of ``GaitOptions.knots``).
+MAX_REFINEMENTS = 6
+MAX_REFINED_KNOTS = 400
+
 ProgressFn = Callable[["StageReport"], None]
+#: A grid: knots per phase (single support, double support), uniform, or one array of
+#: normalised knot times in [0, 1] per phase of the problem (a refined mesh).
+Grid = tuple[int, int] | tuple[np.ndarray, ...]
 
 
 @dataclass(frozen=True)
@@ -110,6 +133,9 @@ class StageReport:
     violation: float
     wall_time_s: float
     parameters: dict[str, float]
+    #: Solves the target problem itself (no relaxation, nothing held): its objective is
+    #: comparable between grids (the cost error estimate uses it).
+    full_problem: bool = False
 
     def line(self) -> str:
         p = self.parameters
@@ -130,6 +156,9 @@ class WalkingSolution:
     result: Result
     stages: tuple[StageReport, ...]
     wall_time_s: float
+    #: The full-problem stages that converged, (knots per phase, cost), in order: the grids
+    #: the cost was computed on (the cost error estimate compares the last two).
+    grid_costs: tuple[tuple[tuple[int, ...], float], ...] = ()
 
     @property
     def success(self) -> bool:
@@ -147,29 +176,52 @@ class WalkingSolution:
 _CACHE: dict[tuple[Any, ...], Transcription] = {}
 
 
+def is_mesh(grid: Grid) -> bool:
+    """Whether ``grid`` is a mesh (arrays of normalised knots) rather than knot counts."""
+    return not all(isinstance(k, int | np.integer) for k in grid)
+
+
+def grid_knots(grid: Grid, options: GaitOptions) -> tuple[int, int]:
+    """Knots per phase of a grid (a phase the problem lacks keeps ``options.knots``)."""
+    if not is_mesh(grid):
+        return (int(grid[0]), int(grid[1]))
+    sizes = [np.asarray(m).size for m in grid]
+    return (sizes[0], sizes[1] if len(sizes) > 1 else options.knots[1])
+
+
+def _grid_key(grid: Grid) -> tuple[Any, ...]:
+    if not is_mesh(grid):
+        return tuple(int(k) for k in grid)
+    return tuple(tuple(float(v) for v in np.asarray(m)) for m in grid)
+
+
 #: Options that enter a solve only through bounds or the solve's own logic, never the NLP's
 #: structure: problems that differ only in these share one transcription.
 BOUNDS_ONLY_OPTIONS = frozenset({"speed", "step_length", "step_time", "knots", "multistart",
-                                 "continuation"})
+                                 "continuation", "mesh_tol"})
 
 
-def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, int],
+def _structure_key(model: RobotModel, options: GaitOptions, grid: Grid,
                    compiled: str | None) -> tuple[Any, ...]:
     """Every option that shapes the NLP (all but :data:`BOUNDS_ONLY_OPTIONS`), the model,
     the grid, whether a step-time row exists, and the compilation mode."""
     shaping = sorted((k, repr(v)) for k, v in dataclasses.asdict(options).items()
                      if k not in BOUNDS_ONLY_OPTIONS)
-    return (model.content_hash(), tuple(knots), options.step_time is not None, compiled,
+    return (model.content_hash(), _grid_key(grid), options.step_time is not None, compiled,
             tuple(shaping))
 
 
-def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int, int], *,
+def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
                       compiled: str | None = None) -> Transcription:
-    """The (process-wide cached) transcription of the walking problem on ``knots``."""
+    """The (process-wide cached) transcription of the walking problem on ``knots`` (knot
+    counts per phase, or a mesh: normalised knot times per phase)."""
     key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
-        problem = problem_for(model, options.replace(knots=tuple(knots)))
-        intervals = {problem.phases[i].name: knots[i] - 1 for i in range(len(problem.phases))}
+        counts = grid_knots(knots, options)
+        problem = problem_for(model, options.replace(knots=counts))
+        intervals: dict[str, Any] = {
+            ph.name: (np.asarray(knots[i], dtype=float) if is_mesh(knots) else counts[i] - 1)
+            for i, ph in enumerate(problem.phases)}
         _CACHE[key] = transcribe(
             problem, method=options.transcription, intervals=intervals, compiled=compiled,
             options={"ipopt.tol": options.tol, "ipopt.max_iter": options.max_iter,
@@ -214,8 +266,9 @@ class _Run:
             compiled
         self.stages: list[StageReport] = []
         self.results: list[Result] = []
+        self.grid_costs: list[tuple[tuple[int, ...], float]] = []
 
-    def stage(self, name: str, knots: tuple[int, int], relax: Relaxation,
+    def stage(self, name: str, knots: Grid, relax: Relaxation,
               guess: Guess | Result, bounds: dict[str, Any], *,
               hold_ankles: bool = False, solver_options: dict[str, Any] | None = None,
               problem: GaitOptions | None = None) -> Result:
@@ -231,13 +284,17 @@ class _Run:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
                           warm_start_multipliers=isinstance(guess, Result))
+        full = (relax == Relaxation() and not hold_ankles
+                and dict(bounds) == dict(parameter_bounds(self.options)))
         report = StageReport(
-            name=name, knots=(knots[0], knots[1]), status=result.status, success=result.success,
-            iterations=result.iterations, objective=result.objective,
+            name=name, knots=grid_knots(knots, self.options), status=result.status,
+            success=result.success, iterations=result.iterations, objective=result.objective,
             violation=result.constraint_violation, wall_time_s=time.perf_counter() - start,
-            parameters=dict(result.parameters))
+            parameters=dict(result.parameters), full_problem=full)
         self.stages.append(report)
         self.results.append(result)
+        if full and result.success:
+            self.grid_costs.append((tuple(m.size for m in result.mesh), result.objective))
         if self.progress is not None:
             self.progress(report)
         return result
@@ -312,17 +369,49 @@ class _Run:
         o = self.options
         if tuple(o.knots) == coarse_knots(o):
             return result
+        return self.on_grid("target grid", o.knots, result)
+
+    def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
+        """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
+        at ``result``'s, then (stage ``name, all free``) released."""
+        o = self.options
         held = dict(parameter_bounds(o))
-        for name in ("step_length", "speed"):
-            held[name] = (result.parameters[name], result.parameters[name])
-        fine = self.stage("target grid", o.knots, Relaxation(), result, held,
+        for key in ("step_length", "speed"):
+            held[key] = (result.parameters[key], result.parameters[key])
+        fine = self.stage(name, grid, Relaxation(), result, held,
                           solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
         if not fine.success or all_fixed:
             return fine
-        return self.stage("target grid, all free", o.knots, Relaxation(), fine,
+        return self.stage(f"{name}, all free", grid, Relaxation(), fine,
                           parameter_bounds(o), solver_options=fine_stage_options(o))
+
+    def refine_mesh(self, result: Result) -> Result:
+        """Refinement rounds (``mesh_tol``): split the intervals whose error estimate exceeds
+        the tolerance and solve again from ``result`` until every estimate is within it (at
+        most :data:`MAX_REFINEMENTS` rounds and :data:`MAX_REFINED_KNOTS` knots per phase);
+        then one round on that mesh with every interval halved, whose solution is the
+        answer and whose cost change from the mesh before is the cost error estimate
+        (:mod:`gaitopt.gait.accuracy`). Successive adaptive meshes differ by a few knots
+        only, so their cost change says little about the remaining error."""
+        tol = self.options.mesh_tol
+        if tol is None:
+            return result
+        for round_ in range(1, MAX_REFINEMENTS + 1):
+            if result.max_error <= tol:
+                break
+            mesh = refined_mesh(result, tol)
+            if max(m.size for m in mesh) > MAX_REFINED_KNOTS:
+                break
+            result = self.on_grid(f"mesh refinement {round_}", mesh, result)
+            if not result.success:
+                return result
+        halved = tuple(split_intervals(m, np.full(m.size - 1, 2, dtype=np.int64))
+                       for m in result.mesh)
+        if max(m.size for m in halved) > MAX_REFINED_KNOTS:
+            return result
+        return self.on_grid("mesh check (halved)", halved, result)
 
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
@@ -414,8 +503,9 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
     if warm_start is not None:
-        result = run.stage("warm start", options.knots, Relaxation(), warm_start,
-                           parameter_bounds(options), solver_options=PRIMAL_WARM_OPTIONS)
+        result = run.stage("warm start", warm_start_grid(options, warm_start), Relaxation(),
+                           warm_start, parameter_bounds(options),
+                           solver_options=PRIMAL_WARM_OPTIONS)
         if not result.success:
             result = None
     outcome: Result | None = result
@@ -432,6 +522,29 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
             outcome = run.release(coarse)
             if outcome.success:
                 outcome = run.refine(outcome)
+    if outcome is not None and outcome.success:
+        outcome = run.refine_mesh(outcome)
     final = outcome if outcome is not None and outcome.success else run.final()
     return WalkingSolution(model=model, options=options, result=final,
-                           stages=tuple(run.stages), wall_time_s=time.perf_counter() - start)
+                           stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
+                           grid_costs=tuple(run.grid_costs))
+
+
+def warm_start_grid(options: GaitOptions, warm_start: Guess | Result) -> Grid:
+    """The grid of a warm start: ``options.knots``; with ``mesh_tol``, the warm start's own
+    mesh (a refined gait's non-uniform knots), every other knot of it when each phase has an
+    odd number >= 5: the mesh before the halving that ended its refinement, so that a chain
+    of warm starts (a sweep) does not double the grid at every point."""
+    if options.mesh_tol is None:
+        return options.knots
+    if isinstance(warm_start, Result):
+        taus = [np.asarray(m, dtype=float) for m in warm_start.mesh]
+    else:
+        taus = [np.asarray(g.tau, dtype=float) for g in warm_start.phases.values()
+                if g.tau is not None]
+    phases = 2 if options.double_support else 1
+    if len(taus) != phases or any(t.size < 2 for t in taus):
+        return options.knots
+    if all(t.size % 2 == 1 and t.size >= 5 for t in taus):
+        taus = [t[::2] for t in taus]
+    return tuple(taus)

@@ -13,7 +13,8 @@ For each event at the end of phase i (its time equals that phase's last knot):
 * ``events.periodicity``: the state after the last event, legs relabelled
   (:func:`~gaitopt.gait.gait_file.leg_swap_permutations`) and shifted back one step length,
   equals the first knot; ``events.periodic_controls`` the same for the controls of the
-  actuators acting at both ends, if the gait was solved with periodic controls.
+  actuators acting at both ends, if the gait was solved with periodic controls (and the
+  paper's control model: with ``control_model = "jumps"`` the torques may jump at the events).
 """
 
 from __future__ import annotations
@@ -122,7 +123,8 @@ def _periodicity_checks(gait: Gait, q_end: Array, qd_end: Array, lim: dict[str, 
     label = names[k] if k < len(names) else f"{names[k - len(names)]}_rate"
     checks = [Check("events.periodicity", float(err[k]), lim["events.periodicity"],
                     f"{label}")]
-    if gait.options.get("periodic_controls", True):
+    if (gait.options.get("periodic_controls", True)
+            and gait.options.get("control_model", "paper") == "paper"):
         u_next = last.u[-1][perm_u]
         active = np.abs(first.u[0]) > 0  # actuators that act at the start of the step
         both = active & (np.abs(u_next) > 0)
