@@ -7,9 +7,11 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
    each phase replaying its torque profile ``u(tau)`` on its own clock ``tau`` (0 at the phase
    start; piecewise linear between knots, the last value held if a perturbed phase runs
    longer), until the guard ``g(q) = y_swing tip = 0`` is crossed moving down with the swing
-   tip ahead of the stance tip (a crossing behind it, the scuffing of a rigid swing leg at
-   mid-stance, is ignored); the crossing is found by the integrator's root finder on its
-   dense output (state-triggered);
+   tip more than ``arm_distance`` ahead of the stance tip (earlier crossings are ignored: the
+   scuffing of a rigid swing leg at mid-stance, and the grazing of the ground by optimal gaits
+   whose swing clearance constraint is active; a tip still below the ground there must come
+   up first); the crossing is found by the integrator's root finder on its dense output
+   (state-triggered);
 2. the **heel-strike impact** ``qd+ = Delta(q, qd-)`` (:func:`gaitopt.dynamics.impact`) with the
    contacts held in double support (or the striking tip alone when the gait has none);
 3. **double support** for a fixed duration (time-triggered);
@@ -39,6 +41,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import casadi as ca
 import numpy as np
@@ -82,32 +85,31 @@ class PhaseProfile:
     qdd: Array | None = None
     nominal_duration: float = 0.0
 
-    def controls(self, tau: float) -> Array:
-        return np.array([np.interp(tau, self.t, self.u[:, j]) for j in range(self.u.shape[1])])
-
-    def references(self, tau: float, nq: int) -> tuple[Array, Array]:
-        """``(q_ref, qd_ref)`` at ``tau`` (zeros when there is no reference)."""
-        if self.q is None or self.qd is None or self.qdd is None:
-            return np.zeros(nq), np.zeros(nq)
+    def inputs(self, tau: float) -> tuple[Array, Array | None, Array | None]:
+        """``(u, q_ref, qd_ref)`` at ``tau`` (the references None without PD knots)."""
         t = self.t
-        if tau >= t[-1]:
-            return self.q[-1].copy(), self.qd[-1].copy()
         k = int(np.clip(np.searchsorted(t, tau, side="right") - 1, 0, t.size - 2))
         h = t[k + 1] - t[k]
-        s = max(0.0, (tau - t[k]) / h)
+        s = min(max((tau - t[k]) / h, 0.0), 1.0)
+        u = (1.0 - s) * self.u[k] + s * self.u[k + 1]
+        if self.q is None or self.qd is None or self.qdd is None:
+            return u, None, None
+        if tau >= t[-1]:
+            return u, self.q[-1], self.qd[-1]
         h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
         h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
         q = h00 * self.q[k] + h * h10 * self.qd[k] + h01 * self.q[k + 1] + h * h11 * self.qd[k + 1]
         qd = (h00 * self.qd[k] + h * h10 * self.qdd[k] + h01 * self.qd[k + 1]
               + h * h11 * self.qdd[k + 1])
-        return q, qd
+        return u, q, qd
 
 
 @dataclass(frozen=True, eq=False)
 class StepSpec:
     """Everything the return map needs: the model, the stance and swing contacts, the single-
     support phase (ends at the guard), the optional double-support phase (fixed duration), the
-    contacts held by the heel-strike impact, the liftoff impulse magnitude (N s), optional PD
+    contacts held by the heel-strike impact, the liftoff impulse magnitude (N s), the distance
+    (m) the swing tip must be ahead of the stance tip before the guard is armed, optional PD
     gains ``(kp, kd)`` (N m/rad, N m s/rad) and the integrator tolerances."""
 
     model: RobotModel
@@ -117,12 +119,13 @@ class StepSpec:
     double: PhaseProfile | None
     impact_contacts: tuple[str, ...]
     liftoff_magnitude: float = 0.0
+    arm_distance: float = 0.0
     pd: tuple[float, float] | None = None
     rtol: float = 1e-11
     atol: float = 1e-11
     _functions: dict[str, ca.Function] = field(default_factory=dict, repr=False)
 
-    @property
+    @cached_property
     def nq(self) -> int:
         return self.model.nq
 
@@ -248,22 +251,28 @@ def _eval(f: ca.Function, *args: Array) -> list[Array]:
 
 def phase_rhs(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> tuple[Array, Array]:
     """The vector field ``f(tau, y)`` (2 nq,) of a phase and its Jacobian ``A`` (2 nq, 2 nq)."""
-    q_ref, qd_ref = phase.references(tau, spec.nq)
-    ydot, a = _eval(_rhs(spec, phase.contacts), y, phase.controls(tau), q_ref, qd_ref)
+    u, q_ref, qd_ref = phase.inputs(tau)
+    zero = np.zeros(spec.nq)
+    ydot, a = _eval(_rhs(spec, phase.contacts), y, u, zero if q_ref is None else q_ref,
+                    zero if qd_ref is None else qd_ref)
     return ydot.ravel(), a
 
 
 def phase_field(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> Array:
     """The vector field ``f(tau, y)`` (2 nq,) of a phase."""
-    q_ref, qd_ref = phase.references(tau, spec.nq)
+    u, q_ref, qd_ref = phase.inputs(tau)
+    zero = np.zeros(spec.nq)
     f = _rhs(spec, phase.contacts, jacobian=False)
-    return np.asarray(f(y, phase.controls(tau), q_ref, qd_ref), dtype=float).ravel()
+    return np.asarray(f(y, u, zero if q_ref is None else q_ref,
+                        zero if qd_ref is None else qd_ref), dtype=float).ravel()
 
 
 def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational: bool,
-                     until: float | None = None) -> tuple[float, Array, Array | None]:
-    """Integrate a phase from ``tau = 0``; stop at ``until`` (if given), at ``phase.duration``
-    (time-triggered), or at the guard (``duration`` None). Returns ``(tau_end, y, Phi)``."""
+                     until: float | None = None, tau0: float = 0.0,
+                     guard: bool | None = None) -> tuple[float, Array, Array | None]:
+    """Integrate a phase from ``tau0`` (0: the phase start); stop at ``until`` (if given and
+    ``guard`` is not True), at ``phase.duration`` (time-triggered), or at the guard
+    (``duration`` None, or ``guard=True``). Returns ``(tau_end, y, Phi)``."""
     n = 2 * spec.nq
     swing = _tip(spec, spec.swing)
     stance = _tip(spec, spec.stance)
@@ -275,20 +284,22 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
         return np.concatenate([ydot, (a @ z[n:].reshape(n, n)).ravel()])
 
     def ahead(tau: float, z: Array) -> float:
-        return float(_eval(swing, z[:n])[0][0, 0] - _eval(stance, z[:n])[0][0, 0])
+        return float(_eval(swing, z[:n])[0][0, 0] - _eval(stance, z[:n])[0][0, 0]
+                     - spec.arm_distance)
 
     def height(tau: float, z: Array) -> float:
         return float(_eval(swing, z[:n])[0][1, 0])
 
     ahead.terminal, ahead.direction = True, 1.0  # type: ignore[attr-defined]
     height.terminal, height.direction = True, -1.0  # type: ignore[attr-defined]
-    guard = phase.duration is None and until is None
-    end = until if until is not None else phase.duration
+    if guard is None:
+        guard = phase.duration is None and until is None
+    end = until if until is not None and not guard else phase.duration
     if end is None:  # state-triggered: search up to three nominal durations
         end = 3.0 * max(phase.nominal_duration, float(phase.t[-1]))
-    breaks = [b for b in phase.t if 0.0 < b < end] + [end]
+    breaks = [b for b in phase.t if tau0 < b < end] + [end]
     z = np.concatenate([y0, np.eye(n).ravel()]) if variational else np.asarray(y0, float)
-    tau, armed = 0.0, ahead(0.0, z) > 0.0
+    tau, armed = tau0, ahead(tau0, z) > 0.0
     for stop in breaks:
         while tau < stop:
             events = ([height] if armed else [ahead]) if guard else None
@@ -329,8 +340,10 @@ def saltation_matrix(spec: StepSpec, y_minus: Array, f_minus: Array, f_plus: Arr
     return d_delta + np.outer(f_plus - d_delta @ f_minus, dg) / rate
 
 
-def impact_state(spec: StepSpec, y_minus: Array) -> Array:
-    return _eval(_impact_jump(spec), y_minus)[0].ravel()
+def impact_jump(spec: StepSpec, y_minus: Array) -> tuple[Array, Array]:
+    """The heel-strike jump ``y+ = (q, qd+(q, qd-))`` (2 nq,) and its Jacobian (2 nq, 2 nq)."""
+    y_plus, jac = _eval(_impact_jump(spec), np.asarray(y_minus, float))
+    return y_plus.ravel(), jac
 
 
 def simulate_step(spec: StepSpec, y0: Array, *, variational: bool = False) -> StepResult:
@@ -375,9 +388,12 @@ def simulate_step(spec: StepSpec, y0: Array, *, variational: bool = False) -> St
 
 
 def integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, until: float | None = None,
-                    *, variational: bool = False) -> tuple[float, Array, Array | None]:
-    """Public form of the phase integration: ``(tau_end, y_end, Phi or None)``."""
-    return _integrate_phase(spec, phase, np.asarray(y0, float), variational, until)
+                    *, tau0: float = 0.0, guard: bool | None = None,
+                    variational: bool = False) -> tuple[float, Array, Array | None]:
+    """Integrate ``phase`` from ``y0`` at clock time ``tau0`` to ``until``, to its duration,
+    or (``guard=True``, or a state-triggered phase without ``until``) to the heel-strike
+    guard: ``(tau_end, y_end (2 nq,), Phi (2 nq, 2 nq) or None)``."""
+    return _integrate_phase(spec, phase, np.asarray(y0, float), variational, until, tau0, guard)
 
 
 def step_map(spec: StepSpec, y0: Array) -> Array:
@@ -402,3 +418,59 @@ def section_constraints(spec: StepSpec, y: Array) -> tuple[Array, Array]:
     ``C = [[J, 0], [d(J qd)/dq, J]]``; the section is ``{position = 0, velocity = 0}``."""
     p, v, c = _eval(_tip(spec, spec.stance), np.asarray(y, float))
     return np.concatenate([p.ravel(), v.ravel()]), c
+
+
+def reference_step(spec: StepSpec) -> StepResult:
+    """The monodromy linearized about the phases' own reference trajectories (the gait's knots
+    interpolated: ``q`` cubic Hermite with ``qd``, ``qd`` with ``qdd``) instead of a simulated
+    step: ``Phi' = A(tau, y_ref(tau)) Phi`` over each phase's nominal duration, the jump
+    Jacobians at the saved pre-event states, and the guard factor with ``f-`` the model's
+    vector field at the saved pre-impact state. ``y_next`` is the gait's own next start (its
+    periodicity residual is the transcription's)."""
+    n = 2 * spec.nq
+    phases = [spec.single] + ([spec.double] if spec.double is not None else [])
+    for ph in phases:
+        if ph.q is None or ph.qd is None:
+            raise StepSimulationError("linearizing about the gait needs its knots")
+
+    def reference(ph: PhaseProfile, tau: float) -> Array:
+        _, q, qd = ph.inputs(tau)
+        assert q is not None and qd is not None
+        return np.concatenate([q, qd])
+
+    def along(ph: PhaseProfile) -> Array:
+        def rhs(tau: float, z: Array) -> Array:
+            _, a = phase_rhs(spec, ph, tau, reference(ph, tau))
+            return (a @ z.reshape(n, n)).ravel()
+
+        z, tau = np.eye(n).ravel(), 0.0
+        for stop in [b for b in ph.t if b > 0.0]:
+            sol = solve_ivp(rhs, (tau, float(stop)), z, method="DOP853", rtol=spec.rtol,
+                            atol=spec.atol)
+            z, tau = np.asarray(sol.y[:, -1], float), float(stop)
+        return z.reshape(n, n)
+
+    single = spec.single
+    t1 = float(single.t[-1])
+    y_strike = reference(single, t1)
+    f_minus = phase_field(spec, single, t1, y_strike)
+    dg = guard_row(spec, y_strike)
+    y_imp, d_imp = (v for v in _eval(_impact_jump(spec), y_strike))
+    factors = {"phi_single": along(single),
+               "jump_strike": d_imp @ (np.eye(n) - np.outer(f_minus, dg) / float(dg @ f_minus))}
+    monodromy = factors["jump_strike"] @ factors["phi_single"]
+    y_end, t2 = y_imp.ravel(), 0.0
+    if spec.double is not None:
+        t2 = float(spec.double.t[-1])
+        y_ds = reference(spec.double, t2)
+        y_lift, d_lift = _eval(_liftoff_jump(spec), y_ds)
+        factors["phi_double"], factors["jump_liftoff"] = along(spec.double), d_lift
+        monodromy = d_lift @ factors["phi_double"] @ monodromy
+        y_end = y_lift.ravel()
+    else:
+        y_ds = y_end
+    y_next, d_swap = _eval(_swap_jump(spec), y_end)
+    factors["jump_swap"] = d_swap
+    return StepResult(y_next=y_next.ravel(), strike_time=t1, y_strike=y_strike,
+                      y_impact=y_imp.ravel(), y_liftoff=y_ds, step_time=t1 + t2,
+                      monodromy=d_swap @ monodromy, factors=factors)

@@ -39,6 +39,7 @@ from gaitopt.analysis.return_map import (
     StepSimulationError,
     StepSpec,
     phase_field,
+    reference_step,
     section_constraints,
     simulate_step,
     step_map,
@@ -51,6 +52,13 @@ from gaitopt.gait.gait_file import Gait, leg_swap_permutations
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
+
+About = Literal["simulation", "gait"]
+
+#: The heel-strike guard of a gait is armed once the swing tip is this fraction of the step
+#: length ahead of the stance tip (optimal gaits graze the ground earlier: their clearance
+#: constraint is active in mid-swing).
+ARM_FRACTION = 0.5
 
 #: Multipliers this close to 1 are reported as "at 1".
 UNIT_TOLERANCE = 1e-3
@@ -153,7 +161,7 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
                     double=double,
                     impact_contacts=double.contacts if double is not None else (swing,),
                     liftoff_magnitude=gait.parameters["liftoff_impulse"] if double else 0.0,
-                    pd=pd, rtol=rtol, atol=rtol)
+                    arm_distance=ARM_FRACTION * gait.step_length, pd=pd, rtol=rtol, atol=rtol)
 
 
 def gait_start(gait: Gait) -> Array:
@@ -224,10 +232,12 @@ def free_rotations(spec: StepSpec, states: list[Array]) -> list[tuple[str, Array
 # -- the analysis ------------------------------------------------------------------------------
 
 def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = 1e-6,
-            margin: float = 1e-3) -> dict[str, Any]:
-    """Monodromy, section restriction, removed directions and multipliers at ``y``."""
+            margin: float = 1e-3, about: About = "simulation") -> dict[str, Any]:
+    """Monodromy, section restriction, removed directions and multipliers at ``y``
+    (``about="gait"``: linearized about the reference trajectories, no finite differences)."""
     nq, n = spec.nq, 2 * spec.nq
-    result = simulate_step(spec, y, variational=True)
+    result = (reference_step(spec) if about == "gait"
+              else simulate_step(spec, y, variational=True))
     assert result.monodromy is not None
     phi = result.monodromy
     basis, c = tangent_basis(spec, y)
@@ -281,7 +291,7 @@ def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = 1e
                      "autonomous system: a shift along the orbit does not change the next "
                      "step's start)")
     fd_agreement = None
-    if check:
+    if check and about == "simulation":
         full_basis, _ = tangent_basis(spec, y)
         fd = np.empty((n, full_basis.shape[1]))
         for j in range(full_basis.shape[1]):
@@ -316,44 +326,57 @@ def newton_fixed_point(spec: StepSpec, y0: Array, *, tol: float = 1e-8,
 
 
 def analyse_step(spec: StepSpec, y0: Array, *, fixed_point: Literal["start", "newton"] = "start",
-                 check: bool = True, margin: float = 1e-3) -> StabilityReport:
+                 check: bool = True, margin: float = 1e-3,
+                 about: About = "simulation") -> StabilityReport:
     """:class:`StabilityReport` of the return map ``spec`` at ``y0`` or at the fixed point
-    Newton's method finds from it."""
+    Newton's method finds from it; ``about="gait"`` linearizes about the reference
+    trajectories of ``spec`` (a gait's knots) instead of the simulated step."""
     y0 = np.asarray(y0, dtype=float)
-    start_residual = float(np.max(np.abs(step_map(spec, y0) - y0)))
+    if about == "gait":
+        if fixed_point == "newton":
+            raise StabilityError("fixed_point='newton' needs about='simulation'")
+        start_residual = float(np.max(np.abs(reference_step(spec).y_next - y0)))
+    else:
+        start_residual = float(np.max(np.abs(step_map(spec, y0) - y0)))
     y = newton_fixed_point(spec, y0)[0] if fixed_point == "newton" else y0
-    out = floquet(spec, y, check=check, margin=margin)
+    out = floquet(spec, y, check=check, margin=margin, about=about)
     result = out["result"]
     return StabilityReport(
         multipliers=out["multipliers"], spectral_radius=out["radius"], verdict=out["verdict"],
         margin=margin, removed=tuple(out["removed"]), notes=tuple(out["notes"]),
-        fixed_point="newton" if fixed_point == "newton" else "gait start",
+        fixed_point=("newton" if fixed_point == "newton" else "gait start") + (
+            " (linearized about the gait's knots)" if about == "gait" else ""),
         residual=out["residual"], start_residual=start_residual, state=y,
         step_time=result.step_time, monodromy=out["monodromy"],
         section_monodromy=out["reduced"], basis=out["basis"],
         fd_agreement=out["fd_agreement"],
         settings={"pd": None if spec.pd is None else list(spec.pd),
                   "pd_torques_bounded": False, "rtol": spec.rtol, "atol": spec.atol,
-                  "margin": margin, "fd_step": 1e-6 if check else None,
+                  "margin": margin, "about": about,
+                  "fd_step": 1e-6 if check and about == "simulation" else None,
                   "unit_tolerance": UNIT_TOLERANCE})
 
 
 def gait_stability(gait: Gait, *, pd: tuple[float, float] | None = None,
                    fixed_point: Literal["start", "newton"] = "start", check: bool = True,
-                   margin: float = 1e-3, rtol: float = 1e-10) -> StabilityReport:
+                   margin: float = 1e-3, rtol: float = 1e-10,
+                   about: About = "simulation") -> StabilityReport:
     """Orbital stability of ``gait``: Floquet multipliers of its return map (module docstring).
 
     ``pd=(kp, kd)`` adds joint-space PD tracking of the gait's knots (N m/rad, N m s/rad;
     torques unbounded). ``fixed_point="newton"`` first finds the nearby fixed point of the
     simulated map; ``"start"`` analyses at the gait's own start state (its residual says how
     periodic the simulated gait is). ``check`` also computes the finite-difference monodromy.
+    ``about="gait"`` linearizes about the gait's own (interpolated) knots instead of the
+    simulated step: the multipliers of the orbit the optimizer found, meaningful when the
+    open-loop simulation drifts far from it (no finite-difference check then).
     Raises :class:`StabilityError` for a failed gait or one whose simulated step has no heel
     strike.
     """
     spec = step_from_gait(gait, pd=pd, rtol=rtol)
     try:
         return analyse_step(spec, gait_start(gait), fixed_point=fixed_point, check=check,
-                            margin=margin)
+                            margin=margin, about=about)
     except StepSimulationError as exc:
         raise StabilityError(f"the simulated step fails ({exc}); the open-loop replay of a "
                              "coarse gait can diverge before the heel strike: try PD tracking "
