@@ -401,18 +401,6 @@ def step_map(spec: StepSpec, y0: Array) -> Array:
     return simulate_step(spec, y0).y_next
 
 
-def finite_difference_monodromy(spec: StepSpec, y0: Array, step: float = 1e-5) -> Array:
-    """Central differences of :func:`step_map` in every full coordinate, ``(2 nq, 2 nq)``."""
-    y0 = np.asarray(y0, dtype=float)
-    n = y0.size
-    out = np.empty((n, n))
-    for j in range(n):
-        e = np.zeros(n)
-        e[j] = step
-        out[:, j] = (step_map(spec, y0 + e) - step_map(spec, y0 - e)) / (2 * step)
-    return out
-
-
 def section_constraints(spec: StepSpec, y: Array) -> tuple[Array, Array]:
     """The stance tip's position and velocity (4,) and their Jacobian ``C`` (4, 2 nq):
     ``C = [[J, 0], [d(J qd)/dq, J]]``; the section is ``{position = 0, velocity = 0}``."""

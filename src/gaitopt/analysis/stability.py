@@ -60,6 +60,12 @@ About = Literal["simulation", "gait"]
 #: constraint is active in mid-swing).
 ARM_FRACTION = 0.5
 
+#: Step of the central differences along the section's tangent basis (rad, m, rad/s, m/s).
+#: The five-link gaits' maps are strongly nonlinear (their swing tip lands almost tangentially,
+#: so the heel-strike time is very sensitive): 1.3e-6 relative agreement at 1e-6, 1.3e-4 at
+#: 1e-5 (PD 300, 30); the smoother compass map prefers 1e-5 (5e-6; 7e-5 at 1e-6).
+FD_STEP = 1e-6
+
 #: Multipliers this close to 1 are reported as "at 1".
 UNIT_TOLERANCE = 1e-3
 
@@ -84,8 +90,8 @@ class StabilityReport:
 
     ``multipliers`` (complex, sorted by modulus, largest first); ``verdict`` "stable" if the
     spectral radius is < 1 - ``margin``, "unstable" if > 1 + ``margin``, else "marginal";
-    ``fixed_point``: "gait start" or "newton"; ``residual``: max |P(y) - y| at the analysed
-    state (rad, m, rad/s, m/s) and ``start_residual`` at the gait's own start state;
+    ``fixed_point``: "gait start" or "Newton fixed point"; ``residual``: max |P(y) - y| at the
+    analysed state (rad, m, rad/s, m/s) and ``start_residual`` at the gait's own start state;
     ``monodromy`` (2 nq, 2 nq) from the variational equations, ``section_monodromy`` on the
     tangent basis ``basis`` (2 nq, m); ``fd_agreement``: the finite-difference check (None if
     not run)."""
@@ -231,7 +237,7 @@ def free_rotations(spec: StepSpec, states: list[Array]) -> list[tuple[str, Array
 
 # -- the analysis ------------------------------------------------------------------------------
 
-def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = 1e-6,
+def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = FD_STEP,
             margin: float = 1e-3, about: About = "simulation") -> dict[str, Any]:
     """Monodromy, section restriction, removed directions and multipliers at ``y``
     (``about="gait"``: linearized about the reference trajectories, no finite differences)."""
@@ -268,9 +274,9 @@ def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = 1e
         basis = basis @ rest
     else:
         reduced = basis.T @ phi @ basis
-    mult = np.linalg.eigvals(reduced)
+    mult, vecs = np.linalg.eig(reduced)
     order = np.argsort(-np.abs(mult), kind="stable")
-    mult, vecs = mult[order], np.linalg.eig(reduced)[1][:, order]
+    mult, vecs = mult[order], vecs[:, order]
     radius = float(np.max(np.abs(mult))) if mult.size else 0.0
     verdict = ("stable" if radius < 1 - margin else "unstable" if radius > 1 + margin
                else "marginal")
@@ -309,7 +315,8 @@ def newton_fixed_point(spec: StepSpec, y0: Array, *, tol: float = 1e-8,
                        max_iter: int = 20) -> tuple[Array, int]:
     """A fixed point of the return map near ``y0`` by Newton's method on the section:
     ``dz = -lstsq(V^T Phi V - I, V^T (P(y) - y))``, ``y <- project(y + V dz)``. Returns
-    ``(y*, iterations)``; raises :class:`StabilityError` if it does not converge."""
+    ``(y*, iterations)``; raises :class:`StabilityError` if it does not converge (undamped: it
+    needs a start near the fixed point)."""
     y = project_to_section(spec, y0)
     for it in range(max_iter):
         result = simulate_step(spec, y, variational=True)
@@ -326,8 +333,8 @@ def newton_fixed_point(spec: StepSpec, y0: Array, *, tol: float = 1e-8,
 
 
 def analyse_step(spec: StepSpec, y0: Array, *, fixed_point: Literal["start", "newton"] = "start",
-                 check: bool = True, margin: float = 1e-3,
-                 about: About = "simulation") -> StabilityReport:
+                 check: bool = True, margin: float = 1e-3, about: About = "simulation",
+                 fd_step: float = FD_STEP) -> StabilityReport:
     """:class:`StabilityReport` of the return map ``spec`` at ``y0`` or at the fixed point
     Newton's method finds from it; ``about="gait"`` linearizes about the reference
     trajectories of ``spec`` (a gait's knots) instead of the simulated step."""
@@ -339,12 +346,12 @@ def analyse_step(spec: StepSpec, y0: Array, *, fixed_point: Literal["start", "ne
     else:
         start_residual = float(np.max(np.abs(step_map(spec, y0) - y0)))
     y = newton_fixed_point(spec, y0)[0] if fixed_point == "newton" else y0
-    out = floquet(spec, y, check=check, margin=margin, about=about)
+    out = floquet(spec, y, check=check, margin=margin, about=about, fd_step=fd_step)
     result = out["result"]
     return StabilityReport(
         multipliers=out["multipliers"], spectral_radius=out["radius"], verdict=out["verdict"],
         margin=margin, removed=tuple(out["removed"]), notes=tuple(out["notes"]),
-        fixed_point=("newton" if fixed_point == "newton" else "gait start") + (
+        fixed_point=("Newton fixed point" if fixed_point == "newton" else "gait start") + (
             " (linearized about the gait's knots)" if about == "gait" else ""),
         residual=out["residual"], start_residual=start_residual, state=y,
         step_time=result.step_time, monodromy=out["monodromy"],
@@ -353,7 +360,7 @@ def analyse_step(spec: StepSpec, y0: Array, *, fixed_point: Literal["start", "ne
         settings={"pd": None if spec.pd is None else list(spec.pd),
                   "pd_torques_bounded": False, "rtol": spec.rtol, "atol": spec.atol,
                   "margin": margin, "about": about,
-                  "fd_step": 1e-6 if check and about == "simulation" else None,
+                  "fd_step": fd_step if check and about == "simulation" else None,
                   "unit_tolerance": UNIT_TOLERANCE})
 
 
