@@ -284,3 +284,16 @@ def test_cli_prints_multipliers_and_writes_json(gait: Gait, tmp_path: Path) -> N
     assert data["verdict"] == "unstable"
     assert len(data["multipliers"]) == 2 * gait.model.nq - 4
     assert data["removed"][0]["count"] == 4
+
+
+def test_cli_reports_a_replay_that_never_lands(gait: Gait, tmp_path: Path) -> None:
+    """The coarse gait's open-loop replay leaves the orbit before the heel strike: one line,
+    exit status 1, nothing written."""
+    path = gait.save(tmp_path / "g.gait.json")
+    out = tmp_path / "report.json"
+    result = CliRunner().invoke(cli, ["stability", str(path), "--json", str(out)])
+    assert result.exit_code == 1, result.output
+    text = " ".join(result.output.split())
+    assert text.startswith("FAILED") and "did not strike" in text and "--pd" in text
+    assert "Traceback" not in result.output
+    assert not out.exists()
