@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
-from gaitopt.codegen import compile_functions
+from gaitopt.codegen import CompileError, compile_functions
 from gaitopt.dynamics.actuation import actuation_rows
 from gaitopt.dynamics.functions import (
     contact_dynamics_function,
@@ -155,9 +155,13 @@ class StepResult:
 # -- CasADi functions ---------------------------------------------------------------------------
 
 def _compiled(spec: StepSpec, function: ca.Function) -> ca.Function:
-    """``function`` compiled to C (cached on disk by its source; see :mod:`gaitopt.codegen`)."""
+    """``function`` compiled to C (cached on disk by its source; see :mod:`gaitopt.codegen`),
+    or as it is if no C compiler works (slower, same results)."""
     name = f"gaitopt_stability_{spec.model.content_hash()}_{function.name()}"
-    return compile_functions([function], re.sub(r"\W", "_", name))[function.name()]
+    try:
+        return compile_functions([function], re.sub(r"\W", "_", name))[function.name()]
+    except CompileError:
+        return function
 
 
 def _rhs(spec: StepSpec, contacts: tuple[str, ...], jacobian: bool = True) -> ca.Function:

@@ -228,7 +228,7 @@ def free_rotations(spec: StepSpec, states: list[Array]) -> list[tuple[str, Array
             scale = np.max(np.abs(m_abs))
             others = np.delete(m_abs[2 + k], 2 + k)
             free = free and bool(np.max(np.abs(others)) <= 1e-12 * scale
-                                 and abs(g_abs[2 + k]) <= 1e-12 * scale * 10.0
+                                 and abs(g_abs[2 + k]) <= 1e-12 * np.max(np.abs(g_abs))
                                  and np.max(np.abs(jac @ v)) <= 1e-12)
         if free:
             out.append((link.name, v / np.linalg.norm(v)))
