@@ -44,6 +44,7 @@ from gaitopt.gait import solve as gait_solve
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution, solve_walking
 from gaitopt.ocp import Result
+from gaitopt.ocp.result import METHODS
 from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot import load_model
 
@@ -80,11 +81,12 @@ class Measure:
 
 def points_per_g(result: Result) -> int:
     """Dynamics evaluations in one evaluation of g: knots, plus midpoints for
-    Hermite-Simpson."""
+    Hermite-Simpson (either form)."""
+    mid = METHODS[result.method].needs_midpoint_dynamics
     total = 0
     for ph in result.phases:
         k = ph.t.size
-        total += k + (k - 1 if result.method == "hermite-simpson" else 0)
+        total += k + (k - 1 if mid else 0)
     return total
 
 

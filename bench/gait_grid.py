@@ -8,13 +8,15 @@ pass rate, median and largest time per variant), with the load average before an
 machine is shared, so times are noisy. The first point of each variant also builds its NLP
 (a few seconds); the later points of the variant reuse it (the process-wide cache).
 
-Verify column: ``pass``, or the failed checks (``interval`` re-integration per interval,
-``limits`` joint limits between knots, ``force`` normal force on the dense samples,
+Verify column: ``pass``, or the failed checks, looked up by stable id (:data:`SHORT`:
+``interval`` re-integration per interval, ``limits`` joint limits between knots, ``force``
+normal force on the dense samples; other checks by their id),
 ``force@strike`` the force check failed only because of the dense sample at the heel-strike
 instant, the verify bug recorded in tests/gait/test_verify.py: recomputed with each sample in
 its own phase, no normal force is negative).
 
-Run: ``python bench/gait_grid.py [--speeds 3 6 ...] [--variants plain ankle] [--json FILE]``
+Run: ``python bench/gait_grid.py [--speeds 3 6 ...] [--variants plain ankle] [--json FILE]
+[--transcription hermite-simpson-separated]``
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from gaitopt.analysis.verify import LIMITS, verify_gait
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 
 VARIANTS = {
@@ -43,18 +45,20 @@ VARIANTS = {
     "plain": {"ankle": False, "impulse": False},
 }
 SPEEDS_M_MIN = tuple(range(3, 61, 3))
+#: Short labels of the verify checks by stable id (``gaitopt.analysis.verify.CHECKS``); a
+#: check without a label here is shown by its id.
 SHORT = {
-    "re-integration per interval": "interval",
-    "normal contact force (negative part)": "force",
-    "held tips on the ground": "tips",
-    "impact and liftoff maps": "events",
-    "periodicity of states (legs relabelled)": "periodic",
-    "periodicity of controls": "periodic-u",
-    "torque bounds (excess)": "torque",
-    "joint limits at knots (excess)": "limits@knots",
-    "joint limits between knots (excess)": "limits",
-    "swing tip above ground (penetration)": "clearance",
-    "cost recomputed from the controls (relative)": "cost",
+    "integration.interval": "interval",
+    "samples.normal_force": "force",
+    "contacts.position": "tips",
+    "events.maps": "events",
+    "events.periodicity": "periodic",
+    "events.periodic_controls": "periodic-u",
+    "bounds.torque": "torque",
+    "bounds.joints_knots": "limits@knots",
+    "bounds.joints_samples": "limits",
+    "swing.clearance": "clearance",
+    "cost.recomputed": "cost",
 }
 
 
@@ -83,12 +87,14 @@ def load_average() -> str:
 
 def verify_summary(gait: Gait) -> str:
     report = verify_gait(gait)
-    failed = [c.name for c in report.checks if not c.passed]
+    failed = report.failed_ids
     if not failed:
         return "pass"
     names = [SHORT.get(n, n) for n in failed]
-    if "force" in names and lowest_force_by_phase(gait) >= -LIMITS["force"]:
-        names[names.index("force")] = "force@strike"
+    weight = gait.model.total_mass * float(np.hypot(*gait.model.gravity))
+    if ("samples.normal_force" in failed
+            and lowest_force_by_phase(gait) >= -LIMITS["samples.normal_force"] * weight):
+        names[failed.index("samples.normal_force")] = "force@strike"
     return " ".join(names)
 
 
@@ -109,8 +115,10 @@ def lowest_force_by_phase(gait: Gait) -> float:
     return lowest
 
 
-def solve_point(variant: str, speed_m_min: float, *, check: bool) -> Point:
-    options = GaitOptions(speed=speed_m_min / 60.0, **VARIANTS[variant])
+def solve_point(variant: str, speed_m_min: float, *, check: bool,
+                transcription: str = "hermite-simpson") -> Point:
+    options = GaitOptions(speed=speed_m_min / 60.0, transcription=transcription,  # type: ignore[arg-type]
+                          **VARIANTS[variant])
     start = time.perf_counter()
     solution = solve_gait_solution("five-link", options)
     wall = time.perf_counter() - start
@@ -167,6 +175,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     parser.add_argument("--no-verify", action="store_true", help="skip the verify column")
     parser.add_argument("--json", type=Path, help="also write the points as JSON")
+    parser.add_argument("--transcription", default="hermite-simpson", choices=TRANSCRIPTIONS,
+                        help="GaitOptions.transcription of every point")
     args = parser.parse_args(argv)
 
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
@@ -174,7 +184,8 @@ def main(argv: list[str] | None = None) -> None:
     for variant in args.variants:
         rows = []
         for speed in args.speeds:
-            point = solve_point(variant, speed, check=not args.no_verify)
+            point = solve_point(variant, speed, check=not args.no_verify,
+                                transcription=args.transcription)
             rows.append(point)
             print(f"  {variant:<14} {speed:5.1f} m/min  {'ok ' if point.success else 'FAIL'}"
                   f" {point.wall_time_s:6.2f} s  verify {point.verify}", flush=True)

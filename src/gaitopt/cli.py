@@ -19,13 +19,14 @@ from rich.text import Text
 
 from gaitopt import cli_gait, cli_stability, cli_study  # noqa: F401  (they register their subcommands)
 from gaitopt.cli_base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
-from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model
+from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model, model_to_yaml
+from gaitopt.robot.symmetry import SymmetryError, model_symmetry
 
 # -- gaitopt model ---------------------------------------------------------------------------
 
 @cli.group()
 def model() -> None:
-    """Show and export robot models (built-in models or model files)."""
+    """Show, export and import robot models (built-in models, model files, URDF)."""
 
 
 @model.command("show")
@@ -42,6 +43,11 @@ def model_show(name_or_file: str) -> None:
     console.print(f"gravity [m/s^2]: ({_g(m.gravity[0])}, {_g(m.gravity[1])})")
     console.print(f"coordinates q: [{', '.join(m.coordinate_names)}]")
     console.print(f"controls u:    [{', '.join(a.name for a in m.actuators)}]")
+    try:
+        symmetry = model_symmetry(m).describe()
+    except SymmetryError as exc:
+        symmetry = f"none ({exc})"
+    console.print(f"symmetry:      {symmetry}")
 
 
 def model_tables(m: RobotModel) -> list[Table]:
@@ -100,21 +106,37 @@ def _bounds(b: tuple[float, float]) -> str:
 
 
 @model.command("export")
-@click.argument("name", type=click.Choice(builtin_names()))
+@click.argument("name_or_file")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
-              help="File to write; '-' for standard output (default: NAME.yaml here).")
+              help="File to write; '-' for standard output (default: NAME.yaml or NAME.urdf "
+                   "here).")
+@click.option("--format", "fmt", type=click.Choice(["yaml", "urdf"]), default="yaml",
+              show_default=True, help="yaml: a gaitopt model file; urdf: a URDF robot "
+              "(docs/urdf.md).")
 @click.option("--force", is_flag=True, help="Overwrite an existing file.")
-def model_export(name: str, output: Path | None, force: bool) -> None:
-    """Write the built-in model NAME as a model file to edit (with its comments).
+def model_export(name_or_file: str, output: Path | None, fmt: str, force: bool) -> None:
+    """Write a model (a built-in NAME or a model FILE) as a model file to edit or as URDF.
 
-    Load the edited file with `gaitopt model show FILE` (and later commands' --model FILE).
+    A built-in model keeps its comments in YAML. Load the edited file with `gaitopt model
+    show FILE` (and later commands' --model FILE); import a URDF with `gaitopt model import`.
     """
-    text = builtin_text(name)
-    load_model(name)  # a built-in model that does not load is a bug: fail before writing
+    m = load_model(name_or_file)  # a model that does not load fails before anything is written
+    if fmt == "urdf":
+        from gaitopt.robot.urdf import urdf_from_model
+
+        text = urdf_from_model(m)
+    else:
+        text = builtin_text(name_or_file) if name_or_file in builtin_names() else model_to_yaml(m)
+    _write_output(text, output, Path(f"{m.name}.{fmt}"), force)
+
+
+def _write_output(text: str, output: Path | None, default: Path, force: bool) -> None:
+    """Write ``text`` atomically to ``output`` (``-``: standard output; None: ``default``),
+    refusing to replace an existing file without ``force``."""
     if output is not None and str(output) == "-":
         click.echo(text, nl=False)
         return
-    out = output or Path(f"{name}.yaml")
+    out = output or default
     if out.exists() and not force:
         raise UserError(f"{out} exists; pass --force to overwrite it")
     from gaitopt.fileio import write_text_atomic
@@ -124,6 +146,41 @@ def model_export(name: str, output: Path | None, force: bool) -> None:
     except OSError as exc:
         raise UserError(f"{out}: cannot write the file ({exc.strerror or exc})") from None
     click.echo(f"wrote {out}")
+
+
+@model.command("import")
+@click.argument("urdf", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              help="Model file to write; '-' for standard output (default: the URDF's name "
+                   "with .yaml, here).")
+@click.option("--contact", "contacts", multiple=True, metavar="NAME=LINK:X,Z",
+              help="Add a contact point NAME on URDF link LINK at (X, Z) m in that link's "
+                   "frame (Y, Z with --axis x). Repeatable; contact frames that gaitopt "
+                   "exported are read back without it.")
+@click.option("--axis", type=click.Choice(["y", "x"]), default="y", show_default=True,
+              help="The common joint axis: y (the sagittal plane is URDF x-z) or x (y-z).")
+@click.option("--name", help="Model name (default: the URDF robot's name).")
+@click.option("--force", is_flag=True, help="Overwrite an existing file.")
+def model_import(urdf: Path, output: Path | None, contacts: tuple[str, ...], axis: str,
+                 name: str | None, force: bool) -> None:
+    """Read the planar robot in the URDF file URDF and write a gaitopt model file.
+
+    Joints about the common axis become gaitopt joints (angles CCW about gaitopt z = URDF -y);
+    fixed joints merge links; the root link, or the link after a planar, floating or
+    prismatic-prismatic-revolute chain, is the floating base. See docs/urdf.md.
+    """
+    from gaitopt.robot.urdf import model_from_urdf, parse_contact_option
+
+    try:
+        specs = [parse_contact_option(c) for c in contacts]
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    m = model_from_urdf(urdf, contacts=specs, axis=axis, name=name)
+    header = f"# imported by `gaitopt model import` from {urdf.name}\n"
+    _write_output(header + model_to_yaml(m), output, Path(f"{urdf.stem}.yaml"), force)
+    if output is None or str(output) != "-":
+        click.echo(f"model {m.name}: {len(m.links)} links, {len(m.contacts)} contact points, "
+                   f"{m.nu} actuators, total mass {_g(m.total_mass)} kg")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -10,7 +11,7 @@ from rich.table import Table
 
 from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError
 from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
@@ -75,8 +76,11 @@ def _knots(text: str) -> tuple[int, int]:
               help="Single-support fraction of the step time; 1 = no double support.")
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
-@click.option("--transcription", type=click.Choice(["hermite-simpson", "trapezoidal"]),
-              default="hermite-simpson", show_default=True)
+@click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
+              default=GaitOptions().transcription, show_default=True,
+              help="hermite-simpson-separated: the same scheme with the midpoint states as "
+                   "variables (bounded like the knots), faster per iteration; see "
+                   "docs/benchmarks-gait.md.")
 @click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,
               help="Controls periodic as well as states (the paper), or states only.")
 @click.option("--friction", type=float, default=None,
@@ -84,6 +88,26 @@ def _knots(text: str) -> tuple[int, int]:
 @click.option("--unilateral-impulses/--paper-impulse-maps", default=True, show_default=True,
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
+@click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
+              show_default=True,
+              help="reduced: the paper's coordinates (five-link biped); full: the whole "
+                   "tree's q, qd with the held points as constraints (any two-legged model, "
+                   "knees may straighten).")
+@click.option("--min-knee-flexion", type=float, default=None,
+              help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
+                   "stance knee straighten, with --formulation full].")
+@click.option("--gait", "gait_kind", type=click.Choice(["walk", "run"]), default="walk",
+              show_default=True, help="The contact sequence: walk, or run (stance then flight; "
+                                      "needs --formulation full --no-impulse).")
+@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
+              show_default=True,
+              help="paper: torque squared per metre; work: mechanical cost of transport; "
+                   "metabolic: positive/negative work efficiencies and a resting power "
+                   "(docs/costs.md).")
+@click.option("--resting-power", type=float, default=None,
+              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
+@click.option("--regularization", type=float, default=0.0, show_default=True,
+              help="Weight of an added mean squared torque (u / u_max)^2 term.")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
 @click.option("--multistart", is_flag=True,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "
@@ -97,7 +121,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   impulse: bool,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
-                  unilateral_impulses: bool, compiled: bool, multistart: bool,
+                  unilateral_impulses: bool, formulation: str,
+                  min_knee_flexion: float | None, gait_kind: str, cost: str,
+                  resting_power: float | None, regularization: float, compiled: bool,
+                  multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
@@ -118,12 +145,20 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         single_support_fraction=single_support, knots=_knots(knots),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
-        unilateral_impulses=unilateral_impulses, multistart=multistart)
+        unilateral_impulses=unilateral_impulses, multistart=multistart,
+        formulation=formulation,  # type: ignore[arg-type]
+        gait=gait_kind, cost=cost,  # type: ignore[arg-type]
+        cost_regularization=regularization)
+    if resting_power is not None:
+        options = options.replace(resting_power=resting_power)
+    if min_knee_flexion is not None:
+        options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots")
+                  + f", {options.knots[0]}+{options.knots[1]} knots, {options.formulation} "
+                  "coordinates")
 
     if (start is None and not multistart and options.speed is not None
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
@@ -161,7 +196,11 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     table.add_row("step time", f"{p['step_time']:.4f} s (single support "
                   f"{p['single_support_time']:.4f} s)")
     table.add_row("liftoff impulse", f"{p['liftoff_impulse']:.4f} N s")
-    table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
+    if gait.options.get("cost", "paper") == "paper":
+        table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
+    else:
+        table.add_row(f"cost ({gait.options['cost']} cost of transport)",
+                      f"{gait.cost_value:.6g} (dimensionless)")
     for name, peak in metrics.peak_torques.items():
         bound = metrics.torque_bounds[name]
         table.add_row(f"peak torque {name}", f"{peak:8.2f} / {bound:g} N m "
@@ -185,26 +224,38 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
 @click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--tolerance", type=float, default=None,
               help="Scale every check's tolerance by this factor (default 1).")
-def verify_command(file: Path, tolerance: float | None) -> None:
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the report as JSON (checks by stable id) instead of a table.")
+def verify_command(file: Path, tolerance: float | None, as_json: bool) -> None:
     """Check a saved gait independently of the solver (exit status 1 if a check fails)."""
-    from gaitopt.analysis.verify import verify_gait
+    import json
 
+    from gaitopt.analysis.verify import UnknownStatesError, verify_gait
+
+    if tolerance is not None and not (math.isfinite(tolerance) and tolerance > 0):
+        raise UserError(f"--tolerance: got {tolerance:g}; allowed: a number > 0")
     console = make_console()
     try:
         gait = Gait.load(file)
-    except GaitFileError as exc:
+        report = verify_gait(gait, tolerance_scale=tolerance or 1.0)
+    except (GaitFileError, UnknownStatesError) as exc:
         raise UserError(str(exc)) from None
-    report = verify_gait(gait, tolerance_scale=tolerance or 1.0)
+    if as_json:
+        click.echo(json.dumps({"file": str(file), **report.to_dict()}, indent=1))
+        if not report.passed:
+            sys.exit(1)
+        return
     table = Table(title=f"verify {file}")
-    for col in ("check", "value", "limit", "result"):
+    for col in ("id", "check", "value", "limit", "result", "worst at"):
         table.add_column(col)
     for c in report.checks:
-        table.add_row(c.name, f"{c.value:.3g}", c.limit_text, "ok" if c.passed else "FAIL")
+        table.add_row(c.id, c.name, f"{c.value:.3g}", c.limit_text, "ok" if c.passed else "FAIL",
+                      c.where)
     console.print(table)
     if report.passed:
         console.print(f"all {len(report.checks)} checks passed")
     else:
-        failed = [c.name for c in report.checks if not c.passed]
+        failed = report.failed_ids
         console.print(f"{len(failed)} check(s) FAILED: {', '.join(failed)}")
         sys.exit(1)
 

@@ -84,7 +84,7 @@ def test_equations_of_motion_check_detects_a_wrong_force(
 
 def test_ankle_actuation_acts_on_torso_hip_and_knee_of_its_leg(
         default_gait: Gait, reference: RefFn) -> None:
-    """The Pinocchio actuation matrix used above has the structure DESIGN.md states."""
+    """The Pinocchio actuation matrix used above has the structure of docs/conventions.md §4."""
     model = default_gait.model
     ref = reference(model)
     q = default_gait.phases[1].q[0]

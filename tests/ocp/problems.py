@@ -203,3 +203,12 @@ def with_path_constraint(intervals: int = 20, limit: float = 1.2) -> Problem:
                path_constraints=[PathConstraint("speed", lambda x, u, p, t: x[1],
                                                 lower=-math.inf, upper=limit)])
     return Problem([ph])
+
+
+# --- 10. an active state bound (a box bound, at the knots) ---
+def with_state_bound(intervals: int = 10, limit: float = 1.2) -> Problem:
+    """Rest-to-rest double integrator with the state bound v <= limit (active)."""
+    ph = Phase("move", ["s", "v"], ["a"], double_integrator_dynamics, 1.0,
+               initial_state={"s": 0.0, "v": 0.0}, final_state={"s": 1.0, "v": 0.0},
+               state_bounds={"v": (-math.inf, limit)}, lagrange=energy, intervals=intervals)
+    return Problem([ph])

@@ -19,8 +19,13 @@ def knot_error(method: str, intervals: int) -> float:
     return float(np.max(np.abs(ph.x[:, 0] - P.smooth_lq_state(ph.t))))
 
 
+HS_FORMS = ["hermite-simpson", "hermite-simpson-separated"]
+
+
 @pytest.mark.parametrize(("method", "low", "high"),
-                         [("hermite-simpson", 12.0, 20.0), ("trapezoidal", 3.0, 5.0)])
+                         [("hermite-simpson", 12.0, 20.0),
+                          ("hermite-simpson-separated", 12.0, 20.0),
+                          ("trapezoidal", 3.0, 5.0)])
 def test_state_error_order_on_mesh_halving(method: str, low: float, high: float) -> None:
     errors = [knot_error(method, n) for n in (8, 16, 32)]
     ratios = [errors[i] / errors[i + 1] for i in range(2)]
@@ -29,8 +34,9 @@ def test_state_error_order_on_mesh_halving(method: str, low: float, high: float)
     assert ratios[-1] > ratios[0] * 0.95
 
 
-def test_hermite_simpson_beats_trapezoidal() -> None:
-    assert knot_error("hermite-simpson", 16) < 1e-2 * knot_error("trapezoidal", 16)
+@pytest.mark.parametrize("hs", HS_FORMS)
+def test_hermite_simpson_beats_trapezoidal(hs: str) -> None:
+    assert knot_error(hs, 16) < 1e-2 * knot_error("trapezoidal", 16)
 
 
 def local_errors(res) -> np.ndarray:  # type: ignore[no-untyped-def]
@@ -45,8 +51,9 @@ def local_errors(res) -> np.ndarray:  # type: ignore[no-untyped-def]
     return np.array(out)
 
 
-def test_error_estimate_ranks_intervals_like_the_true_local_error() -> None:
-    res = transcribe(P.boundary_layer(intervals=10)).solve()
+@pytest.mark.parametrize("hs", HS_FORMS)
+def test_error_estimate_ranks_intervals_like_the_true_local_error(hs: str) -> None:
+    res = transcribe(P.boundary_layer(intervals=10), method=hs).solve()
     est = res.phase(0).error
     ref = local_errors(res)
     assert int(np.argmax(est)) == 0 == int(np.argmax(ref))
@@ -55,9 +62,11 @@ def test_error_estimate_ranks_intervals_like_the_true_local_error() -> None:
     assert 0.1 < est[0] / ref[0] < 100.0
 
 
-def test_refinement_meets_tolerance_and_lowers_the_largest_error() -> None:
+@pytest.mark.parametrize("hs", HS_FORMS)
+def test_refinement_meets_tolerance_and_lowers_the_largest_error(hs: str) -> None:
     tol = 1e-7
-    out = refine(P.boundary_layer(intervals=10), tol=tol)
+    out = refine(P.boundary_layer(intervals=10), tol=tol, method=hs)
+    assert all(r.method == hs for r in out.history)
     errors = [r.max_error for r in out.history]
     assert out.converged and out.result.max_error <= tol
     assert len(out.history) >= 2
@@ -75,8 +84,9 @@ def test_refinement_meets_tolerance_and_lowers_the_largest_error() -> None:
     assert out.result.objective == pytest.approx(j_star, rel=1e-4)
 
 
-def test_refined_mesh_splits_only_bad_intervals() -> None:
-    res = transcribe(P.boundary_layer(intervals=10)).solve()
+@pytest.mark.parametrize("hs", HS_FORMS)
+def test_refined_mesh_splits_only_bad_intervals(hs: str) -> None:
+    res = transcribe(P.boundary_layer(intervals=10), method=hs).solve()
     err = res.phase(0).error
     tol = float(np.sort(err)[-3])  # the two largest are above tol
     new = refined_mesh(res, tol)[0]

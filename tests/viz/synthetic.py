@@ -38,7 +38,7 @@ from gaitopt.robot import RobotModel, load_model, model_to_dict
 
 Array = NDArray[np.float64]
 # q = [x, y, torso, hip_1, knee_1, hip_2, knee_2]; u = [hip_1, knee_1, ankle_1, hip_2, knee_2,
-# ankle_2] (DESIGN.md section 1).
+# ankle_2] (docs/conventions.md section 4).
 X, Y, TORSO, HIP_1, KNEE_1, HIP_2, KNEE_2 = range(7)
 U_HIP_1, U_KNEE_1, U_ANKLE_1, U_HIP_2, U_KNEE_2, U_ANKLE_2 = range(6)
 HIP_HEIGHT = 0.92  # m, mean hip height

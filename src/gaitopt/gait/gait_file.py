@@ -1,7 +1,7 @@
 """The gait file: one solved gait as a self-describing JSON document (``*.gait.json``).
 
-Format ``gaitopt.gait``, version 1 (``DESIGN.md`` section 2, field by field in
-``docs/outputs.md``). A :class:`Gait` holds one *step* of a symmetric periodic gait:
+Format ``gaitopt.gait``, version 1 (field by field in ``docs/outputs.md``; units, frames and the
+step in ``docs/conventions.md``). A :class:`Gait` holds one *step* of a symmetric periodic gait:
 
 * phase 1 (single support on leg 1, contact ``tip_1``) starts when leg 2 lifts off and ends
   when leg 2 strikes the ground at x = step length; phase 2 (double support) ends when leg 1
@@ -33,7 +33,7 @@ from datetime import UTC, datetime
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,6 +41,11 @@ from numpy.typing import NDArray
 from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
 from gaitopt.robot import ModelError, RobotModel, model_from_dict
+
+if TYPE_CHECKING:  # for annotations only: no viz import at run time
+    from matplotlib.figure import Figure
+
+    from gaitopt.viz.notebook import GifAnimation
 
 FORMAT = "gaitopt.gait"
 VERSION = 1
@@ -161,6 +166,9 @@ class GaitPhase:
     x: Array
     xdot: Array
     interpolation: Mapping[str, str] = field(default_factory=lambda: dict(DEFAULT_INTERPOLATION))
+    #: Optional (K-1,) per-interval error estimate of the transcription (relative, >= 0; see
+    #: :mod:`gaitopt.ocp.estimate`); ``None`` in files written before it existed.
+    error_estimate: Array | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -189,6 +197,11 @@ class GaitPhase:
             {c: _array(f"contact_forces.{c}", forces[c], (k, 2)) for c in self.contacts}))
         interp = _mapping("interpolation", self.interpolation, required=("states", "controls"))
         set_(self, "interpolation", MappingProxyType({str(a): str(b) for a, b in interp.items()}))
+        if self.error_estimate is not None:
+            est = _array("error_estimate", self.error_estimate, (k - 1,))
+            if np.any(est < 0.0):
+                raise _fail("error_estimate", "expected numbers >= 0")
+            set_(self, "error_estimate", est)
 
     @property
     def duration(self) -> float:
@@ -440,6 +453,29 @@ class Gait:
                                 f"not valid JSON ({exc.msg})") from None
         return cls.from_dict(data, source=source)
 
+    # -- notebook use (gaitopt.viz.notebook, imported on first use) -------------------------
+    def _repr_html_(self) -> str:
+        """Jupyter's view: a table of speed, step length and time, cost, solver status, largest
+        violation and the verify verdict (:func:`gaitopt.viz.notebook.summary_html`)."""
+        from gaitopt.viz.notebook import summary_html
+
+        return summary_html(self)
+
+    def plot(self, kind: str = "overview") -> Figure:
+        """A Matplotlib figure: ``overview`` (angles, hip, torques over the step), ``torques``,
+        ``hip``, ``heights`` or ``poses`` (:func:`gaitopt.viz.notebook.gait_figure`)."""
+        from gaitopt.viz.notebook import gait_figure
+
+        return gait_figure(self, kind)
+
+    def animate(self, path: str | os.PathLike[str] | None = None, *, steps: int = 4,
+                fps: int = 30) -> Path | GifAnimation:
+        """``steps`` steps of the walk in real time: written to ``path`` (.gif or .mp4; returns
+        the path) or, without a path, an animated GIF that Jupyter shows inline."""
+        from gaitopt.viz.notebook import animate
+
+        return animate(self, path, steps=steps, fps=fps)
+
 
 # -- validation helpers ------------------------------------------------------------------------
 
@@ -600,7 +636,8 @@ def _phase_to_dict(p: GaitPhase) -> dict[str, Any]:
             "qd": p.qd.tolist(), "qdd": p.qdd.tolist(), "u": p.u.tolist(),
             "contact_forces": {c: v.tolist() for c, v in p.contact_forces.items()},
             "state_names": list(p.state_names), "x": p.x.tolist(), "xdot": p.xdot.tolist(),
-            "interpolation": dict(p.interpolation)}
+            "interpolation": dict(p.interpolation),
+            **({} if p.error_estimate is None else {"error_estimate": p.error_estimate.tolist()})}
 
 
 def _dumps(value: Any, indent: int = 0) -> str:
@@ -632,40 +669,12 @@ def swap_leg_label(name: str) -> str:
 
 
 def leg_swap_permutations(model: RobotModel) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """Index permutations of ``q`` and ``u`` that exchange the two legs.
+    """Index permutations of ``q`` and ``u`` that exchange the two legs
+    (:func:`gaitopt.robot.symmetry.swap_permutations`: the declared symmetry or the one
+    inferred from the chains to the first two contacts). ``q_swapped = q[..., perm_q]``."""
+    from gaitopt.robot.symmetry import swap_permutations
 
-    Leg i is the chain of links from the base to the link carrying contact i (the model's
-    first two contacts); the joints of the two chains are paired in order, contact actuators
-    by their contact. ``q_swapped = q[..., perm_q]``; both permutations are involutions.
-    """
-    if len(model.contacts) != 2:
-        raise ValueError(f"model {model.name!r}: swapping legs needs exactly two contacts, "
-                         f"got {len(model.contacts)}")
-    legs = [model.chain(model.link_index(c.link))[1:] for c in model.contacts]
-    if len(legs[0]) != len(legs[1]) or set(legs[0]) & set(legs[1]):
-        raise ValueError(f"model {model.name!r}: the two legs must be separate chains of "
-                         "equal length from the base")
-    perm_q = np.arange(model.nq)
-    joint_pair: dict[str, str] = {}
-    for a, b in zip(legs[0], legs[1], strict=True):
-        ia, ib = model.coordinate_of_link(a), model.coordinate_of_link(b)
-        perm_q[ia], perm_q[ib] = ib, ia
-        ja, jb = model.links[a].joint, model.links[b].joint
-        assert ja is not None and jb is not None
-        joint_pair[ja.name], joint_pair[jb.name] = jb.name, ja.name
-    c0, c1 = (c.name for c in model.contacts)
-    contact_pair = {c0: c1, c1: c0}
-    perm_u = np.arange(model.nu)
-    for i, act in enumerate(model.actuators):
-        other = (joint_pair.get(act.joint, act.joint) if act.joint is not None
-                 else contact_pair[act.contact or ""])
-        matches = [j for j, b in enumerate(model.actuators)
-                   if (b.joint if act.joint is not None else b.contact) == other]
-        if len(matches) != 1:
-            raise ValueError(f"model {model.name!r}: actuator {act.name!r} has no unique "
-                             "counterpart on the other leg")
-        perm_u[i] = matches[0]
-    return perm_q, perm_u
+    return swap_permutations(model)
 
 
 # -- interpolation between knots ---------------------------------------------------------------

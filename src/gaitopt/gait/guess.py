@@ -26,7 +26,10 @@ from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.reduced import checked_biped, leg_inverse_kinematics
 from gaitopt.dynamics.rnea import bias_forces
 from gaitopt.gait import walking
+from gaitopt.gait.full_coordinates import actuator_names
+from gaitopt.gait.full_coordinates import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -37,12 +40,15 @@ _FINE = 400
 
 @dataclass(frozen=True)
 class PhaseGuess:
-    """Knot values of one phase: ``t`` (K,), ``x`` (K, n), ``u`` (K, m)."""
+    """Knot values of one phase: ``t`` (K,), ``x`` (K, n) named by ``states``, ``u`` (K, m)
+    named by ``controls`` (the actuators acting in the phase)."""
 
     name: str
     t: Array
     x: Array
     u: Array
+    states: tuple[str, ...]
+    controls: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -71,9 +77,12 @@ def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple
     h = np.asarray(bias_forces(model, q, qd), dtype=float).reshape(-1)
     b_full = np.asarray(actuation_matrix(model, q, held), dtype=float)
     cols = [model.actuator_index(n) for n in controls]
-    j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(2 * len(held), -1)
     force_scale = 100.0  # forces are cheap in the least-squares norm
-    a = np.hstack([b_full[:, cols], force_scale * j.T])
+    a = b_full[:, cols]
+    if held:
+        j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(2 * len(held),
+                                                                               -1)
+        a = np.hstack([a, force_scale * j.T])
     sol, *_ = np.linalg.lstsq(a, m_q @ qdd + h, rcond=None)
     return np.asarray(sol[: len(cols)], dtype=float)
 
@@ -81,14 +90,16 @@ def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple
 def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                 single_support_fraction: float, knots: tuple[int, int], ankle: bool,
                 r_max: float, clearance: float | None = None,
-                ankle_torques: bool | None = None) -> WalkingGuess:
+                ankle_torques: bool | None = None, full: bool = False) -> WalkingGuess:
     """The geometric guess described in the module docstring (knot values per phase).
 
     ``ankle`` says whether the controls include the ankle torques; ``ankle_torques`` (default:
     ``ankle``) whether the least-squares torques may use them (``False``: they are zero, the
-    guess of a stage that holds the ankles at zero)."""
+    guess of a stage that holds the ankles at zero). ``full``: the states are ``[q, qd]``
+    (the full-coordinate formulation; joints other than the legs' stay at 0), else the reduced
+    states of :mod:`gaitopt.gait.walking`."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
-    legs = checked_biped(model).legs
+    legs = (biped_structure(model) if full else checked_biped(model)).legs
     v, step, f = speed, step_length, single_support_fraction
     total = step / v
     t1, t2 = f * total, (1.0 - f) * total
@@ -114,7 +125,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
             q_fine[k, leg.hip_index] = float(joints.hip)
             q_fine[k, leg.knee_index] = float(joints.knee)
     phases.append(_phase_guess(model, SINGLE, t_fine, q_fine, _knots(0.0, t1, knots[0]),
-                               ankle, use_ankles, [legs[0].contact]))
+                               ankle, use_ankles, [legs[0].contact], full))
     if f < 1.0:
         t_fine = np.linspace(t1, t1 + t2, _FINE)
         p_hip = hip(t_fine)
@@ -128,24 +139,79 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                 q_fine[k, leg.knee_index] = float(joints.knee)
         phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
                                    _knots(t1, t2, knots[1]), ankle, use_ankles,
-                                   [legs[0].contact, legs[1].contact]))
+                                   [legs[0].contact, legs[1].contact], full))
+    return WalkingGuess(phases=tuple(phases),
+                        parameters={"step_length": step, "speed": v, "impulse": 0.0})
+
+
+def default_running_step(speed: float) -> float:
+    """A plausible running step length (m) for a speed (m/s) to start from."""
+    return float(np.clip(0.35 * speed, 0.3, 1.2))
+
+
+def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
+                        stance_fraction: float, knots: tuple[int, int], ankle: bool,
+                        r_max: float, ankle_torques: bool | None = None) -> WalkingGuess:
+    """A geometric guess of a run in full coordinates (phases ``stance`` and ``flight``).
+
+    The hip moves at constant speed at the height where the stance leg reaches its tip at the
+    origin over the whole stance; tip 1 stands during the stance, then flies to ``(L + xb,
+    yb)``; tip 2 travels over the whole step from ``(xb, yb)`` to its landing point ``(L, 0)``
+    (``xb = -0.6 L``, ``yb = 0.1 m``: the swap of legs maps tip 1's end onto tip 2's start),
+    both on smooth arcs; torques by least squares as for the walk."""
+    use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
+    legs = biped_structure(model).legs
+    v, step, f = speed, step_length, stance_fraction
+    total = step / v
+    t1 = f * total
+    s_hip = v * t1
+    height = 0.97 * float(np.sqrt(max(r_max**2 - (s_hip / 2.0) ** 2, 1e-4)))
+    xb, yb, bump = -0.6 * step, 0.1, 0.05
+    phases = []
+    for name, (ta, tb), held in (("stance", (0.0, t1), [legs[0].contact]),
+                                 ("flight", (t1, total), [])):
+        t = np.linspace(ta, tb, _FINE)
+        p_hip = np.stack([-s_hip / 2.0 + v * t, np.full_like(t, height)], axis=1)
+        sig2 = _smoothstep(t / total)
+        tip2 = np.stack([xb + (step - xb) * sig2,
+                         yb * (1.0 - sig2) + bump * np.sin(np.pi * t / total)], axis=1)
+        if name == "stance":
+            tip1 = np.zeros_like(tip2)
+        else:
+            sig1 = _smoothstep((t - t1) / (total - t1))
+            tip1 = np.stack([(step + xb) * sig1,
+                             yb * sig1 + bump * np.sin(np.pi * (t - t1) / (total - t1))],
+                            axis=1)
+        q_fine = np.zeros((_FINE, model.nq))
+        q_fine[:, 0:2] = p_hip
+        for k in range(_FINE):
+            for leg, tip in ((legs[0], tip1[k]), (legs[1], tip2[k])):
+                joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),
+                                                0.0, 0.0)
+                q_fine[k, leg.hip_index] = float(joints.hip)
+                q_fine[k, leg.knee_index] = float(joints.knee)
+        count = knots[0] if name == "stance" else knots[1]
+        phases.append(_phase_guess(model, name, t, q_fine, _knots(ta, tb - ta, count), ankle,
+                                   use_ankles, held, True))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
 
 def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_knots: Array,
-                 ankle: bool, use_ankles: bool, held: list[str]) -> PhaseGuess:
+                 ankle: bool, use_ankles: bool, held: list[str], full: bool) -> PhaseGuess:
     qd_fine = np.gradient(q_fine, t_fine, axis=0)
     qdd_fine = np.gradient(qd_fine, t_fine, axis=0)
-    controls = walking.control_names(model, phase, ankle=ankle)
-    acting = walking.control_names(model, phase, ankle=use_ankles)
+    controls = actuator_names(model, held, ankle=ankle)
+    acting = actuator_names(model, held, ankle=use_ankles)
     columns = [controls.index(name) for name in acting]
     xs, us = [], []
     for t in t_knots:
         q = np.array([np.interp(t, t_fine, q_fine[:, i]) for i in range(model.nq)])
         qd = np.array([np.interp(t, t_fine, qd_fine[:, i]) for i in range(model.nq)])
         qdd = np.array([np.interp(t, t_fine, qdd_fine[:, i]) for i in range(model.nq)])
-        if phase == SINGLE:
+        if full:
+            x = np.concatenate([q, qd])
+        elif phase == SINGLE:
             x = walking.full_to_single_support(model, q, qd)
         else:
             x = walking.full_to_double_support(model, q, qd)
@@ -153,4 +219,6 @@ def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_
         u = np.zeros(len(controls))
         u[columns] = _torques(model, q, qd, qdd, acting, held)
         us.append(u)
-    return PhaseGuess(name=phase, t=np.asarray(t_knots), x=np.array(xs), u=np.array(us))
+    states = full_state_names(model) if full else walking.state_names(model, phase)
+    return PhaseGuess(name=phase, t=np.asarray(t_knots), x=np.array(xs), u=np.array(us),
+                      states=states, controls=controls)

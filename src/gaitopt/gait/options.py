@@ -16,7 +16,14 @@ from typing import Any, Literal
 from gaitopt.robot.biped import BipedStructure
 from gaitopt.units import format_speed
 
-Transcription = Literal["hermite-simpson", "trapezoidal"]
+Transcription = Literal["hermite-simpson", "hermite-simpson-separated", "trapezoidal"]
+#: The accepted values of ``GaitOptions.transcription`` (the literal above, for validation).
+TRANSCRIPTIONS: tuple[str, ...] = ("hermite-simpson", "hermite-simpson-separated",
+                                   "trapezoidal")
+Formulation = Literal["reduced", "full"]
+GaitKind = Literal["walk", "run"]
+CostName = Literal["paper", "work", "metabolic"]
+FORMULATIONS: tuple[str, ...] = ("reduced", "full")
 
 
 class GaitOptionsError(ValueError):
@@ -40,21 +47,41 @@ class GaitOptions:
         single_support_fraction: phase-1 share of the step time, in (0, 1]; 1 gives the
             single-support gait (no double support, the trailing leg leaves at heel strike).
         knots: grid points per phase (single support, double support), as in the paper.
-        transcription: ``"hermite-simpson"`` (DIRCOL's) or ``"trapezoidal"``.
+        transcription: ``"hermite-simpson"`` (DIRCOL's compressed form),
+            ``"hermite-simpson-separated"`` (the same scheme and optimum with the midpoint
+            states as NLP variables; cheaper derivatives) or ``"trapezoidal"``.
         periodic_controls: controls periodic (paper) as well as the states.
         friction: a friction coefficient for an optional friction-cone constraint, or None.
         unilateral_impulses: the ground only pushes at the heel strike and the liftoff (normal
             impulses >= 0 on every held tip). ``False`` uses the paper's maps as they are, in
             which the held tip may be pulled (the liftoff impulse along the trailing leg lifts
             the front tip unless the ground pulls it down; see docs/walking.md).
-        min_stance_knee_flexion: smallest knee bend (rad, > 0) of a leg on the ground; it sets
+        min_stance_knee_flexion: smallest knee bend (rad) of a leg on the ground; it sets
             the largest hip-to-tip distance, the polar box ``r <= r_max`` (paper section 3.5),
-            and keeps the leg inverse kinematics away from its singularity at a straight knee.
+            and keeps the leg inverse kinematics away from its singularity at a straight knee
+            (> 0 in the reduced formulation; >= 0 in the full one, where 0 lets the stance
+            knee straighten up to its joint limit).
         torso_bounds: torso angle bounds (rad).
         rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates.
         max_impulse: upper bound of the liftoff impulse (N s).
         tol: IPOPT tolerance; max_iter: IPOPT iteration limit per stage.
         continuation: use the automatic continuation from a naive start (else one solve).
+        formulation: ``"reduced"`` (the paper's: polar hip coordinates and leg inverse
+            kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
+            with the held contact points as constraints: any model with two legs; a knee may
+            straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md.
+        gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
+            walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
+            ``single_support_fraction`` of the step, then flight; full formulation only, no
+            liftoff impulse).
+        cost: ``"paper"`` (torque squared per metre), ``"work"`` (mechanical cost of
+            transport) or ``"metabolic"`` (with efficiencies and a resting power); formulas in
+            :mod:`gaitopt.gait.cost` and docs/costs.md.
+        efficiency_positive, efficiency_negative: muscle efficiencies of positive and negative
+            work (> 0; 0.25 and 1.2) of the metabolic cost.
+        resting_power: resting metabolic power (W/kg, >= 0) of the metabolic cost.
+        cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs.
+        cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, and keep the lowest optimum (slower; a cold solve can
             otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
@@ -81,6 +108,14 @@ class GaitOptions:
     max_iter: int = 1000
     continuation: bool = True
     multistart: bool = False
+    formulation: Formulation = "reduced"
+    gait: GaitKind = "walk"
+    cost: CostName = "paper"
+    efficiency_positive: float = 0.25
+    efficiency_negative: float = 1.2
+    resting_power: float = 1.2
+    cost_smoothing: float = 0.01
+    cost_regularization: float = 0.0
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -148,9 +183,34 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
             raise GaitOptionsError(f"speed = {format_speed(speed)}: must lie in speed_bounds "
                                    f"[{format_speed(v_lo)}, {format_speed(v_hi)}]")
     l_lo, l_hi = _bounds("step_length_bounds", o.step_length_bounds, positive=True)
+    if o.formulation not in FORMULATIONS:
+        raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
+                               f"{', '.join(FORMULATIONS)}")
+    if o.cost not in ("paper", "work", "metabolic"):
+        raise GaitOptionsError(f"cost = {o.cost!r}: must be one of paper, work, metabolic")
+    for name, value, lo, strict in (("efficiency_positive", o.efficiency_positive, 0.0, True),
+                                    ("efficiency_negative", o.efficiency_negative, 0.0, True),
+                                    ("resting_power", o.resting_power, 0.0, False),
+                                    ("cost_smoothing", o.cost_smoothing, 0.0, True),
+                                    ("cost_regularization", o.cost_regularization, 0.0, False)):
+        v = _finite(name, value)
+        if v < lo or (strict and v == lo):
+            raise GaitOptionsError(f"{name} = {v:g}: must be {'>' if strict else '>='} {lo:g}")
+    if o.gait not in ("walk", "run"):
+        raise GaitOptionsError(f"gait = {o.gait!r}: must be 'walk' or 'run'")
+    if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0
+                            or o.impulse):
+        raise GaitOptionsError(
+            "gait = 'run': needs formulation 'full', single_support_fraction < 1 (the stance "
+            "share of the step) and impulse off (no liftoff impulse in a run)")
     flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
-    if not 0.0 < flex < 1.5:
-        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5)")
+    if o.formulation == "full" and not 0.0 <= flex < 1.5:
+        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in [0, 1.5) "
+                               "(full formulation)")
+    if o.formulation == "reduced" and not 0.0 < flex < 1.5:
+        raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5) "
+                               "in the reduced formulation (its leg inverse kinematics is "
+                               "singular at a straight knee; formulation 'full' allows 0)")
     reach = min(leg.reach(-flex) for leg in biped.legs)
     longest = 2.0 * reach * 0.97
     if o.step_length is not None:
@@ -197,9 +257,9 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
                                "and >= 2 in double support")
     if max(o.knots) > 400:
         raise GaitOptionsError(f"knots = {tuple(o.knots)}: at most 400 per phase")
-    if o.transcription not in ("hermite-simpson", "trapezoidal"):
-        raise GaitOptionsError(f"transcription = {o.transcription!r}: must be "
-                               "'hermite-simpson' or 'trapezoidal'")
+    if o.transcription not in TRANSCRIPTIONS:
+        raise GaitOptionsError(f"transcription = {o.transcription!r}: must be one of "
+                               f"{', '.join(repr(t) for t in TRANSCRIPTIONS)}")
     if o.friction is not None and not _finite("friction", o.friction) > 0.0:
         raise GaitOptionsError(f"friction = {o.friction!r}: must be > 0 "
                                "(leave it unset for no friction cone)")

@@ -26,7 +26,7 @@ import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.reduced import checked_biped
-from gaitopt.gait import walking
+from gaitopt.gait import cost, walking
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp.bounds import Bounds
@@ -191,8 +191,17 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
                 bounds[n] = (-rate, rate)
         return {n: bounds[n] for n in names}
 
-    def usq(u: Any) -> Any:
-        return ca.sumsqr(u)
+    paper_cost = options.cost == "paper" and options.cost_regularization == 0.0
+
+    def running(point: Callable[[Any, Any, Any], walking.PhasePoint],
+                controls: Sequence[str]) -> Callable[[Any, Any, Any, Any], Any]:
+        """The running cost of a phase: ``u'u`` (paper) or :func:`cost.running_cost`."""
+        def fn(x: Any, u: Any, p: Any, t: Any) -> Any:
+            if paper_cost:
+                return ca.sumsqr(u)
+            return cost.running_cost(model, options, point(x, u, p).solution.qd,
+                                     walking.full_controls(model, controls, u), p)
+        return fn
 
     # -- phase 1: single support on leg 1 ----------------------------------------------------
     ss = _PointCache(lambda x, u, p: walking.single_support_point(model, x, u, ss_controls))
@@ -223,7 +232,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         name=SINGLE, states=ss_states, controls=ss_controls, dynamics=ss_dynamics,
         duration=Duration.of_parameters(lambda p: f * p[_L] / p[_V]),
         state_bounds=state_bounds(ss_states), control_bounds=control_bounds(ss_controls),
-        path_constraints=ss_path, lagrange=lambda x, u, p, t: usq(u),
+        path_constraints=ss_path, lagrange=running(ss, ss_controls),
         intervals=options.knots[0] - 1)
 
     phases = [phase1]
@@ -303,7 +312,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             name=DOUBLE, states=ds_states, controls=ds_controls, dynamics=ds_dynamics,
             duration=Duration.of_parameters(lambda p: (1.0 - f) * p[_L] / p[_V]),
             state_bounds=state_bounds(ds_states), control_bounds=control_bounds(ds_controls),
-            path_constraints=ds_path, lagrange=lambda x, u, p, t: usq(u),
+            path_constraints=ds_path, lagrange=running(ds, ds_controls),
             intervals=options.knots[1] - 1)
         phases.append(phase2)
 
@@ -353,9 +362,22 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
                   Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
     return Problem(
         phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
-        parameter_cost=lambda p: p[_P] ** 2,
-        cost_denominator=lambda ends, p: p[_L],
-        objective_scale=1000.0)
+        parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
+        (lambda p: cost.parameter_cost(model, options, p)),
+        mayer=None if options.cost == "paper" or not two_phases else
+        (lambda ends, p: liftoff_cost(model, options, lift(ends, p), p[_P])),
+        cost_denominator=lambda ends, p: cost.denominator(model, options, p),
+        objective_scale=cost.objective_scale(options))
+
+
+def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition,
+                 magnitude: Any) -> Any:
+    """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
+    lifting = checked_biped(model).legs[0].contact
+    from gaitopt.dynamics.kinematics import contact_velocity
+
+    v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
+    return cost.impulse_cost(model, options, tr.impulses[lifting], v_after, magnitude)
 
 
 def relabel_actuator(model: RobotModel, name: str) -> str | None:

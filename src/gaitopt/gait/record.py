@@ -19,17 +19,18 @@ from numpy.typing import NDArray
 from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.kinematics import point_position
 from gaitopt.dynamics.reduced import checked_biped
-from gaitopt.gait import walking
+from gaitopt.gait import cost, walking
 from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
 
-COST_FORMULA = ("energy per metre (paper eq. 5): (integral over the step of u'u dt + "
-                "liftoff_impulse^2) / step_length, in N^2 m s (torques in N m, impulse in N s)")
+#: The paper's cost in words (the default cost; :mod:`gaitopt.gait.cost` has all of them).
+COST_FORMULA = cost.FORMULAS["paper"]
 #: Samples per second of step time in the dense grid (at least 101 samples per step).
 SAMPLE_RATE = 200.0
 
@@ -64,7 +65,7 @@ def _phase_functions(model: RobotModel, phase: str, controls: tuple[str, ...]) -
 @functools.lru_cache(maxsize=8)
 def _points_function(model: RobotModel) -> ca.Function:
     """``q -> (hip, knee_1, knee_2, tip_1, tip_2, torso_top)`` world positions (2, 6)."""
-    legs = checked_biped(model).legs
+    legs = biped_structure(model).legs
     q = ca.SX.sym("q", model.nq)
     cols = [q[0:2]]
     for leg in legs:
@@ -92,12 +93,22 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
         MotionOutOfReachError: the interpolated motion leaves a leg's reach between knots.
     """
     model, options, res = solution.model, solution.options, solution.result
-    legs = checked_biped(model).legs
     step, speed, impulse = (res.parameters[k] for k in ("step_length", "speed", "impulse"))
     # IPOPT may end a hair outside a bound (its bound_relax_factor): the impulse is >= 0.
     impulse = max(impulse, 0.0)
-    phases: list[GaitPhase] = []
     traj = {ph.name: ph for ph in res.phases}
+    if options.formulation == "full":
+        from gaitopt.gait.formulation import contact_sequence
+        from gaitopt.gait.record_full import full_phases_and_events, full_samples
+
+        total = sum(ph.duration for ph in res.phases)
+        count = max(101, int(np.ceil(total * SAMPLE_RATE)) + 1)
+        phase_records, events = full_phases_and_events(
+            model, contact_sequence(model, options), res, step, impulse)
+        samples = full_samples(model, res, count, _points_function(model), POINTS)
+        return _gait(solution, phase_records, events, samples)
+    legs = checked_biped(model).legs
+    phases: list[GaitPhase] = []
     for name in traj:
         ph = traj[name]
         contacts = (legs[0].contact,) if name == SINGLE else (legs[0].contact, legs[1].contact)
@@ -106,10 +117,19 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
         phases.append(GaitPhase(
             name=name, contacts=contacts, t=ph.t, q=q, qd=qd, qdd=qdd, u=u_full,
             contact_forces={c: forces[:, 2 * i:2 * i + 2] for i, c in enumerate(contacts)},
-            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot))
+            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot,
+            error_estimate=ph.error if np.all(np.isfinite(ph.error)) else None))
     events = _events(model, options, traj, step, impulse)
     samples = _samples(model, options, res, step)
-    t1 = traj[SINGLE].duration
+    return _gait(solution, tuple(phases), events, samples)
+
+
+def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
+          events: tuple[GaitEvent, ...], samples: GaitSamples) -> Gait:
+    model, options, res = solution.model, solution.options, solution.result
+    step, speed = res.parameters["step_length"], res.parameters["speed"]
+    impulse = max(res.parameters["impulse"], 0.0)
+    t1 = res.phases[0].duration
     solver = {
         "status": res.status, "success": bool(res.success), "iterations": int(res.iterations),
         "wall_time_s": float(solution.wall_time_s),
@@ -128,8 +148,9 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
         model_data=model.to_dict(), options=options.to_dict(),
         parameters={"step_length": step, "speed": speed, "step_time": step / speed,
                     "single_support_time": t1, "liftoff_impulse": impulse},
-        cost={"value": float(res.objective), "formula": COST_FORMULA},
-        solver=solver, phases=tuple(phases), events=events, samples=samples)
+        cost={"value": float(res.objective), "name": options.cost,
+              "formula": cost.formula(options)},
+        solver=solver, phases=phases, events=events, samples=samples)
 
 
 def _vec(value: Any, n: int) -> Array:

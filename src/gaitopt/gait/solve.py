@@ -33,6 +33,7 @@ and reused: speed, step length and impulse enter through parameter bounds only.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -40,16 +41,16 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.dynamics.reduced import checked_biped
-from gaitopt.gait.guess import WalkingGuess, default_step_length, naive_guess
-from gaitopt.gait.options import GaitOptions, validate_options
-from gaitopt.gait.problem import (
-    Relaxation,
-    parameter_bounds,
-    relaxed_bounds,
-    walking_problem,
-    with_step_time,
+from gaitopt.gait.formulation import biped_of, problem_for, stage_bounds
+from gaitopt.gait.guess import (
+    WalkingGuess,
+    default_running_step,
+    default_step_length,
+    naive_guess,
+    naive_running_guess,
 )
+from gaitopt.gait.options import GaitOptions, validate_options
+from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
 from gaitopt.ocp import Bounds, Guess, PhaseGuess, Result, Transcription, transcribe
 from gaitopt.robot.model import RobotModel
 
@@ -59,6 +60,9 @@ REFERENCE_SPEED = 0.2
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
+#: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
+#: cost's optimum, when the requested one is finer.
+COST_SMOOTHING_START = 1.0
 #: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
 #: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
 #: the lower local optimum more often than the default monotone one: over 20 speeds with and
@@ -82,6 +86,13 @@ PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
 #: 2 s) to the same optimum and tolerance. Warm starts on a fine grid (a sweep's neighbours)
 #: use the exact Hessian, built once per process.
 FINE_STAGE_OPTIONS = {"ipopt.hessian_approximation": "limited-memory"}
+
+
+def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
+    """:data:`FINE_STAGE_OPTIONS` in the reduced formulation; the exact Hessian in the full
+    one, where the quasi-Newton stages took 365 + 228 iterations at 16 + 6 knots and ended
+    at IPOPT's acceptable level, against 23 + 13 with the exact Hessian (12 m/min)."""
+    return dict(FINE_STAGE_OPTIONS) if options.formulation == "reduced" else {}
 
 ProgressFn = Callable[["StageReport"], None]
 
@@ -136,15 +147,20 @@ class WalkingSolution:
 _CACHE: dict[tuple[Any, ...], Transcription] = {}
 
 
+#: Options that enter a solve only through bounds or the solve's own logic, never the NLP's
+#: structure: problems that differ only in these share one transcription.
+BOUNDS_ONLY_OPTIONS = frozenset({"speed", "step_length", "step_time", "knots", "multistart",
+                                 "continuation"})
+
+
 def _structure_key(model: RobotModel, options: GaitOptions, knots: tuple[int, int],
                    compiled: str | None) -> tuple[Any, ...]:
-    o = options
-    return (model.content_hash(), o.ankle, o.single_support_fraction, tuple(knots),
-            o.step_time is not None,
-            o.transcription, o.periodic_controls, o.friction, o.unilateral_impulses,
-            o.min_stance_knee_flexion,
-            tuple(o.torso_bounds), o.rate_bound, o.max_impulse, o.tol, o.max_iter,
-            tuple(o.speed_bounds), tuple(o.step_length_bounds), compiled)
+    """Every option that shapes the NLP (all but :data:`BOUNDS_ONLY_OPTIONS`), the model,
+    the grid, whether a step-time row exists, and the compilation mode."""
+    shaping = sorted((k, repr(v)) for k, v in dataclasses.asdict(options).items()
+                     if k not in BOUNDS_ONLY_OPTIONS)
+    return (model.content_hash(), tuple(knots), options.step_time is not None, compiled,
+            tuple(shaping))
 
 
 def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int, int], *,
@@ -152,7 +168,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int,
     """The (process-wide cached) transcription of the walking problem on ``knots``."""
     key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
-        problem = walking_problem(model, options.replace(knots=tuple(knots)))
+        problem = problem_for(model, options.replace(knots=tuple(knots)))
         intervals = {problem.phases[i].name: knots[i] - 1 for i in range(len(problem.phases))}
         _CACHE[key] = transcribe(
             problem, method=options.transcription, intervals=intervals, compiled=compiled,
@@ -165,7 +181,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: tuple[int,
 
 def held_ankles(model: RobotModel, tr: Transcription, bounds: Bounds) -> Bounds:
     """``bounds`` with every ankle torque of every phase bounded to zero."""
-    ankles = {leg.ankle_actuator for leg in checked_biped(model).legs}
+    ankles = {a.name for a in model.actuators if a.contact is not None}
     for ph in tr.problem.phases:
         for name in ph.controls:
             if name in ankles:
@@ -178,7 +194,9 @@ def ocp_guess(guess: WalkingGuess) -> Guess:
     phases = {}
     for ph in guess.phases:
         span = ph.t[-1] - ph.t[0]
-        phases[ph.name] = PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / span)
+        phases[ph.name] = PhaseGuess(
+            x={n: ph.x[:, j] for j, n in enumerate(ph.states)},
+            u={n: ph.u[:, j] for j, n in enumerate(ph.controls)}, tau=(ph.t - ph.t[0]) / span)
     return Guess(phases=phases, parameters=dict(guess.parameters))
 
 
@@ -199,14 +217,16 @@ class _Run:
 
     def stage(self, name: str, knots: tuple[int, int], relax: Relaxation,
               guess: Guess | Result, bounds: dict[str, Any], *,
-              hold_ankles: bool = False, solver_options: dict[str, Any] | None = None
-              ) -> Result:
+              hold_ankles: bool = False, solver_options: dict[str, Any] | None = None,
+              problem: GaitOptions | None = None) -> Result:
         """Solve one stage; a Result guess also passes its multipliers to IPOPT.
         ``hold_ankles`` bounds the ankle torques to zero (the no-ankle gait);
-        ``solver_options`` are merged over the transcription's."""
-        tr = transcription_for(self.model, self.options, knots, compiled=self.compiled)
+        ``solver_options`` are merged over the transcription's; ``problem`` replaces the
+        run's options for this stage's NLP (another cost, say)."""
+        tr = transcription_for(self.model, problem or self.options, knots,
+                               compiled=self.compiled)
         start = time.perf_counter()
-        nlp_bounds = with_step_time(relaxed_bounds(tr, relax), self.options)
+        nlp_bounds = with_step_time(stage_bounds(tr, relax, self.options), self.options)
         if hold_ankles:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
@@ -227,7 +247,7 @@ class _Run:
         (the requested step length, or a speed-based guess and two others): the first that
         converges, or with ``every_start`` the best of all that converge."""
         o, coarse = self.options, coarse_knots(self.options)
-        legs = checked_biped(self.model).legs
+        legs = biped_of(self.model, o).legs
         r_max = min(leg.reach(-o.min_stance_knee_flexion) for leg in legs)
         bounds = dict(parameter_bounds(o))
         bounds["speed"] = (speed, speed)
@@ -237,13 +257,20 @@ class _Run:
         elif o.step_time is not None:
             steps = [o.step_time * speed]
         else:
-            steps = [default_step_length(speed) * f for f in (1.0, 0.7, 1.4)]
+            default = default_running_step if o.gait == "run" else default_step_length
+            steps = [default(speed) * f for f in (1.0, 0.7, 1.4)]
         found: list[Result] = []
         for step0 in steps:
-            guess = naive_guess(self.model, speed=speed, step_length=step0,
-                                single_support_fraction=o.single_support_fraction,
-                                knots=coarse, ankle=o.ankle, r_max=r_max,
-                                ankle_torques=False)
+            if o.gait == "run":
+                guess = naive_running_guess(
+                    self.model, speed=speed, step_length=step0,
+                    stance_fraction=o.single_support_fraction, knots=coarse, ankle=o.ankle,
+                    r_max=r_max, ankle_torques=False)
+            else:
+                guess = naive_guess(self.model, speed=speed, step_length=step0,
+                                    single_support_fraction=o.single_support_fraction,
+                                    knots=coarse, ankle=o.ankle, r_max=r_max,
+                                    ankle_torques=False, full=o.formulation == "full")
             relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
                                  hold_ankles=o.ankle, solver_options=COLD_START_OPTIONS)
             if not relaxed.success:
@@ -289,13 +316,13 @@ class _Run:
         for name in ("step_length", "speed"):
             held[name] = (result.parameters[name], result.parameters[name])
         fine = self.stage("target grid", o.knots, Relaxation(), result, held,
-                          solver_options={**PRIMAL_WARM_OPTIONS, **FINE_STAGE_OPTIONS})
+                          solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
         if not fine.success or all_fixed:
             return fine
         return self.stage("target grid, all free", o.knots, Relaxation(), fine,
-                          parameter_bounds(o), solver_options=FINE_STAGE_OPTIONS)
+                          parameter_bounds(o), solver_options=fine_stage_options(o))
 
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
@@ -316,6 +343,36 @@ class _Run:
                 return None
         return current
 
+    def other_cost(self) -> Result | None:
+        """A cost other than the paper's, by continuation: the whole solve with the paper's
+        cost first (its stages reported with the prefix ``paper cost:``), then the cost
+        asked for from that optimum, first with a coarse smoothing of the positive parts
+        (:data:`COST_SMOOTHING_START`) when it is finer. None if the paper solve fails."""
+        o = self.options
+        paper = o.replace(cost="paper", cost_regularization=0.0)
+
+        def report(stage: StageReport) -> None:
+            stage = dataclasses.replace(stage, name=f"paper cost: {stage.name}")
+            self.stages.append(stage)
+            if self.progress is not None:
+                self.progress(stage)
+
+        start = solve_walking(self.model, paper, progress=report, compiled=self.compiled)
+        if not start.success:
+            self.results.append(start.result)
+            return None
+        guess: Guess | Result = result_guess(start.result)
+        if o.cost != "paper" and o.cost_smoothing < COST_SMOOTHING_START:
+            smooth = o.replace(cost_smoothing=COST_SMOOTHING_START)
+            guess = self.stage(f"{o.cost} cost, eps {COST_SMOOTHING_START:g} W", o.knots,
+                               Relaxation(), guess, parameter_bounds(o),
+                               solver_options=PRIMAL_WARM_OPTIONS, problem=smooth)
+            if not guess.success:
+                return guess
+            guess = result_guess(guess)
+        return self.stage(f"{o.cost} cost", o.knots, Relaxation(), guess, parameter_bounds(o),
+                          solver_options=PRIMAL_WARM_OPTIONS)
+
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
         the last stage whose values are, marked failed."""
@@ -327,6 +384,13 @@ class _Run:
         return self.results[-1]
 
 
+def result_guess(result: Result) -> Guess:
+    """A result's knot values and parameters as a guess (values only, no multipliers)."""
+    phases = {ph.name: PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0]))
+              for ph in result.phases}
+    return Guess(phases=phases, parameters=dict(result.parameters))
+
+
 def best_of(results: Sequence[Result | None]) -> Result | None:
     """The converged result with the lowest objective (None if none converged)."""
     ok = [r for r in results if r is not None and r.success]
@@ -335,8 +399,6 @@ def best_of(results: Sequence[Result | None]) -> Result | None:
 
 def _as_failed(result: Result, failed: Result) -> Result:
     """``result``'s values with the failed stage's status (never reported as converged)."""
-    import dataclasses
-
     return dataclasses.replace(result, success=False, status=failed.status,
                                message=f"{failed.message} (values of an earlier stage)")
 
@@ -347,7 +409,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   compiled: str | None = None) -> WalkingSolution:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed."""
-    validate_options(options, checked_biped(model))
+    validate_options(options, biped_of(model, options))
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
@@ -357,7 +419,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         if not result.success:
             result = None
     outcome: Result | None = result
-    if result is None:
+    if result is None and (options.cost != "paper" or options.cost_regularization > 0.0):
+        outcome = run.other_cost()
+        result = outcome if outcome is not None and outcome.success else None
+    elif result is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
         coarse = run.cold(speed, every_start=options.multistart)
         far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9

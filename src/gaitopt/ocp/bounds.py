@@ -34,6 +34,8 @@ class Bounds:
     ubw: Array
     lbg: Array
     ubg: Array
+    midpoint_bounds: bool = True
+    """Whether whole-phase state bounds also hold at the midpoint states (separated form)."""
 
     def _set_w(self, index: int | slice | NDArray[np.int64], lo: float, hi: float) -> Bounds:
         lbw, ubw = self.lbw.copy(), self.ubw.copy()
@@ -52,11 +54,15 @@ class Bounds:
 
     def with_state(self, phase: str, name: str, lower: float, upper: float | None = None,
                    knot: int | None = None) -> Bounds:
-        """Bound state ``name`` of ``phase`` at one knot or (``knot=None``) at all knots."""
+        """Bound state ``name`` of ``phase`` at one knot or (``knot=None``) along the phase:
+        at all knots and, in the separated Hermite-Simpson form with ``midpoint_bounds``, at
+        all midpoint states."""
         lo, hi = _pair(lower, upper, f"phase {phase!r} state {name!r}")
         pl = self.layout.phase(phase)
-        idx = pl.across_knots("state", name) if knot is None else pl.index("state", name, knot)
-        return self._set_w(idx, lo, hi)
+        if knot is not None:
+            return self._set_w(pl.index("state", name, knot), lo, hi)
+        out = self._set_w(pl.across_knots("state", name), lo, hi)
+        return out._set_w(pl.across_midpoints(name), lo, hi) if self.midpoint_bounds else out
 
     def with_control(self, phase: str, name: str, lower: float, upper: float | None = None,
                      knot: int | None = None) -> Bounds:
@@ -100,6 +106,9 @@ def describe(layout: Layout, index: int) -> str:
     for pl in layout.phases:
         if pl.duration_index == index:
             return f"phase {pl.name!r} duration"
+        if pl.midpoint_start <= index < pl.end:
+            k, j = divmod(index - pl.midpoint_start, len(pl.states))
+            return f"phase {pl.name!r} state {pl.states[j]!r} midpoint {k}"
         if pl.start <= index < pl.end:
             k, j = divmod(index - pl.start, pl.stride)
             if j < len(pl.states):
@@ -108,8 +117,15 @@ def describe(layout: Layout, index: int) -> str:
     return f"w[{index}]"
 
 
-def variable_bounds(problem: Problem, layout: Layout) -> tuple[Array, Array]:
-    """Default ``(lbw, ubw)`` from the statement: path bounds, then end-knot bounds on top."""
+def variable_bounds(problem: Problem, layout: Layout,
+                    midpoint_bounds: bool = True) -> tuple[Array, Array]:
+    """Default ``(lbw, ubw)`` from the statement: path bounds, then end-knot bounds on top.
+
+    The midpoint states of the separated Hermite-Simpson form take the path state bounds when
+    ``midpoint_bounds`` (the states then respect their bounds between knots too, and the
+    dynamics are never evaluated far outside them during the iterations); without, they are
+    unbounded like the compressed form's midpoints (which are no variables), and both forms
+    have the same feasible set and optimum."""
     lbw, ubw = np.full(layout.size, -math.inf), np.full(layout.size, math.inf)
     for ph, pl in zip(problem.phases, layout.phases, strict=True):
         where = f"phase {ph.name!r}"
@@ -117,8 +133,10 @@ def variable_bounds(problem: Problem, layout: Layout) -> tuple[Array, Array]:
                 ("state", ph.state_bounds, ph.initial_state, ph.final_state),
                 ("control", ph.control_bounds, ph.initial_control, ph.final_control)):
             for name, pb in path.items():
-                lbw[pl.across_knots(kind, name)], ubw[pl.across_knots(kind, name)] = \
-                    as_bound(pb, f"{where} {kind} bound {name!r}")
+                lo, hi = as_bound(pb, f"{where} {kind} bound {name!r}")
+                lbw[pl.across_knots(kind, name)], ubw[pl.across_knots(kind, name)] = lo, hi
+                if kind == "state" and midpoint_bounds:
+                    lbw[pl.across_midpoints(name)], ubw[pl.across_midpoints(name)] = lo, hi
             for knot, mapping, label in ((0, first, "initial"), (-1, last, "final")):
                 for name, b in mapping.items():
                     i = pl.index(kind, name, knot)

@@ -4,7 +4,9 @@ A :class:`Guess` gives, per phase, values on normalised times ``tau`` in [0, 1] 
 linearly onto the knots) and durations and parameters by name; anything missing falls back to
 the default. A :class:`~gaitopt.ocp.result.Result` is also a guess: its trajectories are
 evaluated with its own interpolants at the new knots (same normalised times, so a different
-mesh or number of intervals is fine).
+mesh or number of intervals is fine). Midpoint state variables (separated Hermite-Simpson)
+get the same guess evaluated at the interval midpoints, so a Result of either Hermite-Simpson
+form starts the other one at a point that satisfies the midpoint defects.
 
 Defaults: a state goes linearly from its fixed initial value (or its path default) to its fixed
 final value (or the start value); the path default is the midpoint of finite path bounds, else
@@ -142,6 +144,23 @@ def _from_result(res: Result, ph: Phase, index: int, tau: Array,
     return x, u, old.duration
 
 
+def _phase_values(guess: Guess | Result | None, ph: Phase, index: int, tau: Array,
+                  duration: float | None) -> tuple[Array, Array, float | None]:
+    """States (M, n), controls (M, m) at normalised times ``tau`` (M,) and the duration of
+    phase ``ph`` (position ``index``) from ``guess``, on top of the defaults."""
+    x, u = _default_states(ph, tau), _default_controls(ph, tau)
+    if isinstance(guess, Result):
+        x, u, d = _from_result(guess, ph, index, tau, x, u)
+        duration = d if d is not None else duration
+    elif isinstance(guess, Guess) and ph.name in guess.phases:
+        pg = guess.phases[ph.name]
+        where = f"guess for phase {ph.name!r}"
+        x = _user_values(pg.x, tuple(ph.states), tau, pg.tau, x, f"{where} x")
+        u = _user_values(pg.u, tuple(ph.controls), tau, pg.tau, u, f"{where} u")
+        duration = pg.duration if pg.duration is not None else duration
+    return x, u, duration
+
+
 def guess_vector(problem: Problem, layout: Layout, mesh: Mesh,
                  guess: Guess | Result | None) -> Array:
     """The unscaled initial point w0 (layout.size,) from ``guess`` (see module docstring)."""
@@ -156,21 +175,15 @@ def guess_vector(problem: Problem, layout: Layout, mesh: Mesh,
                 raise ProblemError(f"guess: {name!r} is not a parameter "
                                    f"(parameters: {list(layout.parameters)})")
     for i, (ph, pl, tau) in enumerate(zip(problem.phases, layout.phases, mesh, strict=True)):
-        x, u = _default_states(ph, tau), _default_controls(ph, tau)
         spec = ph.duration_spec()
-        dur = spec.guess
-        if isinstance(guess, Result):
-            x, u, d = _from_result(guess, ph, i, tau, x, u)
-            dur = d if d is not None else dur
-        elif isinstance(guess, Guess) and ph.name in guess.phases:
-            pg = guess.phases[ph.name]
-            where = f"guess for phase {ph.name!r}"
-            x = _user_values(pg.x, tuple(ph.states), tau, pg.tau, x, f"{where} x")
-            u = _user_values(pg.u, tuple(ph.controls), tau, pg.tau, u, f"{where} u")
-            dur = pg.duration if pg.duration is not None else dur
+        x, u, dur = _phase_values(guess, ph, i, tau, spec.guess)
         w[pl.state_indices()] = x
         if ph.n_controls:
             w[pl.control_indices()] = u
+        if pl.midpoints:
+            # Midpoint states (separated Hermite-Simpson): the same guess at the midpoints.
+            x_mid, _, _ = _phase_values(guess, ph, i, 0.5 * (tau[:-1] + tau[1:]), spec.guess)
+            w[pl.midpoint_indices()] = x_mid
         if pl.duration_index is not None:
             if dur is None:
                 dur = default_value(spec.lower, spec.upper)

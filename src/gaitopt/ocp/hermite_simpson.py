@@ -23,6 +23,7 @@ class HermiteSimpson:
     name = "hermite-simpson"
     order = 4
     needs_midpoint_dynamics = True
+    midpoint_variables = False
 
     def midpoint_state(self, x_k: Any, x_k1: Any, f_k: Any, f_k1: Any, h: Any) -> Any:
         """``(x_k + x_{k+1}) / 2 + h (f_k - f_{k+1}) / 8``."""

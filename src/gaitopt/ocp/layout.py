@@ -4,14 +4,17 @@ Decision vector order (the documented contract; never index it by hand, use a La
 
     w = [ phase 0 block, phase 1 block, ..., parameters p (n_p) ]
     phase block = [ T (only if the duration is free),
-                    x_0 (n), u_0 (m), x_1 (n), u_1 (m), ..., x_{K-1} (n), u_{K-1} (m) ]
+                    x_0 (n), u_0 (m), x_1 (n), u_1 (m), ..., x_{K-1} (n), u_{K-1} (m),
+                    x_m0 (n), x_m1 (n), ..., x_m{N-1} (n)   (separated Hermite-Simpson only) ]
 
-Knot-major interleaving keeps the constraint Jacobian banded. The same layout serves
-Hermite-Simpson (compressed: no midpoint variables) and trapezoidal transcriptions.
+Knot-major interleaving keeps the constraint Jacobian banded. Compressed Hermite-Simpson and
+trapezoidal transcriptions have no midpoint variables; the separated Hermite-Simpson form
+appends the midpoint state of every interval after the knots of its phase.
 
 Constraint vector order::
 
     g = [ for each phase: defects (N intervals x n, interval-major),
+                          midpoint defects (N x n, separated Hermite-Simpson only),
                           path constraints at knots (K x r_knots, knot-major),
                           path constraints at midpoints (N x r_mid, interval-major),
                           duration bounds (1 row, only for bounded expression durations),
@@ -33,7 +36,9 @@ class PhaseLayout:
     """Where one phase's variables sit in w.
 
     ``start`` is the index of ``x_0[0]``; knot k occupies ``[start + k*stride, start +
-    (k+1)*stride)`` with ``stride = n + m``, states first.
+    (k+1)*stride)`` with ``stride = n + m``, states first. With ``midpoints = N`` (separated
+    Hermite-Simpson) the midpoint state of interval k follows the knots at
+    ``[midpoint_start + k*n, midpoint_start + (k+1)*n)``; otherwise ``midpoints = 0``.
     """
 
     name: str
@@ -42,6 +47,7 @@ class PhaseLayout:
     knots: int
     start: int
     duration_index: int | None
+    midpoints: int = 0
 
     @property
     def stride(self) -> int:
@@ -54,13 +60,22 @@ class PhaseLayout:
         return self.knots - 1
 
     @property
+    def midpoint_start(self) -> int:
+        """Index of the first midpoint state (one past the last knot variable)."""
+        return self.start + self.knots * self.stride
+
+    @property
     def end(self) -> int:
         """One past the last index of the phase block."""
-        return self.start + self.knots * self.stride
+        return self.midpoint_start + self.midpoints * len(self.states)
 
     def knot_block(self) -> slice:
         """All knot variables, reshapeable to (K, n + m) row-major."""
-        return slice(self.start, self.end)
+        return slice(self.start, self.midpoint_start)
+
+    def midpoint_block(self) -> slice:
+        """All midpoint states, reshapeable to (midpoints, n) row-major (empty if none)."""
+        return slice(self.midpoint_start, self.end)
 
     def _offset(self, kind: str, name: str) -> int:
         if kind == "state":
@@ -87,7 +102,27 @@ class PhaseLayout:
     def across_knots(self, kind: str, name: str) -> slice:
         """Slice of w giving ``name`` at every knot, (K,)."""
         first = self.start + self._offset(kind, name)
-        return slice(first, self.end, self.stride)
+        return slice(first, self.midpoint_start, self.stride)
+
+    def across_midpoints(self, name: str) -> slice:
+        """Slice of w giving state ``name`` at every midpoint, (midpoints,) (empty if none)."""
+        first = self.midpoint_start + self._offset("state", name)
+        return slice(first, self.end, len(self.states))
+
+    def midpoint_index(self, name: str, interval: int) -> int:
+        """Index in w of state ``name`` at the midpoint of ``interval`` (negative ok)."""
+        k = interval + self.midpoints if interval < 0 else interval
+        if not 0 <= k < self.midpoints:
+            raise IndexError(f"phase {self.name!r}: midpoint {interval} out of range "
+                             f"[0, {self.midpoints})")
+        return self.midpoint_start + k * len(self.states) + self._offset("state", name)
+
+    def midpoint_indices(self) -> NDArray[np.int64]:
+        """Indices of all midpoint states, (midpoints, n) ((0, n) if none)."""
+        n = len(self.states)
+        grid = self.midpoint_start + n * np.arange(self.midpoints)[:, None]
+        return np.asarray(grid + np.arange(n)[None, :], dtype=np.int64).reshape(
+            self.midpoints, n)
 
     def state_indices(self) -> NDArray[np.int64]:
         """Indices of all states, (K, n)."""
@@ -111,8 +146,9 @@ class Layout:
 
     @staticmethod
     def build(phase_specs: Sequence[tuple[str, Sequence[str], Sequence[str], int, bool]],
-              parameters: Sequence[str]) -> Layout:
-        """Lay out phases ``(name, states, controls, knots, has_free_duration)`` then p."""
+              parameters: Sequence[str], *, midpoint_states: bool = False) -> Layout:
+        """Lay out phases ``(name, states, controls, knots, has_free_duration)`` then p;
+        ``midpoint_states`` appends the N midpoint states of each phase after its knots."""
         pos = 0
         out = []
         for name, states, controls, knots, free in phase_specs:
@@ -120,7 +156,8 @@ class Layout:
             if free:
                 dur = pos
                 pos += 1
-            pl = PhaseLayout(name, tuple(states), tuple(controls), int(knots), pos, dur)
+            mids = int(knots) - 1 if midpoint_states else 0
+            pl = PhaseLayout(name, tuple(states), tuple(controls), int(knots), pos, dur, mids)
             out.append(pl)
             pos = pl.end
         return Layout(tuple(out), tuple(parameters), pos, pos + len(parameters))
@@ -159,7 +196,7 @@ class Layout:
 
     def signature(self) -> tuple[object, ...]:
         """Equal for layouts with the same variables in the same places."""
-        return (tuple((p.name, p.states, p.controls, p.knots, p.duration_index)
+        return (tuple((p.name, p.states, p.controls, p.knots, p.duration_index, p.midpoints)
                       for p in self.phases), self.parameters)
 
 

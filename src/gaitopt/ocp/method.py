@@ -20,6 +20,11 @@ class Method(Protocol):
     """Order of the state error on mesh refinement (h^order)."""
     needs_midpoint_dynamics: bool
     """Whether the defects use the dynamics at the interval midpoints."""
+    midpoint_variables: bool
+    """Whether the midpoint states are decision variables (separated form): then the NLP has
+    the midpoint defects ``x_m - midpoint_state(...) = 0`` and the dynamics, path constraints
+    and integrand at a midpoint are evaluated at the variable ``x_m``, never composed with the
+    knot dynamics."""
 
     def midpoint_state(self, x_k: Any, x_k1: Any, f_k: Any, f_k1: Any, h: Any) -> Any:
         """State at the interval midpoint from the scheme's interpolant, (n, N)."""

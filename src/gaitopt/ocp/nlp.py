@@ -4,8 +4,11 @@ With w the unscaled decision vector (see :mod:`gaitopt.ocp.layout`), phase i of 
 ``T_i`` starting at ``t0_i = t0 + sum_{j<i} T_j`` has knots ``t_k = t0_i + T_i tau_k``. The
 phase's point function is mapped over the K knots (and, when needed, over the N midpoints
 ``t_k + h_k/2`` with the method's midpoint state and the averaged control), giving the defects,
-the path constraints and the quadrature of the Lagrange integrand. The ends function adds the
-linkages, boundary constraints and the end/parameter costs::
+the path constraints and the quadrature of the Lagrange integrand. For a method with midpoint
+variables (separated Hermite-Simpson) the midpoint state is the variable ``x_m``, the point
+function is mapped once over the K + N points, and the midpoint defects
+``x_m - midpoint_state(x_k, x_{k+1}, f_k, f_{k+1}, h)`` are added after the defects. The
+ends function adds the linkages, boundary constraints and the end/parameter costs::
 
     J = (sum_i quad_i(L_i) + M(ends, p) + P(p)) / D(ends, p)
 
@@ -111,25 +114,39 @@ def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
         else:
             T = ca.MX(spec.lower)
         durations.append(T)
-        Z = ca.reshape(w[pl.start:pl.end], pl.stride, K)
+        Z = ca.reshape(w[pl.knot_block()], pl.stride, K)
         X, U = Z[:n, :], Z[n:, :]
         tk = t_start + T * ca.DM(tau).T
+        tm = t_start + T * ca.DM(0.5 * (tau[:-1] + tau[1:])).T
         dtau = ca.DM(np.diff(tau)).T
         h = T * dtau
         Hn = ca.repmat(h, n, 1)
-        XD, C, L = pf.point.map(K)(X, U, p, tk)
-        x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
-        need_mid = method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0
+        Um = midpoint_control(U[:, :-1], U[:, 1:])
+        mid_defects = None
         f_m = L_m = None
-        if need_mid:
-            Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
-            Um = midpoint_control(U[:, :-1], U[:, 1:])
-            tm = t_start + T * ca.DM(0.5 * (tau[:-1] + tau[1:])).T
-            f_m, Cm, L_m = pf.point.map(N)(Xm, Um, p, tm)
+        if method.midpoint_variables:
+            # Separated form: one call of the point function per knot and per midpoint, all
+            # in one map, at the variable midpoint states (no dynamics nested in dynamics).
+            Xm = ca.reshape(w[pl.midpoint_block()], n, N)
+            XD, C, L = pf.point.map(K + N)(ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
+                                           ca.horzcat(tk, tm))
+            f_m, Cm, L_m = XD[:, K:], C[:, K:], L[:, K:]
+            XD, C, L = XD[:, :K], C[:, :K], L[:, :K]
+            x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
+            mid_defects = Xm - method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
+        else:
+            XD, C, L = pf.point.map(K)(X, U, p, tk)
+            x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
+            if method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0:
+                Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
+                f_m, Cm, L_m = pf.point.map(N)(Xm, Um, p, tm)
         defects = method.defects(x_k, x_k1, f_k, f_k1, f_m, Hn)
         dx = state_scales[i]
         rows.add(f"{ph.name}/defects", ph.name, "defects", flat(defects), (N, n),
                  np.zeros(N * n), np.zeros(N * n), np.tile(dx, N))
+        if mid_defects is not None:
+            rows.add(f"{ph.name}/midpoint defects", ph.name, "defects", flat(mid_defects),
+                     (N, n), np.zeros(N * n), np.zeros(N * n), np.tile(dx, N))
         r = pf.n_path
         rows.add(f"{ph.name}/path@knots", ph.name, "path", flat(C), (K, r),
                  np.tile(pf.path_lower, K), np.tile(pf.path_upper, K), np.tile(pf.path_scale, K))

@@ -1,8 +1,9 @@
 """The result of a solve: always returned, converged or not.
 
 Trajectories are per phase at the knots (``t`` (K,), ``x`` (K, n), ``u`` (K, m)) with
-interpolants consistent with the transcription: cubic Hermite states for Hermite-Simpson
-(through x_k with slope f_k), quadratic for trapezoidal, piecewise-linear controls.
+interpolants consistent with the transcription: cubic Hermite states for Hermite-Simpson, in
+both its forms (through x_k with slope f_k), quadratic for trapezoidal, piecewise-linear
+controls. The separated form also keeps its midpoint state variables (``x_mid``).
 """
 
 from __future__ import annotations
@@ -15,12 +16,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from gaitopt.ocp.hermite_simpson import HermiteSimpson
+from gaitopt.ocp.hermite_simpson_separated import HermiteSimpsonSeparated
 from gaitopt.ocp.method import Method, control_at
 from gaitopt.ocp.trapezoidal import Trapezoidal
 
 Array = NDArray[np.float64]
 
-METHODS: dict[str, Method] = {"hermite-simpson": HermiteSimpson(), "trapezoidal": Trapezoidal()}
+METHODS: dict[str, Method] = {"hermite-simpson": HermiteSimpson(),
+                               "hermite-simpson-separated": HermiteSimpsonSeparated(),
+                               "trapezoidal": Trapezoidal()}
 
 
 @dataclass(frozen=True)
@@ -46,7 +50,9 @@ class PhaseTrajectory:
     Attributes: ``t`` (K,) s; ``x`` (K, n); ``u`` (K, m); ``xdot`` (K, n) the dynamics
     f(x_k, u_k, p, t_k); ``path`` path-constraint values at the knots by name, (K, r);
     ``error`` (N,) relative per-interval error estimate and ``error_by_state`` (N, n) the
-    absolute integrated residuals (see :mod:`gaitopt.ocp.estimate`).
+    absolute integrated residuals (see :mod:`gaitopt.ocp.estimate`); ``x_mid`` (N, n) the
+    midpoint state variables of the separated Hermite-Simpson form (at a converged point equal
+    to ``x_at`` at the interval midpoints), ``None`` for the other methods.
     """
 
     name: str
@@ -60,6 +66,7 @@ class PhaseTrajectory:
     path: Mapping[str, Array]
     error: Array
     error_by_state: Array
+    x_mid: Array | None = None
 
     @property
     def t0(self) -> float:
@@ -172,6 +179,11 @@ class Result:
     def max_error(self) -> float:
         """Largest per-interval error estimate over all phases."""
         return max(float(np.max(ph.error)) if ph.error.size else 0.0 for ph in self.phases)
+
+    def errors_by_phase(self) -> dict[str, float]:
+        """Largest per-interval error estimate of each phase, by phase name."""
+        return {ph.name: float(np.max(ph.error)) if ph.error.size else 0.0
+                for ph in self.phases}
 
     @property
     def infeasible(self) -> bool:

@@ -58,6 +58,7 @@ def variable_scales(problem: Problem, layout: Layout, enabled: bool = True) -> A
         return d
     for ph, pl in zip(problem.phases, layout.phases, strict=True):
         d[pl.state_indices()] = state_scales(ph)[None, :]
+        d[pl.midpoint_indices()] = state_scales(ph)[None, :]
         if ph.n_controls:
             d[pl.control_indices()] = control_scales(ph)[None, :]
         if pl.duration_index is not None:

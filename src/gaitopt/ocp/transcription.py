@@ -52,7 +52,8 @@ class Transcription:
     """The NLP of ``problem`` transcribed by ``method`` on ``mesh``, with cached solvers.
 
     Attributes:
-        problem, method (name), mesh (normalised knots per phase), layout (w), nlp
+        problem, method (name), mesh (normalised knots per phase), midpoint_bounds (state
+        bounds at the separated form's midpoints), layout (w), nlp
         (symbolic NLP with constraint layout and scales), builds (Counter: ``nlp``,
         ``solver``), options (the default solver options).
     """
@@ -60,8 +61,8 @@ class Transcription:
     def __init__(self, problem: Problem, method: str, mesh: Mesh, *, expand: bool | None = None,
                  compiled: str | None = None, options: Mapping[str, Any] | None = None,
                  scaling: bool = True, cse: bool = True,
-                 compile_flags: Sequence[str] | None = None, build_solver: bool = True
-                 ) -> None:
+                 compile_flags: Sequence[str] | None = None, build_solver: bool = True,
+                 midpoint_bounds: bool = True) -> None:
         check_problem(problem)
         if method not in METHODS:
             raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -81,7 +82,8 @@ class Transcription:
         n_p = len(problem.parameters)
         self.layout = Layout.build(
             [(ph.name, ph.states, ph.controls, tau.size, ph.duration_spec().kind == "free")
-             for ph, tau in zip(problem.phases, mesh, strict=True)], problem.parameter_names)
+             for ph, tau in zip(problem.phases, mesh, strict=True)], problem.parameter_names,
+            midpoint_states=METHODS[method].midpoint_variables)
         self.phase_functions: tuple[PhaseFunction, ...] = tuple(
             build_phase_function(ph, n_p, cse=cse) for ph in problem.phases)
         sx = tuple(state_scales(ph, scaling) for ph in problem.phases)
@@ -90,9 +92,10 @@ class Transcription:
         d_w = variable_scales(problem, self.layout, scaling)
         self.nlp: Nlp = assemble(problem, METHODS[method], mesh, self.layout,
                                  self.phase_functions, ends, d_w, sx)
-        lbw, ubw = variable_bounds(problem, self.layout)
+        self.midpoint_bounds = midpoint_bounds
+        lbw, ubw = variable_bounds(problem, self.layout, midpoint_bounds)
         self._bounds = Bounds(self.layout, self.nlp.constraints, lbw, ubw, self.nlp.lbg,
-                              self.nlp.ubg)
+                              self.nlp.ubg, midpoint_bounds)
         self._bounds.check()
         self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
         self.builds["nlp"] += 1
@@ -237,9 +240,10 @@ class Transcription:
             else:
                 eta, err = np.full((tau.size - 1, ph.n_states), np.nan), np.full(tau.size - 1,
                                                                                  np.nan)
+            x_mid = w[pl.midpoint_indices()] if pl.midpoints else None
             phases.append(PhaseTrajectory(
                 ph.name, tuple(ph.states), tuple(ph.controls), self.method, t, x, u, xdot,
-                {pr.name: path[:, pr.rows] for pr in pf.path_rows}, err, eta))
+                {pr.name: path[:, pr.rows] for pr in pf.path_rows}, err, eta, x_mid))
             t_start = t_start + T
         st = out.stats
         status = str(st.get("return_status", "unknown")) if out.error is None else \
@@ -269,11 +273,13 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
                expand: bool | None = None, compiled: str | None = None,
                options: Mapping[str, Any] | None = None, scaling: bool = True,
                cse: bool = True, compile_flags: Sequence[str] | None = None,
-               build_solver: bool = True) -> Transcription:
+               build_solver: bool = True, midpoint_bounds: bool = True) -> Transcription:
     """Validate ``problem``, build its NLP and solver once, and return the transcription.
 
     Args:
-        method: ``"hermite-simpson"`` (default) or ``"trapezoidal"``.
+        method: ``"hermite-simpson"`` (default; DIRCOL's compressed form),
+            ``"hermite-simpson-separated"`` (the same scheme with the midpoint states as
+            variables: same optimum, cheaper derivatives) or ``"trapezoidal"``.
         intervals: None (each phase's ``intervals``), an int for all phases, or by phase name
             an int (uniform) or an array of normalised knots in [0, 1].
         expand: evaluate the NLP as one SX graph rather than MX with mapped point functions.
@@ -291,6 +297,9 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
         build_solver: build the solver for ``options`` now (default), or at the first solve
             (a caller that solves with a limited-memory Hessian first never derives the
             exact one it would not use: for a large expanded NLP, most of the build time).
+        midpoint_bounds: separated Hermite-Simpson only: the state box bounds hold at the
+            midpoint state variables too (default). ``False`` leaves them unbounded, which
+            makes the NLP equivalent to the compressed one (the same optimum on every mesh).
     """
     if method not in METHODS:
         raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -298,4 +307,4 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
     mesh = make_mesh(problem, intervals)
     return Transcription(problem, method, mesh, expand=expand, compiled=compiled,
                          options=options, scaling=scaling, cse=cse, compile_flags=compile_flags,
-                         build_solver=build_solver)
+                         build_solver=build_solver, midpoint_bounds=midpoint_bounds)

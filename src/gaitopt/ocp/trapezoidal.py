@@ -20,6 +20,7 @@ class Trapezoidal:
     name = "trapezoidal"
     order = 2
     needs_midpoint_dynamics = False
+    midpoint_variables = False
 
     def midpoint_state(self, x_k: Any, x_k1: Any, f_k: Any, f_k1: Any, h: Any) -> Any:
         """``(x_k + x_{k+1}) / 2 + h (f_k - f_{k+1}) / 8`` (the quadratic at s = 1/2)."""

@@ -135,11 +135,21 @@ class Actuator:
 
 
 @dataclass(frozen=True)
+class SymmetrySpec:
+    """A declared left/right symmetry: pairs of link names and of contact names that swap
+    with a step (see :mod:`gaitopt.robot.symmetry`)."""
+
+    links: tuple[tuple[str, str], ...]
+    contacts: tuple[tuple[str, str], ...]
+
+
+@dataclass(frozen=True)
 class RobotModel:
     """An immutable planar multibody model (a tree with a floating base).
 
     ``links[0]`` is the floating base; every other link comes after its parent. ``gravity`` is
-    the world gravity vector in m/s^2.
+    the world gravity vector in m/s^2. ``symmetry`` is the declared left/right symmetry, or
+    None (then it is inferred where needed: :func:`gaitopt.robot.symmetry.model_symmetry`).
     """
 
     name: str
@@ -148,6 +158,7 @@ class RobotModel:
     actuators: tuple[Actuator, ...]
     gravity: tuple[float, float] = (0.0, -9.81)
     description: str = ""
+    symmetry: SymmetrySpec | None = None
     _index: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
     # ``_index`` is derived from ``links`` and excluded from ``==`` and ``hash``; models are
     # hashable (usable as cache keys) because every field is immutable.

@@ -31,14 +31,24 @@ import numbers
 from collections.abc import Mapping
 from typing import Any
 
-from gaitopt.robot.model import Actuator, Contact, Direction, Joint, Link, RobotModel, Shape
+from gaitopt.robot.model import (
+    Actuator,
+    Contact,
+    Direction,
+    Joint,
+    Link,
+    RobotModel,
+    Shape,
+    SymmetrySpec,
+)
 
 FORMAT = "gaitopt.model"
 VERSION = 1
 DEFAULT_GRAVITY: tuple[float, float] = (0.0, -9.81)
 
 TOP_KEYS = ("format", "version", "name", "description", "gravity", "links", "contacts",
-            "actuators")
+            "actuators", "symmetry")
+SYMMETRY_KEYS = ("links", "contacts")
 LINK_KEYS = ("name", "parent", "joint", "direction", "length", "mass", "com", "inertia", "shape")
 JOINT_KEYS = ("name", "at", "limits")
 CONTACT_KEYS = ("name", "link", "at")
@@ -138,12 +148,16 @@ def model_to_dict(model: RobotModel) -> dict[str, Any]:
     for a in model.actuators:
         target = {"joint": a.joint} if a.joint is not None else {"contact": a.contact}
         actuators.append({"name": a.name, **target, "limits": list(a.limits)})
-    return {
+    out = {
         "format": FORMAT, "version": VERSION, "name": model.name,
         "description": model.description, "gravity": list(model.gravity), "links": links,
         "contacts": [{"name": c.name, "link": c.link, "at": list(c.at)} for c in model.contacts],
         "actuators": actuators,
     }
+    if model.symmetry is not None:  # only when declared: older models keep their hash
+        out["symmetry"] = {"links": [list(p) for p in model.symmetry.links],
+                           "contacts": [list(p) for p in model.symmetry.contacts]}
+    return out
 
 
 # -- plain data -> model ---------------------------------------------------------------------
@@ -280,8 +294,46 @@ class _Validator:
                                                     "contact points"), links)
         actuators = self.actuators(self.optional_list("actuators", top.get("actuators"),
                                                       "actuators"), links, contacts)
-        return RobotModel(name=name, links=links, contacts=contacts, actuators=actuators,
-                          gravity=gravity, description=description)
+        symmetry = (self.symmetry(top["symmetry"], links, contacts)
+                    if top.get("symmetry") is not None else None)
+        model = RobotModel(name=name, links=links, contacts=contacts, actuators=actuators,
+                           gravity=gravity, description=description, symmetry=symmetry)
+        if symmetry is not None:
+            from gaitopt.robot.symmetry import SymmetryError, swap_permutations
+
+            try:
+                swap_permutations(model)
+            except SymmetryError as exc:
+                raise self.fail("symmetry", top["symmetry"],
+                                "pairs that map the model onto itself", problem=str(exc)
+                                ) from None
+        return model
+
+    def symmetry(self, raw: Any, links: tuple[Link, ...],
+                 contacts: tuple[Contact, ...]) -> SymmetrySpec:
+        """``{links: [[a, b], ...], contacts: [[c, d], ...]}``: disjoint pairs of names."""
+        top = self.mapping("symmetry", raw, SYMMETRY_KEYS, ("contacts",),
+                           "the left/right symmetry (pairs of links and of contacts)")
+        seen: set[str] = set()
+        out: dict[str, tuple[tuple[str, str], ...]] = {}
+        for key, known in (("links", [link.name for link in links[1:]]),
+                           ("contacts", [c.name for c in contacts])):
+            pairs = []
+            for i, item in enumerate(self.optional_list(f"symmetry.{key}", top.get(key), key)):
+                path = f"symmetry.{key}[{i}]"
+                if (not isinstance(item, list) or len(item) != 2
+                        or not all(isinstance(n, str) and n in known for n in item)
+                        or item[0] == item[1]):
+                    raise self.fail(path, item, f"a pair [left, right] of two different "
+                                                f"{key} of this model ({_names(known)})")
+                for n in item:
+                    if n in seen:
+                        raise self.fail(path, item, "each name in one pair at most",
+                                        problem=f"{n!r} is already paired")
+                    seen.add(n)
+                pairs.append((item[0], item[1]))
+            out[key] = tuple(pairs)
+        return SymmetrySpec(links=out["links"], contacts=out["contacts"])
 
     def links(self, raw: Any) -> tuple[Link, ...]:
         if not isinstance(raw, list) or not raw:

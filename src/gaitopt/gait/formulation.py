@@ -1,0 +1,48 @@
+"""The two formulations of the walking problem behind one interface.
+
+``GaitOptions.formulation`` chooses between the paper's reduced coordinates
+(:mod:`gaitopt.gait.problem`, :mod:`gaitopt.gait.walking`) and full coordinates on a contact
+sequence (:mod:`gaitopt.gait.full_coordinates`). The staged solve (:mod:`gaitopt.gait.solve`)
+asks this module for the legs, the problem and the bounds of a stage; everything else
+(guesses, stages, warm starts, refinement) is shared.
+"""
+
+from __future__ import annotations
+
+from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.gait import full_coordinates as full
+from gaitopt.gait.contact_sequence import ContactSequence, running_sequence, walking_sequence
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
+from gaitopt.ocp import Bounds, Problem, Transcription
+from gaitopt.robot.biped import BipedStructure, biped_structure
+from gaitopt.robot.model import RobotModel
+
+
+def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure:
+    """The legs of ``model``: the reduced formulation needs exactly the five-link shape, the
+    full one any torso with two thigh-shank legs (other links allowed)."""
+    return checked_biped(model) if options.formulation == "reduced" else biped_structure(model)
+
+
+def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
+    """The contact sequence of ``options``: the paper's walk, the single-support walk or a
+    run."""
+    if options.gait == "run":
+        return running_sequence(model, options.single_support_fraction)
+    return walking_sequence(model, options.single_support_fraction,
+                            impulse=options.impulse and options.double_support)
+
+
+def problem_for(model: RobotModel, options: GaitOptions) -> Problem:
+    """The OCP of one step in the formulation ``options.formulation``."""
+    if options.formulation == "full":
+        return full.full_problem(model, options, contact_sequence(model, options))
+    return walking_problem(model, options)
+
+
+def stage_bounds(tr: Transcription, relax: Relaxation, options: GaitOptions) -> Bounds:
+    """The bounds of a stage: the unilateral conditions relaxed by ``relax``."""
+    if options.formulation == "full":
+        return full.full_stage_bounds(tr, relax.force, relax.impulse)
+    return relaxed_bounds(tr, relax)

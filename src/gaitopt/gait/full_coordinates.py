@@ -1,0 +1,528 @@
+"""The walking problem in full coordinates: the whole tree's ``q, qd`` on a contact sequence.
+
+Beside the paper's reduced formulation (:mod:`gaitopt.gait.problem`: polar hip coordinates and
+leg inverse kinematics, singular at a straight knee, five-link bipeds only), this formulation
+works for any planar tree with contact points and any :class:`ContactSequence`:
+
+* every phase has the states ``x = [q, qd]`` (``2 nq``, named after ``model.coordinate_names``
+  and ``<name>_rate``) and the controls: the joint actuators, the contact (ankle) actuators of
+  the held points when ankle torques are on, and the *projection controls* below;
+* dynamics: the Contact Algorithm with the phase's points held (``qdd`` and the contact forces
+  ``f`` from :func:`gaitopt.dynamics.contact.contact_dynamics`), plus the projection::
+
+      q'  = qd  + J(q)^T gamma
+      qd' = qdd + J(q)^T nu
+
+  ``gamma, nu`` (2 per held point, named ``gamma_<c>_x`` ...) are free controls that only move
+  the state back onto the constraint manifold. The held points' positions ``p_c(q) = (a_c L,
+  0)`` and velocities ``J qd = 0`` are enforced at every knot after the first (at the first
+  they follow from the event map and the previous phase, so they are not stated twice), and
+  ``gamma = nu = 0`` at the first knot. This makes the NLP square in the constraint
+  directions: the projection is the discrete correction of the collocation's drift (as in
+  Posa, Kuindersma and Tedrake 2016) and vanishes as the grid is refined. The contact points
+  stay put to the solver's tolerance at every knot;
+* events: an inelastic impact (:func:`gaitopt.dynamics.impact.impact`) when points touch
+  down, the liftoff impulse (:func:`gaitopt.dynamics.impact.liftoff_impulse`) when a point is
+  released with one, and after the last event the leg swap and the shift by one step;
+* constraints as in the reduced problem where they make sense: torque and joint limits
+  (joints may reach them: a knee may straighten fully), normal forces and impulses ``>= 0``,
+  optional friction cones, every point that is not held above the ground, released points
+  moving up, points touching down at their anchors, controls continuous and periodic;
+* the paper's objective ``(sum of int u'u dt + P^2) / L`` over the actuator controls only.
+
+The rows relaxed by the first continuation stage are named like the reduced problem's
+(:data:`FORCES`, :data:`IMPULSES`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from gaitopt.dynamics.actuation import generalized_forces
+from gaitopt.dynamics.backend import as_scalars, vector
+from gaitopt.dynamics.contact import contact_dynamics
+from gaitopt.dynamics.impact import impact, liftoff_impulse
+from gaitopt.dynamics.kinematics import contact_jacobian, contact_position, contact_velocity
+from gaitopt.gait import cost
+from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, check_sequence
+from gaitopt.gait.options import GaitOptions
+from gaitopt.ocp.bounds import Bounds
+from gaitopt.ocp.problem import (
+    BoundaryConstraint,
+    ControlLinkage,
+    Duration,
+    Linkage,
+    Parameter,
+    PathConstraint,
+    Phase,
+    Problem,
+)
+from gaitopt.ocp.transcription import Transcription
+from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import swap_maps, swap_permutations
+
+STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
+_L, _V, _P = range(3)
+
+#: Path constraint of the held points' positions and velocities (knots only).
+HELD = "held points: position and velocity"
+#: Path constraint of the normal contact forces (and friction cones).
+FORCES = "contact forces"
+#: Path constraint of the points not held: heights >= 0.
+CLEARANCE = "free points above the ground"
+#: The same for the points that touch down at the end of the phase (not at its last knot,
+#: where the touchdown constraint puts them on the ground).
+LANDING_CLEARANCE = "landing points above the ground"
+#: Boundary constraints of the events (suffixes of ``<event>: ...``).
+TOUCHDOWN = "touchdown at the anchor"
+IMPULSES = "normal impulses"
+RISE = "released points rise (impulse)"
+EVENT_FRICTION = "friction cones of the impulses"
+#: The step time ``L / v`` (s) row, present when a step time is given.
+STEP_TIME = "step time L / v"
+#: Bound on the projection controls (m/s and m/s^2 per unit of J^T): generous, they vanish.
+PROJECTION_BOUND = 10.0
+#: Scales of the rate states (rad/s, m/s) and of the projection controls in the NLP. Measured
+#: from the naive guess at 12 m/min: with projection controls scaled by 0.01 (their size at
+#: the optimum) two of three cold starts did not converge in 500 iterations; scaled by 1,
+#: all three converge in 33-47; rate scale 5 made it worse.
+RATE_SCALE = 1.0
+PROJECTION_SCALE = 1.0
+
+
+@dataclass(frozen=True)
+class Symmetry:
+    """How the legs swap after a step: permutations of ``q`` (nq,) and ``u`` (nu,), and the
+    contact names."""
+
+    perm_q: tuple[int, ...]
+    perm_u: tuple[int, ...]
+    contacts: Mapping[str, str]
+
+
+def model_symmetry(model: RobotModel) -> Symmetry:
+    """The leg swap of a model (declared in its file or inferred:
+    :mod:`gaitopt.robot.symmetry`)."""
+    perm_q, perm_u = swap_permutations(model)
+    _, contacts = swap_maps(model)
+    return Symmetry(tuple(int(i) for i in perm_q), tuple(int(i) for i in perm_u), contacts)
+
+
+def state_names(model: RobotModel) -> tuple[str, ...]:
+    """``[q, qd]`` names: the coordinates, then ``<coordinate>_rate``."""
+    names = model.coordinate_names
+    return names + tuple(f"{n}_rate" for n in names)
+
+
+def projection_names(held: Sequence[str]) -> tuple[str, ...]:
+    """Names of the projection controls of the held points."""
+    return tuple(f"{kind}_{c}_{axis}" for kind in ("gamma", "nu") for c in held
+                 for axis in ("x", "y"))
+
+
+def actuator_names(model: RobotModel, held: Sequence[str], *, ankle: bool) -> tuple[str, ...]:
+    """Actuators acting in a phase, in model order: the joint actuators, and the contact
+    actuators of held points when ``ankle``."""
+    return tuple(a.name for a in model.actuators
+                 if a.joint is not None or (ankle and a.contact in held))
+
+
+def full_controls(model: RobotModel, names: Sequence[str], u: Any) -> list[Any]:
+    """The model's actuator vector (nu,) from the first ``len(names)`` entries of ``u``."""
+    values = as_scalars(u, len(names), "u") if len(names) else []
+    out: list[Any] = [0.0] * model.nu
+    for name, value in zip(names, values, strict=True):
+        out[model.actuator_index(name)] = value
+    return out
+
+
+@dataclass(frozen=True)
+class PointValues:
+    """What the phase dynamics computes at one point."""
+
+    xdot: Any
+    qdd: Any
+    forces: Any
+
+
+def phase_point(model: RobotModel, held: Sequence[str], actuators: Sequence[str], x: Any,
+                u: Any) -> PointValues:
+    """``xdot = [qd + J^T gamma, qdd + J^T nu]`` with ``qdd, f`` from the Contact Algorithm
+    (``u`` = actuator torques then projection controls)."""
+    nq, na = model.nq, len(actuators)
+    xs = as_scalars(x, 2 * nq, "x")
+    q, qd = xs[:nq], xs[nq:]
+    us = as_scalars(u, na + 4 * len(held), "u")
+    tau = generalized_forces(model, vector(q), vector(full_controls(model, actuators,
+                                                                    us[:na])), held)
+    sol = contact_dynamics(model, vector(q), vector(qd), tau, held)
+    qdd = as_scalars(sol.qdd, nq, "qdd")
+    dq, dqd = list(qd), list(qdd)
+    if held:
+        m = 2 * len(held)
+        gamma, nu = us[na:na + m], us[na + m:na + 2 * m]
+        jac = contact_jacobian(model, vector(q), held)
+        for r in range(m):
+            for j in range(nq):
+                dq[j] = dq[j] + jac[r, j] * gamma[r]
+                dqd[j] = dqd[j] + jac[r, j] * nu[r]
+    return PointValues(xdot=vector(dq + dqd), qdd=sol.qdd, forces=sol.forces)
+
+
+@dataclass(frozen=True)
+class EventValues:
+    """A velocity jump: ``qd_after`` (nq,) and the impulses on each point by name (2,)."""
+
+    qd_after: Any
+    impulses: dict[str, Any]
+
+
+def event_map(model: RobotModel, seq: ContactSequence, i: int, q: Any, qd: Any,
+              impulse: Any) -> EventValues:
+    """Event ``i``: impact of the points held afterwards if any touch down; else the
+    liftoff impulse of magnitude ``impulse`` (N s) on the released point; else nothing."""
+    ev: EventSpec = seq.events[i]
+    after = seq.held_after(i)
+    if ev.touchdown:
+        sol = impact(model, q, qd, after)
+        flat = as_scalars(sol.impulses, 2 * len(after), "impulses")
+        return EventValues(sol.qd_plus, {c: vector(flat[2 * k:2 * k + 2])
+                                         for k, c in enumerate(after)})
+    if ev.impulse:
+        lift = liftoff_impulse(model, q, qd, ev.release[0], impulse, after)
+        flat = as_scalars(lift.impulses_held, 2 * len(after), "impulses") if after else []
+        out = {ev.release[0]: lift.impulse_lifting}
+        out |= {c: vector(flat[2 * k:2 * k + 2]) for k, c in enumerate(after)}
+        return EventValues(lift.qd_plus, out)
+    return EventValues(qd, {})
+
+
+def event_impulses(model: RobotModel, seq: ContactSequence, i: int, x: Any, impulse: Any
+                   ) -> dict[str, Any]:
+    """The impulses of event ``i`` as the constraints see them (N s, by point).
+
+    A touchdown's impact impulses come from the state ``x = [q, qd]`` before it. A release's
+    impulses on the held points are evaluated with ``qd = 0``: the held points stand still
+    before the release (``J qd = 0``, enforced at the phase's last knot), so this is the same
+    value, written without the dependence on those rows (which would make the constraint a
+    combination of them, a degenerate NLP when the impulse is 0)."""
+    nq = model.nq
+    xs = as_scalars(x, 2 * nq, "x")
+    q = vector(xs[:nq])
+    qd = vector(xs[nq:]) if seq.events[i].touchdown else vector([0.0] * nq)
+    return event_map(model, seq, i, q, qd, impulse).impulses
+
+
+def swap_state(model: RobotModel, symmetry: Symmetry, q: Any, qd: Any, step: Any
+               ) -> tuple[list[Any], list[Any]]:
+    """The next step's ``(q, qd)``: legs swapped, moved back by one step length."""
+    qs, qds = as_scalars(q, model.nq, "q"), as_scalars(qd, model.nq, "qd")
+    q_next = [qs[j] for j in symmetry.perm_q]
+    q_next[0] = q_next[0] - step
+    return q_next, [qds[j] for j in symmetry.perm_q]
+
+
+def _limits(model: RobotModel) -> dict[str, tuple[float, float]]:
+    return {j.name: j.limits for j in model.joints}
+
+
+def stance_knees(model: RobotModel) -> dict[str, str]:
+    """Contact name -> the knee joint of its leg, for five-link-like models (else empty)."""
+    from gaitopt.robot.biped import BipedStructureError, biped_structure
+
+    try:
+        legs = biped_structure(model).legs
+    except BipedStructureError:
+        return {}
+    return {leg.contact: leg.knee for leg in legs}
+
+
+def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) -> Problem:
+    """The OCP of one periodic step of ``seq`` in full coordinates (module docstring)."""
+    symmetry = model_symmetry(model)
+    check_sequence(model, seq, dict(symmetry.contacts))
+    nq = model.nq
+    mu = options.friction
+    floor = 0.0 if options.unilateral_impulses else -ca.inf
+    limits = _limits(model)
+    knees = stance_knees(model)
+    names = state_names(model)
+    weight = model.total_mass * 9.81
+    rate = options.rate_bound
+
+    def state_bounds(held: Sequence[str]) -> dict[str, tuple[float, float]]:
+        b: dict[str, tuple[float, float]] = {
+            "x": (-3.0, 3.0), "y": (0.0, 3.0),
+            model.base.name: (options.torso_bounds[0], options.torso_bounds[1])}
+        for j, lim in limits.items():
+            b[j] = lim
+        for c in held:
+            knee = knees.get(c)
+            if knee is not None and options.min_stance_knee_flexion > 0.0:
+                lo, hi = limits[knee]
+                b[knee] = (lo, min(hi, -options.min_stance_knee_flexion))
+        for n in model.coordinate_names:
+            b[f"{n}_rate"] = (-rate, rate)
+        return b
+
+    phases: list[Phase] = []
+    actuators_of: dict[str, tuple[str, ...]] = {}
+    for ph in seq.phases:
+        held = ph.held
+        acts = actuator_names(model, held, ankle=options.ankle)
+        actuators_of[ph.name] = acts
+        proj = projection_names(held)
+        controls = acts + proj
+        cache: dict[str, Any] = {}
+
+        def point(x: Any, u: Any, held: tuple[str, ...] = held, acts: tuple[str, ...] = acts,
+                  cache: dict[str, Any] = cache) -> PointValues:
+            key = cache.get("key")
+            if key is None or key[0] is not x or key[1] is not u:
+                cache["value"] = phase_point(model, held, acts, x, u)
+                cache["key"] = (x, u)
+            return cache["value"]
+
+        path: list[PathConstraint] = []
+        if held:
+            def held_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held) -> Any:
+                xs = as_scalars(x, 2 * nq, "x")
+                q, qd = vector(xs[:nq]), vector(xs[nq:])
+                rows: list[Any] = []
+                for c in held:
+                    pos = as_scalars(contact_position(model, q, c), 2, "p")
+                    rows += [pos[0] - seq.anchor(c) * p[_L], pos[1]]
+                for c in held:
+                    rows += as_scalars(contact_velocity(model, q, qd, c), 2, "v")
+                return vector(rows)
+
+            def force_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held,
+                           point: Any = point) -> Any:
+                f = as_scalars(point(x, u).forces, 2 * len(held), "forces")
+                rows = [f[2 * k + 1] for k in range(len(held))]
+                if mu is not None:
+                    for k in range(len(held)):
+                        rows += [mu * f[2 * k + 1] - f[2 * k], mu * f[2 * k + 1] + f[2 * k]]
+                return vector(rows)
+
+            path.append(PathConstraint(HELD, held_rows, lower=0.0, upper=0.0, at="knots",
+                                       scale=[0.1] * (2 * len(held)) + [1.0] * (2 * len(held))))
+            path.append(PathConstraint(FORCES, force_rows, lower=0.0, upper=ca.inf,
+                                       scale=weight))
+        landing = seq.events[len(phases)].touchdown
+        free = [c.name for c in model.contacts if c.name not in held]
+        for label, points in ((CLEARANCE, [c for c in free if c not in landing]),
+                              (LANDING_CLEARANCE, [c for c in free if c in landing])):
+            if not points:
+                continue
+
+            def clearance(x: Any, u: Any, p: Any, t: Any, points: list[str] = points) -> Any:
+                q = vector(as_scalars(x, 2 * nq, "x")[:nq])
+                return vector([as_scalars(contact_position(model, q, c), 2, "p")[1]
+                               for c in points])
+
+            path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf, scale=0.1))
+
+        def dynamics(x: Any, u: Any, p: Any, t: Any, point: Any = point) -> Any:
+            return point(x, u).xdot
+
+        def lagrange(x: Any, u: Any, p: Any, t: Any, acts: tuple[str, ...] = acts,
+                     n_u: int = len(controls)) -> Any:
+            n_act = len(acts)
+            if options.cost == "paper" and options.cost_regularization == 0.0:
+                return ca.sumsqr(u[:n_act]) if n_act else ca.SX(0.0)
+            qd = vector(as_scalars(x, 2 * nq, "x")[nq:])
+            u_act = as_scalars(u, n_u, "u")[:n_act] if n_act else []
+            return cost.running_cost(model, options, qd, full_controls(model, acts, u_act), p)
+
+        control_bounds = {a: model.actuators[model.actuator_index(a)].limits for a in acts}
+        control_bounds |= {n: (-PROJECTION_BOUND, PROJECTION_BOUND) for n in proj}
+        scales = {n: 1.0 for n in names} | {f"{n}_rate": RATE_SCALE
+                                            for n in model.coordinate_names}
+        phases.append(Phase(
+            name=ph.name, states=names, controls=controls, dynamics=dynamics,
+            duration=Duration.of_parameters(_step_share(ph.fraction)),
+            state_bounds=state_bounds(held), control_bounds=control_bounds,
+            initial_control={n: 0.0 for n in proj}, path_constraints=path,
+            lagrange=lagrange, state_scales=scales,
+            control_scales={n: PROJECTION_SCALE for n in proj},
+            intervals=options.knots[min(len(phases), len(options.knots) - 1)] - 1))
+
+    linkages: list[Linkage | ControlLinkage] = []
+    events: list[BoundaryConstraint] = []
+    n_ph = len(seq.phases)
+
+    def split(x: Any) -> tuple[Any, Any]:
+        xs = as_scalars(x, 2 * nq, "x")
+        return vector(xs[:nq]), vector(xs[nq:])
+
+    for i, ev in enumerate(seq.events):
+        src, dst = seq.phases[i].name, seq.phases[(i + 1) % n_ph].name
+        last = i == n_ph - 1
+
+        def jump(xf: Any, uf: Any, p: Any, i: int = i, last: bool = last) -> Any:
+            q, qd = split(xf)
+            after = event_map(model, seq, i, q, qd, p[_P]).qd_after
+            if last:
+                q_next, qd_next = swap_state(model, symmetry, q, after, p[_L])
+                return vector(q_next + qd_next)
+            return vector(as_scalars(q, nq, "q") + as_scalars(after, nq, "qd"))
+
+        linkages.append(Linkage(src, dst, jump=jump, name=f"{ev.name}: event map" +
+                                (" and periodicity (legs swapped)" if last else "")))
+        if ev.touchdown:
+            def touchdown(ends: Mapping[str, Any], p: Any, src: str = src,
+                        ev: EventSpec = ev) -> Any:
+                q, _ = split(ends[src].xf)
+                rows: list[Any] = []
+                for c in ev.touchdown:
+                    pos = as_scalars(contact_position(model, q, c), 2, "p")
+                    rows += [pos[0] - seq.anchor(c) * p[_L], pos[1]]
+                return vector(rows)
+
+            events.append(BoundaryConstraint(f"{ev.name}: {TOUCHDOWN}", touchdown, 0.0, 0.0,
+                                             scale=0.1))
+        after = seq.held_after(i)
+        if after and (ev.touchdown or ev.impulse):
+            def normal(ends: Mapping[str, Any], p: Any, i: int = i, src: str = src,
+                       after: tuple[str, ...] = after) -> Any:
+                imp = event_impulses(model, seq, i, ends[src].xf, p[_P])
+                return vector([as_scalars(imp[c], 2, "i")[1] for c in after])
+
+            events.append(BoundaryConstraint(f"{ev.name}: {IMPULSES}", normal, lower=floor,
+                                             upper=ca.inf, scale=1.0))
+            if mu is not None:
+                def friction(ends: Mapping[str, Any], p: Any, i: int = i, src: str = src,
+                             after: tuple[str, ...] = after) -> Any:
+                    imp = event_impulses(model, seq, i, ends[src].xf, p[_P])
+                    rows: list[Any] = []
+                    for c in after:
+                        t_i, n_i = as_scalars(imp[c], 2, "i")
+                        rows += [mu * n_i - t_i, mu * n_i + t_i]
+                    return vector(rows)
+
+                events.append(BoundaryConstraint(f"{ev.name}: {EVENT_FRICTION}", friction,
+                                                 lower=0.0, upper=ca.inf, scale=1.0))
+        if ev.release and ev.impulse:
+            def rise(ends: Mapping[str, Any], p: Any, i: int = i, src: str = src,
+                     ev: EventSpec = ev) -> Any:
+                q, _ = split(ends[src].xf)
+                jump = event_map(model, seq, i, q, vector([0.0] * nq), p[_P]).qd_after
+                return vector([as_scalars(contact_velocity(model, q, jump, c), 2, "v")[1]
+                               for c in ev.release])
+
+            events.append(BoundaryConstraint(f"{ev.name}: {RISE}", rise, lower=0.0,
+                                             upper=ca.inf, scale=0.1))
+        if not last:
+            shared = [a for a in actuators_of[src] if a in actuators_of[dst]]
+            if shared:
+                linkages.append(ControlLinkage(src, dst, controls=shared,
+                                               name=f"controls continuous at {ev.name}"))
+    if options.periodic_controls:
+        linkages.append(_periodic_controls(model, symmetry, seq, actuators_of))
+    if options.step_time is not None:
+        events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
+                                         lower=-ca.inf, upper=ca.inf, scale=1.0))
+
+    from gaitopt.gait.problem import parameter_bounds
+
+    bounds = parameter_bounds(options)
+    if not any(ev.impulse for ev in seq.events):
+        bounds[IMPULSE] = (0.0, 0.0)
+    parameters = [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH], scale=0.5),
+                  Parameter(SPEED, *bounds[SPEED], scale=1.0),
+                  Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
+    return Problem(
+        phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
+        parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
+        (lambda p: cost.parameter_cost(model, options, p)),
+        mayer=None if options.cost == "paper" else _impulse_cost(model, options, seq, split),
+        cost_denominator=lambda ends, p: cost.denominator(model, options, p),
+        objective_scale=cost.objective_scale(options))
+
+
+def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
+                  split: Callable[[Any], tuple[Any, Any]]) -> Callable[..., Any] | None:
+    """The Mayer term of the costs of transport: the liftoff impulse's work, if any."""
+    events = [i for i, ev in enumerate(seq.events) if ev.impulse]
+    if not events:
+        return None
+
+    def mayer(ends: Mapping[str, Any], p: Any) -> Any:
+        total: Any = 0.0
+        for i in events:
+            ev = seq.events[i]
+            q, qd = split(ends[seq.phases[i].name].xf)
+            jump = event_map(model, seq, i, q, qd, p[_P])
+            v_after = contact_velocity(model, q, jump.qd_after, ev.release[0])
+            total = total + cost.impulse_cost(model, options, jump.impulses[ev.release[0]],
+                                              v_after, p[_P])
+        return total
+
+    return mayer
+
+
+def _step_share(fraction: float) -> Callable[[Any], Any]:
+    """``p -> fraction * L / v``: a phase's duration."""
+    return lambda p: fraction * p[_L] / p[_V]
+
+
+def _periodic_controls(model: RobotModel, symmetry: Symmetry, seq: ContactSequence,
+                       actuators_of: Mapping[str, Sequence[str]]) -> ControlLinkage:
+    """``u_first(0)[a] = u_last(T)[swap(a)]`` for every actuator ``a`` of the first phase
+    whose swapped counterpart acts at the end of the last phase."""
+    first, last = seq.phases[0].name, seq.phases[-1].name
+    last_acts = list(actuators_of[last])
+    names = [a.name for a in model.actuators]
+    targets, sources = [], []
+    for a in actuators_of[first]:
+        other = names[symmetry.perm_u[model.actuator_index(a)]]
+        if other in last_acts:
+            targets.append(a)
+            sources.append(last_acts.index(other))
+    n_last = len(last_acts) + 4 * len(seq.phases[-1].held)
+
+    def fn(u_from: Any, p: Any) -> Any:
+        us = as_scalars(u_from, n_last, "u")
+        return vector([us[k] for k in sources])
+
+    return ControlLinkage(last, first, fn=fn, controls=targets,
+                          name="controls periodic (legs swapped)")
+
+
+def full_stage_bounds(tr: Transcription, force: float, impulse: float) -> Bounds:
+    """The transcription's bounds with the held-point rows of each phase's first knot freed
+    (they follow from the event maps), and the unilateral conditions relaxed by ``force``
+    (N) and ``impulse`` (N s) (0 enforces them)."""
+    bounds = tr.bounds()
+    for ph, pf in zip(tr.problem.phases, tr.phase_functions, strict=True):
+        rows_of = {pr.name: pr for pr in pf.path_rows}
+        block = tr.nlp.constraints.block(f"{ph.name}/path@knots")
+        if HELD in rows_of:
+            pr = rows_of[HELD]
+            first = np.arange(pr.rows.start, pr.rows.stop) + block.rows.start
+            bounds = bounds.with_rows(first, -ca.inf, ca.inf)
+        # Heights at the first knot repeat the previous phase's last knot (events keep q);
+        # landing points are on the ground at the last knot by the touchdown constraint.
+        for label, knots in ((CLEARANCE, (0,)), (LANDING_CLEARANCE, (0, block.shape[0] - 1))):
+            if label in rows_of:
+                pr = rows_of[label]
+                for k in knots:
+                    rows = block.rows.start + k * pf.n_path + np.arange(pr.rows.start,
+                                                                        pr.rows.stop)
+                    bounds = bounds.with_rows(rows, -ca.inf, ca.inf)
+        if FORCES in rows_of and force > 0.0:
+            rows = tr.path_rows(ph.name, FORCES)
+            bounds = bounds.with_rows(rows, np.minimum(bounds.lbg[rows], -force), ca.inf)
+    if impulse > 0.0:
+        for blk in tr.nlp.constraints.blocks:
+            if blk.name.endswith(IMPULSES) or blk.name.endswith(EVENT_FRICTION):
+                rows = np.arange(blk.rows.start, blk.rows.stop)
+                bounds = bounds.with_rows(rows, np.minimum(bounds.lbg[rows], -impulse),
+                                          ca.inf)
+    return bounds

@@ -1,0 +1,415 @@
+"""URDF import and export: a planar robot in a URDF file <-> a :class:`RobotModel`.
+
+Frames (see ``docs/urdf.md``). URDF's world is x forward, y left, z up; gaitopt's is x
+forward, y up, z out of the page. With the common joint axis ``y`` (the default) the sagittal
+plane is URDF x-z and
+
+    gaitopt (x, y, z) = URDF (x, z, -y),
+
+so a revolute joint about URDF +y turns the child by ``-q`` in gaitopt's sense (angle, limits
+and torque change sign) and a joint about URDF -y (``<axis xyz="0 -1 0"/>``, what the export
+writes) needs no flip. With ``axis="x"`` the plane is URDF y-z and gaitopt (x, y, z) = URDF
+(-y, z, -x). A gaitopt link frame at zero angle is parallel to the world, so URDF frames
+turned by ``rpy`` are re-expressed in that frame (only the rotation about the common axis may
+remain between a joint's parent and child for the joint axis to stay normal to the plane).
+
+Import, in short: the root link is the floating base, unless it is a massless link followed
+by a floating-base chain (two prismatic joints along x and z and a revolute joint about y
+through massless links, a ``planar`` joint or a ``floating`` joint), whose last child is then
+the base. Every revolute or continuous joint starts a gaitopt link; a fixed joint merges its
+child into its parent (masses, centres of mass and inertias about the common axis combined by
+the parallel-axis theorem). Contact points come from fixed joints named
+``gaitopt_contact_NAME`` to a massless leaf link NAME (what the export writes) and from
+:class:`ContactSpec` arguments (``--contact NAME=LINK:X,Z``). What URDF cannot hold (ground
+torques at contact points such as ankles, the order and exact bounds of the actuators,
+gravity, the description, each link's direction and length, the shapes inertias came from)
+travels in a ``<gaitopt>`` element
+inside ``<robot>``, which other URDF readers ignore.
+
+Parser: the XML is read with :mod:`xml.etree.ElementTree`. The maintained PyPI parsers do not
+fit: ``yourdfpy`` (0.0.60) pulls in ``trimesh[easy]`` (a mesh stack of a dozen packages) to
+read a few XML elements, and silently reads a missing ``ixx``, ``iyy`` or ``izz`` as 1 and a
+``<mass>`` without a value as 0, which must be refused here; ``urdf-parser-py`` has had no
+release since 2021 (0.0.4). Every problem is a one-line :class:`ModelError` naming the joint
+or link.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gaitopt.robot.model import RobotModel, Shape
+from gaitopt.robot.schema import INERTIA_RTOL, ModelError, model_from_dict, shape_inertia
+from gaitopt.robot.urdf_export import urdf_from_model
+from gaitopt.robot.urdf_xml import CONTACT_PREFIX, Extension, Reader, UJoint, ULink
+
+__all__ = ["CONTACT_PREFIX", "ContactSpec", "model_from_urdf", "parse_contact_option",
+           "urdf_from_model"]
+
+#: Coordinates smaller than this (m) computed through a frame rotation are taken as exactly 0.
+SNAP = 1e-12
+#: Tolerance on a joint axis being the common axis (a unit vector).
+AXIS_TOL = 1e-9
+
+#: Rows: gaitopt x, y, z as URDF vectors, for each common axis.
+_PLANE = {"y": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
+          "x": np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])}
+#: Which URDF coordinates of a link frame a ``--contact`` point gives, for each common axis.
+_IN_PLANE = {"y": (0, 2), "x": (1, 2)}
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """A contact point to add on import: ``point`` = the two in-plane coordinates (m) in the
+    frame of URDF link ``link`` (x, z for the common axis y; y, z for axis x)."""
+
+    name: str
+    link: str
+    point: tuple[float, float]
+
+
+def parse_contact_option(text: str) -> ContactSpec:
+    """Parse ``NAME=LINK:X,Z`` (e.g. ``tip_1=shank_1:0,-0.5``); ValueError names the form."""
+    form = "NAME=LINK:X,Z (e.g. tip_1=shank_1:0,-0.5; X, Z in metres in the link's frame)"
+    name, eq, rest = text.partition("=")
+    link, colon, coords = rest.rpartition(":")
+    parts = coords.split(",")
+    try:
+        if not (eq and colon and name.strip() and link.strip()) or len(parts) != 2:
+            raise ValueError
+        x, z = float(parts[0]), float(parts[1])
+        if not (math.isfinite(x) and math.isfinite(z)):
+            raise ValueError
+    except ValueError:
+        raise ValueError(f"--contact: got {text!r}; allowed: {form}") from None
+    return ContactSpec(name.strip(), link.strip(), (x, z))
+
+
+# -- import ----------------------------------------------------------------------------------
+
+@dataclass
+class _Body:
+    """A gaitopt link under construction: URDF links merged by fixed joints."""
+
+    name: str
+    parent: int
+    joint: dict[str, Any] | None
+    effort: float = 0.0
+    parts: list[tuple[float, np.ndarray, float]] = field(default_factory=list)  # m, com, I
+    points: list[np.ndarray] = field(default_factory=list)  # joints and contacts (plane)
+
+
+def _read_source(source: str | os.PathLike[str]) -> tuple[str, str]:
+    """The URDF text and the name to use in errors."""
+    if isinstance(source, str) and source.lstrip().startswith("<"):
+        return source, "<string>"
+    label = os.fspath(source)
+    try:
+        return Path(label).read_text("utf-8-sig"), label
+    except (OSError, UnicodeDecodeError) as exc:
+        detail = getattr(exc, "strerror", None) or str(exc)
+        raise ModelError(label, "", label, "a readable URDF file (UTF-8 XML)",
+                         problem=f"cannot be read ({detail})") from None
+
+
+def model_from_urdf(source: str | os.PathLike[str], *, contacts: Iterable[ContactSpec] = (),
+                    axis: str = "y", name: str | None = None) -> RobotModel:
+    """Read a planar robot from URDF text or a URDF file (see the module docstring).
+
+    Args:
+        source: a path, or URDF text (a string starting with ``<``).
+        contacts: contact points to add to those the file marks (``gaitopt_contact_*``).
+        axis: the common joint axis, ``"y"`` (plane URDF x-z) or ``"x"`` (plane URDF y-z).
+        name: the model name (default: the robot's name).
+
+    Raises:
+        ModelError: one line naming the file, the joint or link and what is allowed.
+    """
+    text, label = _read_source(source)
+    if axis not in _PLANE:
+        raise ModelError(label, "axis", axis, "y or x (the common joint axis)")
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ModelError(label, "", "(XML text)", "well-formed XML",
+                         problem=f"not valid XML: {exc}") from None
+    if root.tag != "robot":
+        raise ModelError(label, "", f"<{root.tag}>", "a <robot> element",
+                         problem=f"the root element is <{root.tag}>")
+    return _Importer(Reader(label), root, _PLANE[axis], axis).model(list(contacts), name)
+
+
+class _Importer:
+    def __init__(self, reader: Reader, root: ET.Element, plane: np.ndarray, axis: str) -> None:
+        self.r, self.plane, self.axis = reader, plane, axis
+        self.links: dict[str, ULink] = {}
+        for elem in root.findall("link"):
+            link = reader.link(elem)
+            if link.name in self.links:
+                raise reader.fail(f"link {link.name!r}", link.name, "unique link names",
+                                  problem="a second link of this name")
+            self.links[link.name] = link
+        self.joints = [reader.joint(e) for e in root.findall("joint")]
+        joint_names: set[str] = set()
+        for j in self.joints:
+            if j.name in joint_names:
+                raise reader.fail(f"joint {j.name!r}", j.name, "unique joint names",
+                                  problem="a second joint of this name")
+            joint_names.add(j.name)
+        self.extension = root.find("gaitopt")
+        self.robot_name = root.get("name") or "robot"
+        self.parent_joint: dict[str, UJoint] = {}
+        self.children: dict[str, list[UJoint]] = {n: [] for n in self.links}
+        for j in self.joints:
+            for end in (j.parent, j.child):
+                if end not in self.links:
+                    raise reader.fail(f"joint {j.name!r}", end, "the name of a <link> of this "
+                                      "robot", problem=f"no link {end!r}")
+            if j.child in self.parent_joint:
+                other = self.parent_joint[j.child].name
+                raise reader.fail(f"joint {j.name!r}", j.child, "a tree: one parent joint per "
+                                  "link", problem=f"link {j.child!r} already has parent joint "
+                                  f"{other!r} (a closed loop or a second parent)")
+            self.parent_joint[j.child] = j
+            self.children[j.parent].append(j)
+        roots = [n for n in self.links if n not in self.parent_joint]
+        if not self.links:
+            raise reader.fail("", None, "a <robot> with <link> elements", problem="no links")
+        if len(roots) > 1:
+            raise reader.fail("", roots, "one root link and a tree of joints",
+                              problem=f"{len(roots)} links without a parent "
+                                      f"({', '.join(roots)})")
+        seen, todo = set(), roots[:1]
+        while todo:
+            n = todo.pop()
+            seen.add(n)
+            todo.extend(j.child for j in self.children[n])
+        if len(seen) != len(self.links):  # a link outside the tree is on a loop of parents
+            path = [next(n for n in self.links if n not in seen)]
+            while (up := self.parent_joint[path[-1]].parent) not in path:
+                path.append(up)
+            loop = [*path[path.index(up):], up][::-1]
+            joints = [self.parent_joint[n].name for n in loop[1:]]
+            raise reader.fail(f"joint {joints[0]!r}", loop, "a tree of joints from one root "
+                              "link", problem=f"a closed loop of links {' -> '.join(loop)} "
+                              f"(joints {', '.join(joints)})")
+        self.root = roots[0]
+
+    # -- frames ------------------------------------------------------------------------------
+    def in_plane(self, v: np.ndarray, exact: bool) -> np.ndarray:
+        """gaitopt (x, y) of a URDF vector given in a body's (world-parallel) frame; unless
+        ``exact`` (no rotation went into ``v``), rounding dust (``|x| < SNAP``) becomes 0."""
+        g = self.plane[:2] @ v + 0.0
+        return g if exact else np.where(np.abs(g) < SNAP, 0.0, g)
+
+    def about_normal(self, where: str, v: np.ndarray) -> float:
+        """+1 if the unit vector ``v`` is gaitopt's +z, -1 if -z; else a ModelError."""
+        g = self.plane @ v
+        if abs(abs(g[2]) - 1.0) > AXIS_TOL:
+            raise self.r.fail(where, " ".join(f"{x:.6g}" for x in v), f"an axis along "
+                              f"+-{self.axis} (the common joint axis; the robot is planar)")
+        return 1.0 if g[2] > 0 else -1.0
+
+    def base_chain(self) -> tuple[str, list[UJoint]]:
+        """The base link and the floating-base joints above it (see the module docstring)."""
+        cur = self.root
+        chain: list[UJoint] = []
+        while self.links[cur].mass == 0.0 and len(self.children[cur]) == 1:
+            j = self.children[cur][0]
+            kinds = [c.type for c in chain]
+            if j.type in ("fixed", "prismatic", "planar", "floating") or (
+                    j.type in ("revolute", "continuous") and "prismatic" in kinds):
+                chain.append(j)
+                cur = j.child
+                if j.type in ("revolute", "continuous", "planar", "floating"):
+                    break
+            else:
+                break
+        moving = [j for j in chain if j.type != "fixed"]
+        rot, prismatic = np.eye(3), []
+        for j in chain:
+            rot = rot @ j.rot
+            world_axis = rot @ j.axis  # a joint axis is given in the child frame
+            if j.type == "planar":
+                self.about_normal(f"joint {j.name!r} axis (the plane normal)", world_axis)
+            elif j.type in ("revolute", "continuous"):
+                self.about_normal(f"joint {j.name!r} axis", world_axis)
+            elif j.type == "prismatic":
+                prismatic.append(np.abs(self.plane @ world_axis))
+        # the walk takes revolute joints only after a prismatic one, and stops after them
+        if prismatic and not (len(moving) == 3 and moving[-1].type != "prismatic" and sorted(
+                int(np.argmax(g)) for g in prismatic) == [0, 1] and all(
+                abs(float(np.max(g)) - 1.0) <= AXIS_TOL for g in prismatic)):
+            raise self.r.fail(f"joint {moving[0].name!r}", moving[0].type,
+                              "a floating base of two prismatic joints (along x and z) and a "
+                              f"revolute joint about {self.axis} through massless links, a "
+                              "planar or a floating joint, at the root",
+                              problem="an incomplete floating-base chain")
+        self.base_rot = rot
+        return cur, chain
+
+    # -- the model ---------------------------------------------------------------------------
+    def model(self, specs: list[ContactSpec], name: str | None) -> RobotModel:
+        base, chain = self.base_chain()
+        bodies = [_Body(base, -1, None)]
+        # URDF link -> (its gaitopt link, its axes and origin in that link's frame, whether
+        # no rotation went into them: then points computed from them are exact)
+        frame = {base: (0, self.base_rot, np.zeros(3), _is_identity(self.base_rot))}
+        contacts: list[tuple[str, int, np.ndarray]] = []
+        done = {j.name for j in chain}
+        pending = [j for j in self.joints if j.name not in done]
+        while pending:
+            ready = [j for j in pending if j.parent in frame]
+            if not ready:  # only links of the base chain are left as parents
+                j = pending[0]
+                raise self.r.fail(f"joint {j.name!r}", j.parent, "joints below the base link",
+                                  problem=f"a joint on the floating-base chain link {j.parent!r}")
+            j = ready[0]
+            pending.remove(j)
+            k, rot_p, pos_p, exact_p = frame[j.parent]
+            rot, pos = rot_p @ j.rot, pos_p + rot_p @ j.pos
+            where = f"joint {j.name!r}"
+            if j.type == "fixed":
+                child = self.links[j.child]
+                if (j.name.startswith(CONTACT_PREFIX) and child.mass == 0.0
+                        and not self.children[j.child]):
+                    contacts.append((j.child, k, self.in_plane(pos, exact_p)))
+                frame[j.child] = (k, rot, pos, exact_p and _is_identity(rot))
+            elif j.type in ("revolute", "continuous"):
+                sign = self.about_normal(f"{where} axis", rot @ j.axis)
+                assert j.limits is not None
+                lo, hi = (j.limits if sign > 0 else (-j.limits[1] + 0.0, -j.limits[0] + 0.0))
+                at = self.in_plane(pos, exact_p)
+                bodies[k].points.append(at)
+                bodies.append(_Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
+                                    effort=j.effort or 0.0))
+                frame[j.child] = (len(bodies) - 1, rot, np.zeros(3), _is_identity(rot))
+            else:
+                raise self.r.fail(where, j.type, "revolute, continuous or fixed joints below "
+                                  "the base (prismatic, planar and floating joints only in the "
+                                  "floating-base chain at the root)",
+                                  problem=f"a {j.type} joint outside the floating-base chain")
+        normal = -self.plane[2]
+        for link_name, (k, rot, pos, exact) in frame.items():
+            link = self.links[link_name]
+            if link.mass > 0.0:
+                inertia = float(normal @ rot @ link.inertia @ rot.T @ normal)
+                com = self.in_plane(pos + rot @ link.com, exact)
+                bodies[k].parts.append((link.mass, com, inertia))
+        taken = {c[0] for c in contacts}
+        for spec in specs:
+            if spec.name in taken:
+                raise self.r.fail(f"contact {spec.name!r}", spec.name, "a contact name not "
+                                  "used by another contact", problem="a duplicate contact name")
+            if spec.link not in frame:
+                raise self.r.fail(f"contact {spec.name!r}", spec.link,
+                                  "the name of a link at or below the base link "
+                                  f"({', '.join(sorted(frame))})", problem=f"no link "
+                                  f"{spec.link!r}")
+            k, rot, pos, exact = frame[spec.link]
+            local = np.zeros(3)
+            i0, i1 = _IN_PLANE[self.axis]
+            local[i0], local[i1] = spec.point
+            contacts.append((spec.name, k, self.in_plane(pos + rot @ local, exact)))
+            taken.add(spec.name)
+        for _, k, p in contacts:
+            bodies[k].points.append(p)
+        return model_from_dict(self.to_dict(bodies, contacts, name), source=self.r.source)
+
+    def to_dict(self, bodies: list[_Body], contacts: list[tuple[str, int, np.ndarray]],
+                name: str | None) -> dict[str, Any]:
+        ext = Extension(self.r, self.extension)
+        links: list[dict[str, Any]] = []
+        for i, b in enumerate(bodies):
+            mass = sum(m for m, _, _ in b.parts)
+            if not mass > 0.0:
+                raise self.r.fail(f"link {b.name!r}", 0.0, "a mass > 0 on every gaitopt link "
+                                  "(the base, or a URDF link after a revolute joint, with the "
+                                  "links fixed to it)", problem="no mass")
+            com = (b.parts[0][1] if len(b.parts) == 1 else
+                   sum((m * c for m, c, _ in b.parts), np.zeros(2)) / mass)
+            inertia = sum(i_ + m * float(np.sum((c - com) ** 2)) for m, c, i_ in b.parts)
+            if not inertia > 0.0:
+                raise self.r.fail(f"link {b.name!r}", inertia, "an inertia > 0 about the "
+                                  f"{self.axis} axis (kg m^2)")
+            direction, length = ext.links.get(b.name) or _direction_and_length(
+                b.points, com, base=i == 0)
+            entry: dict[str, Any] = {"name": b.name,
+                                     "parent": None if b.parent < 0 else bodies[b.parent].name}
+            if b.joint is not None:
+                # the joint's position is a point on the parent (listed before its children)
+                entry["joint"] = {**b.joint, "at": _point(b.joint["at"],
+                                                          links[b.parent]["direction"])}
+            entry.update({"direction": direction, "length": length, "mass": mass,
+                          "com": _point(com, direction), "inertia": inertia})
+            shape = ext.shapes.get(b.name)
+            if shape is not None:
+                s = Shape(type=shape["type"], radius=shape.get("radius"))
+                expected = shape_inertia(s, mass, length)
+                if abs(expected - inertia) <= INERTIA_RTOL * expected:
+                    entry["shape"] = shape
+            links.append(entry)
+        directions = {b.name: links[i]["direction"] for i, b in enumerate(bodies)}
+        data: dict[str, Any] = {
+            "name": name or self.robot_name, "links": links,
+            "contacts": [{"name": c, "link": bodies[k].name, "at": _point(p, directions[
+                bodies[k].name])} for c, k, p in contacts],
+        }
+        if ext.actuators is not None:
+            data["actuators"] = ext.actuators
+        else:
+            data["actuators"] = [
+                {"name": b.joint["name"], "joint": b.joint["name"], "limits": [-b.effort,
+                                                                               b.effort]}
+                for b in bodies if b.joint is not None and b.effort > 0.0]
+        if ext.gravity is not None:
+            data["gravity"] = ext.gravity
+        if ext.description is not None:
+            data["description"] = ext.description
+        return data
+
+
+def _is_identity(rot: np.ndarray) -> bool:
+    return bool(np.array_equal(rot, np.eye(3)))
+
+
+def _point(p: Sequence[float] | np.ndarray, direction: str) -> list[float]:
+    """gaitopt link-frame coordinates (x, y) as ``[along, across]`` for a link direction
+    (``+ 0.0`` turns ``-0.0`` into ``0.0``)."""
+    x, y = float(p[0]), float(p[1])
+    return [-y + 0.0, x + 0.0] if direction == "down" else [y + 0.0, -x + 0.0]
+
+
+def _direction_and_length(points: list[np.ndarray], com: np.ndarray,
+                          base: bool) -> tuple[str, float]:
+    """The documented rule (``docs/urdf.md``) for a link's axis and length.
+
+    ``points`` are the link's child joints and contact points and ``com`` its centre of mass,
+    as gaitopt (x, y) in the link frame at zero angle. A non-base link points ``down`` to its
+    lowest point below the origin (length: that depth), else ``up`` to its highest point above
+    it. The base, and a link whose points are all level with its origin, points towards its
+    centre of mass (``up`` if above the origin) with length twice the centre's height (the
+    centre in the middle), at least reaching its points on that side; a link with nothing
+    above or below its origin gets ``down`` and 1 m.
+    """
+    below = max([-float(p[1]) for p in points if p[1] < 0.0], default=0.0)
+    above = max([float(p[1]) for p in points if p[1] > 0.0], default=0.0)
+    height = float(com[1])
+    if not base or height == 0.0:
+        if below > 0.0:
+            return "down", below
+        if above > 0.0:
+            return "up", above
+    if height > 0.0:
+        return "up", max(2.0 * height, above)
+    if height < 0.0:
+        return "down", max(-2.0 * height, below)
+    return "down", 1.0

@@ -1,0 +1,93 @@
+"""The family of costs: each converges, its saved value is what the file recomputes to, the
+work cost is the integral of positive actuator power (computed independently on dense
+samples), and the resting term scales with the step time."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from gaitopt.analysis.verify import verify_gait
+from gaitopt.gait import cost
+from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.robot import load_model
+from gaitopt.robot.biped import biped_structure
+from tests.gait.conftest import Solved
+
+SolveFn = Callable[..., Solved]
+
+
+def _positive_work_on_samples(gait: Gait) -> float:
+    """int sum_a max(0, u_a w_a) dt over the dense samples (trapezoid), w_a from the samples'
+    qd: joint rates, and for an ankle the absolute rate of the shank (torso + hip + knee)."""
+    model, s = gait.model, gait.samples
+    rates = np.zeros_like(s.u)
+    for j, a in enumerate(model.actuators):
+        if a.joint is not None:
+            rates[:, j] = s.qd[:, model.joint_coordinate(a.joint)]
+        else:
+            link = model.link_index(model.contact(a.contact or "").link)
+            rates[:, j] = sum(s.qd[:, model.coordinate_of_link(i)] for i in model.chain(link))
+    power = np.maximum(s.u * rates, 0.0).sum(axis=1)
+    return float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(s.t)))
+
+
+@pytest.mark.parametrize("name", ["work", "metabolic"])
+def test_each_cost_converges_and_recomputes(solved: SolveFn, name: str) -> None:
+    gait = solved(GaitOptions(cost=name)).gait  # type: ignore[arg-type]
+    assert gait.success
+    assert gait.cost["name"] == name and name in gait.cost["formula"]
+    assert cost.recompute_cost(gait) == pytest.approx(gait.cost_value, rel=1e-6)
+    report = verify_gait(gait)
+    assert report.passed, report.failed_ids
+
+
+def test_work_cost_is_the_positive_actuator_work(solved: SolveFn) -> None:
+    """Independently of the solver's smoothing and quadrature: the positive work of the
+    torques on the dense samples, over weight x step length, within the smoothing's bound
+    (n_a eps T / (2 W L)) and the grid's quadrature error of the kinked integrand (a few per
+    cent at 16 + 6 knots)."""
+    gait = solved(GaitOptions(cost="work", impulse=False, knots=(16, 6))).gait
+    assert gait.success
+    model = gait.model
+    denominator = cost.weight(model) * gait.step_length
+    independent = _positive_work_on_samples(gait) / denominator
+    smoothing = model.nu * 0.01 * gait.step_time / (2.0 * denominator)
+    assert gait.cost_value == pytest.approx(independent, rel=0.05, abs=smoothing)
+
+
+def test_resting_term_scales_exactly_with_step_time() -> None:
+    model = load_model("five-link")
+    options = GaitOptions(cost="metabolic", resting_power=1.5)
+    rest = [cost.parameter_cost(model, options, [step, 0.5, 0.0]) for step in (0.2, 0.4, 0.8)]
+    np.testing.assert_allclose(rest, [1.5 * model.total_mass * t for t in (0.4, 0.8, 1.6)])
+    assert cost.parameter_cost(model, GaitOptions(cost="work"), [0.2, 0.5, 0.0]) == 0.0
+
+
+def test_metabolic_cost_changes_by_the_resting_energy(solved: SolveFn) -> None:
+    """The same gait costs exactly (delta P_rest) m T / (W L) more with a larger resting
+    power: recomputed from the file with the option changed."""
+    gait = solved(GaitOptions(cost="metabolic")).gait
+    data = gait.to_dict()
+    data["options"]["resting_power"] = gait.options["resting_power"] + 0.5
+    changed = Gait.from_dict(data)
+    model = gait.model
+    expected = 0.5 * model.total_mass * gait.step_time / (cost.weight(model) * gait.step_length)
+    assert cost.recompute_cost(changed) - cost.recompute_cost(gait) == pytest.approx(
+        expected, rel=1e-9)
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"cost": "fun"}, "cost = 'fun': must be one of paper, work, metabolic"),
+    ({"efficiency_positive": 0.0}, "efficiency_positive = 0: must be > 0"),
+    ({"efficiency_negative": -1.2}, "efficiency_negative = -1.2: must be > 0"),
+    ({"resting_power": -1.0}, "resting_power = -1: must be >= 0"),
+    ({"cost_regularization": -0.1}, "cost_regularization = -0.1: must be >= 0"),
+])
+def test_bad_cost_options_name_the_field(changes: dict[str, object], message: str) -> None:
+    legs = biped_structure(load_model("five-link"))
+    with pytest.raises(GaitOptionsError, match=message):
+        validate_options(GaitOptions().replace(**changes), legs)
