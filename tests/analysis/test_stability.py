@@ -18,6 +18,7 @@ from click.testing import CliRunner
 
 from gaitopt.analysis.return_map import (
     PhaseProfile,
+    StepEvent,
     StepSpec,
     impact_jump,
     integrate_phase,
@@ -61,8 +62,9 @@ def compass() -> StepSpec:
     model = load_model(DATA / "compass.yaml")
     free = PhaseProfile(contacts=("tip_1",), duration=None, t=np.array([0.0, 1.0]),
                         u=np.zeros((2, 0)), nominal_duration=1.0)
-    return StepSpec(model=model, stance="tip_1", swing="tip_2", single=free, double=None,
-                    impact_contacts=("tip_2",), rtol=1e-10, atol=1e-10)
+    strike = StepEvent("strike", "tip_2", ("tip_2",))
+    return StepSpec(model=model, stance="tip_1", swing="tip_2", phases=(free,),
+                    events=((strike,),), rtol=1e-10, atol=1e-10)
 
 
 def compass_state(model: RobotModel, stance: float, swing: float, stance_rate: float,
@@ -124,7 +126,7 @@ def test_compass_two_period_one_gaits_longer_step_stable(compass: StepSpec) -> N
         np.testing.assert_allclose(np.abs(hip.multipliers), 1.0, atol=1e-5)
         # Autonomous map: a shift along the orbit does not change the next start -> a zero
         # multiplier along the flow.
-        f = phase_field(compass, compass.single, 0.0, rep.state)
+        f = phase_field(compass, compass.phases[0], 0.0, rep.state)
         ft = rep.basis.T @ f
         assert np.linalg.norm(rep.section_monodromy @ ft) < 1e-6 * np.linalg.norm(ft)
         assert np.min(np.abs(rep.multipliers)) < 1e-6
@@ -148,19 +150,19 @@ def test_linearizing_about_knots_reproduces_the_simulated_monodromy(compass: Ste
     t = np.linspace(0.0, step.strike_time, 121)
     states = [y]
     for a, b in zip(t[:-1], t[1:], strict=True):
-        states.append(integrate_phase(compass, compass.single, states[-1], until=b, tau0=a)[1])
+        states.append(integrate_phase(compass, compass.phases[0], states[-1], until=b, tau0=a)[1])
     ys = np.array(states)
-    acc = np.array([phase_field(compass, compass.single, 0.0, s)[5:] for s in ys])
-    knots = PhaseProfile(contacts=("tip_1",), duration=step.strike_time, t=t,
+    acc = np.array([phase_field(compass, compass.phases[0], 0.0, s)[5:] for s in ys])
+    knots = PhaseProfile(contacts=("tip_1",), duration=None, t=t,
                          u=np.zeros((t.size, 0)), q=ys[:, :5], qd=ys[:, 5:], qdd=acc,
                          nominal_duration=step.strike_time)
-    ref = reference_step(dataclasses.replace(compass, single=knots, _functions={}))
+    ref = reference_step(dataclasses.replace(compass, phases=(knots,), _functions={}))
     assert step.monodromy is not None and ref.monodromy is not None
     scale = np.max(np.abs(step.monodromy))
     assert np.max(np.abs(ref.monodromy - step.monodromy)) < 1e-4 * scale
     # Without the guard term the result is far off: the check can fail.
     d_delta = impact_jump(compass, ref.y_strike)[1]
-    wrong = ref.factors["jump_swap"] @ d_delta @ ref.factors["phi_single"]
+    wrong = ref.factors["jump_swap"] @ d_delta @ ref.factors["phi_0"]
     assert np.max(np.abs(wrong - step.monodromy)) > 1e-2 * scale
 
 
@@ -173,24 +175,23 @@ def test_saltation_matrix_matches_finite_differences_of_the_crossing(gait: Gait)
     Phi_single with the classical saltation matrix Xi; central differences of that map on its
     own agree; the plain composition of the flows and the impact Jacobian does not."""
     spec = step_from_gait(gait, pd=GAINS, rtol=1e-12)
-    assert spec.double is not None
+    single, double = spec.phases
     y0 = gait_start(gait)
     strike = simulate_step(spec, y0).strike_time
     tau_a, t_b, c = strike - 5e-3, strike + 5e-3, 1e-3
-    y_a = integrate_phase(spec, spec.single, y0, until=tau_a)[1]
+    y_a = integrate_phase(spec, single, y0, until=tau_a)[1]
 
     def window(y: np.ndarray, variational: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
-        assert spec.double is not None
-        t1, y_minus, phi1 = integrate_phase(spec, spec.single, y, tau0=tau_a, guard=True,
+        t1, y_minus, phi1 = integrate_phase(spec, single, y, tau0=tau_a, guard=True,
                                             variational=variational)
         y_plus = impact_jump(spec, y_minus)[0]
-        _, y_end, phi2 = integrate_phase(spec, spec.double, y_plus, tau0=t1 - strike + c,
+        _, y_end, phi2 = integrate_phase(spec, double, y_plus, tau0=t1 - strike + c,
                                          until=t_b - strike + c, variational=variational)
         if not variational:
             return y_end, None
         assert phi1 is not None and phi2 is not None
-        f_minus = phase_field(spec, spec.single, t1, y_minus)
-        f_plus = phase_field(spec, spec.double, t1 - strike + c, y_plus)
+        f_minus = phase_field(spec, single, t1, y_minus)
+        f_plus = phase_field(spec, double, t1 - strike + c, y_plus)
         xi = saltation_matrix(spec, y_minus, f_minus, f_plus)
         return y_end, phi2 @ xi @ phi1
 
@@ -205,11 +206,11 @@ def test_saltation_matrix_matches_finite_differences_of_the_crossing(gait: Gait)
     scale = np.max(np.abs(jac))
     assert np.max(np.abs(fd - jac)) < 1e-5 * scale, np.max(np.abs(fd - jac)) / scale
     # The crossing matters: the plain composition of the flows and the impact Jacobian misses.
-    t1, y_minus, phi1 = integrate_phase(spec, spec.single, y_a, tau0=tau_a, guard=True,
+    t1, y_minus, phi1 = integrate_phase(spec, single, y_a, tau0=tau_a, guard=True,
                                         variational=True)
     y_plus, d_delta = impact_jump(spec, y_minus)
     assert phi1 is not None
-    naive = integrate_phase(spec, spec.double, y_plus, tau0=t1 - strike + c,
+    naive = integrate_phase(spec, double, y_plus, tau0=t1 - strike + c,
                             until=t_b - strike + c, variational=True)[2]
     assert naive is not None
     assert np.max(np.abs(naive @ d_delta @ phi1 - fd)) > 1e-2 * scale

@@ -104,21 +104,32 @@ class PhaseProfile:
         return u, q, qd
 
 
+@dataclass(frozen=True)
+class StepEvent:
+    """A jump between phases: ``kind`` "strike" (an inelastic impact after which the
+    ``contacts`` are at rest: the striking ``contact`` and those held next) or "liftoff" (the
+    ``contact`` leaves with an impulse of ``magnitude`` N s along the leg while the
+    ``contacts`` stay held)."""
+
+    kind: str
+    contact: str
+    contacts: tuple[str, ...]
+    magnitude: float = 0.0
+
+
 @dataclass(frozen=True, eq=False)
 class StepSpec:
-    """Everything the return map needs: the model, the stance and swing contacts, the single-
-    support phase (ends at the guard), the optional double-support phase (fixed duration), the
-    contacts held by the heel-strike impact, the liftoff impulse magnitude (N s), the distance
-    (m) the swing tip must be ahead of the stance tip before the guard is armed, optional PD
-    gains ``(kp, kd)`` (N m/rad, N m s/rad) and the integrator tolerances."""
+    """Everything the return map needs: the model, the stance and swing contacts, the phases
+    in order (exactly one ends at the guard: ``duration`` None; the others last their
+    ``duration``), the events after each phase (``events[i]``, applied in order), the
+    distance (m) the swing tip must be ahead of the stance tip before the guard is armed,
+    optional PD gains ``(kp, kd)`` (N m/rad, N m s/rad) and the integrator tolerances."""
 
     model: RobotModel
     stance: str
     swing: str
-    single: PhaseProfile
-    double: PhaseProfile | None
-    impact_contacts: tuple[str, ...]
-    liftoff_magnitude: float = 0.0
+    phases: tuple[PhaseProfile, ...]
+    events: tuple[tuple[StepEvent, ...], ...]
     arm_distance: float = 0.0
     pd: tuple[float, float] | None = None
     rtol: float = 1e-11
@@ -128,6 +139,15 @@ class StepSpec:
     @cached_property
     def nq(self) -> int:
         return self.model.nq
+
+    @cached_property
+    def guard_phase(self) -> int:
+        """Index of the phase that ends at the heel-strike guard."""
+        guards = [i for i, ph in enumerate(self.phases) if ph.duration is None]
+        if len(guards) != 1 or len(self.events) != len(self.phases):
+            raise StepSimulationError("a step needs exactly one guard-terminated phase and a "
+                                      "list of events after each phase")
+        return guards[0]
 
     def function(self, key: str, build: Callable[[], ca.Function]) -> ca.Function:
         if key not in self._functions:
@@ -202,32 +222,21 @@ def _tip(spec: StepSpec, contact: str) -> ca.Function:
     return spec.function("tip:" + contact, build)
 
 
-def _impact_jump(spec: StepSpec) -> ca.Function:
-    """``jump(y-) -> (y+, d y+ / d y-)`` of the heel-strike impact."""
+def _event_jump(spec: StepSpec, event: StepEvent) -> ca.Function:
+    """``jump(y-) -> (y+, d y+ / d y-)`` of an impact or a liftoff impulse."""
     nq = spec.nq
 
     def build() -> ca.Function:
         y = ca.SX.sym("y", 2 * nq)
-        qd_plus = impact_function(spec.model, spec.impact_contacts)(y[:nq], y[nq:])[0]
+        if event.kind == "strike":
+            qd_plus = impact_function(spec.model, event.contacts)(y[:nq], y[nq:])[0]
+        else:
+            f = liftoff_function(spec.model, event.contact, event.contacts)
+            qd_plus = f(y[:nq], y[nq:], event.magnitude)[0]
         out = ca.vertcat(y[:nq], qd_plus)
-        return ca.Function("impact_jump", [y], [out, ca.jacobian(out, y)])
+        return ca.Function("jump", [y], [out, ca.jacobian(out, y)])
 
-    return spec.function("impact", build)
-
-
-def _liftoff_jump(spec: StepSpec) -> ca.Function:
-    """``jump(y-) -> (y+, d y+ / d y-)`` of the liftoff impulse (magnitude fixed)."""
-    nq = spec.nq
-    held = tuple(c for c in spec.impact_contacts if c != spec.stance)
-
-    def build() -> ca.Function:
-        y = ca.SX.sym("y", 2 * nq)
-        f = liftoff_function(spec.model, spec.stance, held)
-        qd_plus = f(y[:nq], y[nq:], spec.liftoff_magnitude)[0]
-        out = ca.vertcat(y[:nq], qd_plus)
-        return ca.Function("liftoff_jump", [y], [out, ca.jacobian(out, y)])
-
-    return spec.function("liftoff", build)
+    return spec.function(f"jump:{event!r}", build)
 
 
 def _swap_jump(spec: StepSpec) -> ca.Function:
@@ -335,7 +344,7 @@ def saltation_matrix(spec: StepSpec, y_minus: Array, f_minus: Array, f_plus: Arr
     (2 nq, 2 nq) of the heel strike at the pre-impact state ``y_minus``: it maps a
     perturbation just before the crossing time to the perturbation just after it, both at the
     same time. ``f_minus``/``f_plus`` are the vector fields before and after the event."""
-    _, d_delta = _eval(_impact_jump(spec), y_minus)
+    _, d_delta = impact_jump(spec, y_minus)
     dg = guard_row(spec, y_minus)
     rate = float(dg @ f_minus)
     if abs(rate) < 1e-12:
@@ -344,51 +353,59 @@ def saltation_matrix(spec: StepSpec, y_minus: Array, f_minus: Array, f_plus: Arr
     return d_delta + np.outer(f_plus - d_delta @ f_minus, dg) / rate
 
 
-def impact_jump(spec: StepSpec, y_minus: Array) -> tuple[Array, Array]:
-    """The heel-strike jump ``y+ = (q, qd+(q, qd-))`` (2 nq,) and its Jacobian (2 nq, 2 nq)."""
-    y_plus, jac = _eval(_impact_jump(spec), np.asarray(y_minus, float))
+def event_jump(spec: StepSpec, event: StepEvent, y_minus: Array) -> tuple[Array, Array]:
+    """An event's jump ``y+ = (q, qd+(q, qd-))`` (2 nq,) and its Jacobian (2 nq, 2 nq)."""
+    y_plus, jac = _eval(_event_jump(spec, event), np.asarray(y_minus, float))
     return y_plus.ravel(), jac
+
+
+def events_jump(spec: StepSpec, events: tuple[StepEvent, ...],
+                y_minus: Array) -> tuple[Array, Array]:
+    """The events after a phase applied in order: ``(y+, d y+ / d y-)``."""
+    y, jac = np.asarray(y_minus, float), np.eye(2 * spec.nq)
+    for event in events:
+        y, d = event_jump(spec, event, y)
+        jac = d @ jac
+    return y, jac
+
+
+def impact_jump(spec: StepSpec, y_minus: Array) -> tuple[Array, Array]:
+    """The heel-strike jump (the events after the guard phase), ``(y+, Jacobian)``."""
+    return events_jump(spec, spec.events[spec.guard_phase], y_minus)
 
 
 def simulate_step(spec: StepSpec, y0: Array, *, variational: bool = False) -> StepResult:
     """One step of the return map from ``y0`` (2 nq,) (see the module docstring)."""
-    y0 = np.asarray(y0, dtype=float)
+    y = np.asarray(y0, dtype=float)
     n = 2 * spec.nq
-    t1, y_strike, phi1 = _integrate_phase(spec, spec.single, y0, variational)
-    y_imp, d_imp = (v for v in _eval(_impact_jump(spec), y_strike))
-    y_imp = y_imp.ravel()
+    guard = spec.guard_phase
+    monodromy = np.eye(n)
     factors: dict[str, Array] = {}
-    if variational:
-        assert phi1 is not None
-        f_minus, _ = phase_rhs(spec, spec.single, t1, y_strike)
-        dg = guard_row(spec, y_strike)
-        rate = float(dg @ f_minus)
-        if abs(rate) < 1e-12:
-            raise StepSimulationError("the swing tip grazes the ground at the heel strike")
-        factors["phi_single"] = phi1
-        factors["jump_strike"] = d_imp @ (np.eye(n) - np.outer(f_minus, dg) / rate)
-    y, t2 = y_imp, 0.0
-    d_lift = np.eye(n)
-    if spec.double is not None:
-        t2, y_ds, phi2 = _integrate_phase(spec, spec.double, y_imp, variational)
-        y_lift, d_lift = _eval(_liftoff_jump(spec), y_ds)
-        y = y_lift.ravel()
+    t_total, t_strike, y_strike, y_imp = 0.0, 0.0, y, y
+    for i, (phase, events) in enumerate(zip(spec.phases, spec.events, strict=True)):
+        tau, y_end, phi = _integrate_phase(spec, phase, y, variational)
+        t_total += tau
+        y, jump = events_jump(spec, events, y_end)
+        if i == guard:
+            t_strike, y_strike, y_imp = tau, y_end, y
         if variational:
-            assert phi2 is not None
-            factors["phi_double"] = phi2
-            factors["jump_liftoff"] = d_lift
-    else:
-        y_ds = y_imp
+            assert phi is not None
+            if i == guard:
+                f_minus = phase_field(spec, phase, tau, y_end)
+                dg = guard_row(spec, y_end)
+                rate = float(dg @ f_minus)
+                if abs(rate) < 1e-12:
+                    raise StepSimulationError("the swing tip grazes the ground at the heel "
+                                              "strike")
+                jump = jump @ (np.eye(n) - np.outer(f_minus, dg) / rate)
+            factors[f"phi_{i}"], factors[f"jump_{i}"] = phi, jump
+            monodromy = jump @ phi @ monodromy
     y_next, d_swap = _eval(_swap_jump(spec), y)
-    monodromy = None
-    if variational:
-        factors["jump_swap"] = d_swap
-        monodromy = factors["jump_strike"] @ factors["phi_single"]
-        if spec.double is not None:
-            monodromy = factors["jump_liftoff"] @ factors["phi_double"] @ monodromy
-        monodromy = d_swap @ monodromy
-    return StepResult(y_next=y_next.ravel(), strike_time=t1, y_strike=y_strike, y_impact=y_imp,
-                      y_liftoff=y_ds, step_time=t1 + t2, monodromy=monodromy, factors=factors)
+    factors["jump_swap"] = d_swap
+    return StepResult(y_next=y_next.ravel(), strike_time=t_strike, y_strike=y_strike,
+                      y_impact=y_imp, y_liftoff=y, step_time=t_total,
+                      monodromy=d_swap @ monodromy if variational else None,
+                      factors=factors if variational else {})
 
 
 def integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, until: float | None = None,
@@ -415,13 +432,12 @@ def section_constraints(spec: StepSpec, y: Array) -> tuple[Array, Array]:
 def reference_step(spec: StepSpec) -> StepResult:
     """The monodromy linearized about the phases' own reference trajectories (the gait's knots
     interpolated: ``q`` cubic Hermite with ``qd``, ``qd`` with ``qdd``) instead of a simulated
-    step: ``Phi' = A(tau, y_ref(tau)) Phi`` over each phase's nominal duration, the jump
-    Jacobians at the saved pre-event states, and the guard factor with ``f-`` the model's
-    vector field at the saved pre-impact state. ``y_next`` is the gait's own next start (its
-    periodicity residual is the transcription's)."""
+    step: ``Phi' = A(tau, y_ref(tau)) Phi`` over each phase's knots, the jump Jacobians at the
+    saved pre-event states, and the guard factor with ``f-`` the model's vector field at the
+    saved pre-impact state. ``y_next`` is the gait's own next start (its periodicity residual
+    is the transcription's)."""
     n = 2 * spec.nq
-    phases = [spec.single] + ([spec.double] if spec.double is not None else [])
-    for ph in phases:
+    for ph in spec.phases:
         if ph.q is None or ph.qd is None:
             raise StepSimulationError("linearizing about the gait needs its knots")
 
@@ -442,27 +458,25 @@ def reference_step(spec: StepSpec) -> StepResult:
             z, tau = np.asarray(sol.y[:, -1], float), float(stop)
         return z.reshape(n, n)
 
-    single = spec.single
-    t1 = float(single.t[-1])
-    y_strike = reference(single, t1)
-    f_minus = phase_field(spec, single, t1, y_strike)
-    dg = guard_row(spec, y_strike)
-    y_imp, d_imp = (v for v in _eval(_impact_jump(spec), y_strike))
-    factors = {"phi_single": along(single),
-               "jump_strike": d_imp @ (np.eye(n) - np.outer(f_minus, dg) / float(dg @ f_minus))}
-    monodromy = factors["jump_strike"] @ factors["phi_single"]
-    y_end, t2 = y_imp.ravel(), 0.0
-    if spec.double is not None:
-        t2 = float(spec.double.t[-1])
-        y_ds = reference(spec.double, t2)
-        y_lift, d_lift = _eval(_liftoff_jump(spec), y_ds)
-        factors["phi_double"], factors["jump_liftoff"] = along(spec.double), d_lift
-        monodromy = d_lift @ factors["phi_double"] @ monodromy
-        y_end = y_lift.ravel()
-    else:
-        y_ds = y_end
-    y_next, d_swap = _eval(_swap_jump(spec), y_end)
+    guard = spec.guard_phase
+    monodromy = np.eye(n)
+    factors: dict[str, Array] = {}
+    t_total, t_strike = 0.0, 0.0
+    y_strike = y_imp = y = reference(spec.phases[0], 0.0)
+    for i, (phase, events) in enumerate(zip(spec.phases, spec.events, strict=True)):
+        tau = float(phase.t[-1])
+        y_end = reference(phase, tau)
+        t_total += tau
+        y, jump = events_jump(spec, events, y_end)
+        if i == guard:
+            f_minus = phase_field(spec, phase, tau, y_end)
+            dg = guard_row(spec, y_end)
+            jump = jump @ (np.eye(n) - np.outer(f_minus, dg) / float(dg @ f_minus))
+            t_strike, y_strike, y_imp = tau, y_end, y
+        factors[f"phi_{i}"], factors[f"jump_{i}"] = along(phase), jump
+        monodromy = jump @ factors[f"phi_{i}"] @ monodromy
+    y_next, d_swap = _eval(_swap_jump(spec), y)
     factors["jump_swap"] = d_swap
-    return StepResult(y_next=y_next.ravel(), strike_time=t1, y_strike=y_strike,
-                      y_impact=y_imp.ravel(), y_liftoff=y_ds, step_time=t1 + t2,
+    return StepResult(y_next=y_next.ravel(), strike_time=t_strike, y_strike=y_strike,
+                      y_impact=y_imp, y_liftoff=y, step_time=t_total,
                       monodromy=d_swap @ monodromy, factors=factors)

@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 
 from gaitopt.analysis.return_map import (
     PhaseProfile,
+    StepEvent,
     StepSimulationError,
     StepSpec,
     phase_field,
@@ -142,31 +143,41 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
     if pd is not None and (len(pd) != 2 or not all(np.isfinite(pd)) or min(pd) < 0):
         raise StabilityError(f"pd: got {pd!r}; allowed: two finite gains kp, kd >= 0")
     phases = gait.phases
-    if len(phases) not in (1, 2) or len(phases[0].contacts) != 1:
-        raise StabilityError("phases: the step must be single support on one contact, then "
-                             f"optionally double support; got "
-                             f"{[list(p.contacts) for p in phases]}")
+    if len(phases[0].contacts) != 1:
+        raise StabilityError(f"phases[0].contacts: the step must start in single support on "
+                             f"one contact, got {list(phases[0].contacts)}")
     stance = phases[0].contacts[0]
     strikes = [e for e in gait.events if e.name == "heel_strike"]
-    if not strikes:
-        raise StabilityError("events: the gait has no heel_strike event")
+    if len(strikes) != 1:
+        raise StabilityError(f"events: expected one heel_strike event, got {len(strikes)}")
     swing = strikes[0].leg
+    ends = [float(ph.t[-1]) for ph in phases]
+    events: list[list[StepEvent]] = [[] for _ in phases]
+    guard = -1
+    for e in sorted(gait.events, key=lambda e: e.name != "heel_strike"):
+        i = int(np.argmin([abs(e.t - t) for t in ends]))
+        if abs(e.t - ends[i]) > 1e-9:
+            raise StabilityError(f"events: {e.name} at {e.t:g} s is not at the end of a phase")
+        after = phases[i + 1].contacts if i + 1 < len(phases) else (swing,)
+        if e.name == "heel_strike":
+            guard = i
+            events[i].append(StepEvent("strike", e.leg, tuple(dict.fromkeys((*after, e.leg)))))
+        else:
+            impulse = e.impulses.get(e.leg)
+            magnitude = 0.0 if impulse is None else float(np.hypot(*impulse))
+            events[i].append(StepEvent("liftoff", e.leg, tuple(c for c in after if c != e.leg),
+                                       magnitude))
 
-    def profile(i: int, state_triggered: bool) -> PhaseProfile:
+    def profile(i: int) -> PhaseProfile:
         ph = phases[i]
-        return PhaseProfile(contacts=ph.contacts, duration=None if state_triggered else
-                            ph.duration, t=ph.t - ph.t[0], u=np.array(ph.u), q=np.array(ph.q),
+        return PhaseProfile(contacts=ph.contacts, duration=None if i == guard else ph.duration,
+                            t=ph.t - ph.t[0], u=np.array(ph.u), q=np.array(ph.q),
                             qd=np.array(ph.qd), qdd=np.array(ph.qdd),
                             nominal_duration=ph.duration)
 
-    double = profile(1, False) if len(phases) == 2 else None
-    if double is not None and set(double.contacts) != {stance, swing}:
-        raise StabilityError(f"phases[1].contacts: expected {stance} and {swing} (double "
-                             f"support), got {list(double.contacts)}")
-    return StepSpec(model=gait.model, stance=stance, swing=swing, single=profile(0, True),
-                    double=double,
-                    impact_contacts=double.contacts if double is not None else (swing,),
-                    liftoff_magnitude=gait.parameters["liftoff_impulse"] if double else 0.0,
+    return StepSpec(model=gait.model, stance=stance, swing=swing,
+                    phases=tuple(profile(i) for i in range(len(phases))),
+                    events=tuple(tuple(ev) for ev in events),
                     arm_distance=ARM_FRACTION * gait.step_length, pd=pd, rtol=rtol, atol=rtol)
 
 
@@ -289,7 +300,7 @@ def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = FD
             notes.append(f"multiplier {m.real:.6f}{m.imag:+.1e}j is at 1: direction {comp}")
     if not any(abs(m - 1.0) < UNIT_TOLERANCE for m in mult):
         notes.append(f"no multiplier within {UNIT_TOLERANCE:g} of 1")
-    f0 = phase_field(spec, spec.single, 0.0, y)
+    f0 = phase_field(spec, spec.phases[0], 0.0, y)
     f_t = basis.T @ f0
     if np.linalg.norm(f_t) > 0:
         ratio = float(np.linalg.norm(reduced @ f_t) / np.linalg.norm(f_t))
