@@ -298,3 +298,32 @@ def test_cli_reports_a_replay_that_never_lands(gait: Gait, tmp_path: Path) -> No
     assert text.startswith("FAILED") and "did not strike" in text and "--pd" in text
     assert "Traceback" not in result.output
     assert not out.exists()
+
+
+@pytest.fixture(scope="module")
+def single_support_gait() -> Gait:
+    """A walk without double support (``single_support_fraction = 1``), 8 knots."""
+    return solve_gait("five-link", GaitOptions(speed=0.2, single_support_fraction=1.0))
+
+
+def test_single_support_walk_strikes_and_lifts_off_at_once(single_support_gait: Gait) -> None:
+    """Without double support the heel strike (the striking tip alone) and the liftoff of the
+    stance tip (no impulse) both end the one phase; linearized about its knots the gait is
+    open-loop unstable and periodic to the transcription's accuracy."""
+    spec = step_from_gait(single_support_gait, pd=GAINS)
+    assert len(spec.phases) == 1 and spec.phases[0].duration is None
+    (strike, liftoff), = spec.events
+    assert (strike.kind, strike.contact, strike.contacts) == ("strike", "tip_2", ("tip_2",))
+    assert (liftoff.kind, liftoff.contact, liftoff.contacts) == ("liftoff", "tip_1", ("tip_2",))
+    assert liftoff.magnitude == 0.0
+    rep = gait_stability(single_support_gait, about="gait")
+    assert rep.verdict == "unstable" and rep.start_residual < 1e-6
+
+
+@pytest.mark.slow
+def test_single_support_walk_monodromies_agree(single_support_gait: Gait) -> None:
+    """With PD the variational and finite-difference monodromies agree (about 8 s)."""
+    rep = gait_stability(single_support_gait, pd=GAINS)
+    assert rep.fd_agreement is not None and rep.fd_agreement < 1e-4, rep.fd_agreement
+    assert rep.residual < 0.05
+    assert rep.multipliers.size == 2 * single_support_gait.model.nq - 4
