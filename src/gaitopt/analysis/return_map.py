@@ -20,6 +20,10 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
    base position by the new stance tip's position, so that it is at the origin:
    ``q+ = P q - E c(P q)``, ``qd+ = P qd`` (``E`` puts the 2-vector on ``x, y``).
 
+That is the paper's walk; in general (:class:`StepSpec`) the phases run in order, the one that
+ends at the guard is state-triggered and the others last their durations, and after each
+phase its :class:`StepEvent` jumps (impacts, liftoffs) are applied in order, then the swap.
+
 Optional joint-space PD tracking adds ``u = kp B^T (q_ref(tau) - q) + kd B^T (qd_ref(tau) -
 qd)`` to the replayed torques (``B`` the actuation matrix of the phase, so a joint actuator
 tracks its joint angle and an ankle its link's absolute angle); the torques are not bounded.
@@ -158,9 +162,11 @@ class StepSpec:
 @dataclass(frozen=True, eq=False)
 class StepResult:
     """One simulated step: ``y_next`` (2 nq,) on the section; the guard crossing (phase-clock
-    time ``strike_time``, pre-impact state ``y_strike``); the state after the impact and before
-    the liftoff; the step time; with ``variational=True`` the monodromy ``(2 nq, 2 nq)`` and its
-    factors (``phi_single``, ``jump_strike``, ``phi_double``, ``jump_liftoff``, ``jump_swap``)."""
+    time ``strike_time``, pre-impact state ``y_strike``); the state after the heel strike's
+    events and after the last phase's events; the step time; with ``variational=True`` the
+    monodromy ``(2 nq, 2 nq)`` and its factors: ``phi_i`` (phase i's flow), ``jump_i`` (the
+    events after it, with the guard factor ``I - f- Dg / (Dg f-)`` for the guard phase) and
+    ``jump_swap``."""
 
     y_next: Array
     strike_time: float
