@@ -67,6 +67,12 @@ def compass() -> StepSpec:
                     events=((strike,),), rtol=1e-10, atol=1e-10)
 
 
+#: Indices in the compass walker's state [q; qd] (nq = 5: x, y, hip, hip_1, hip_2).
+NQ = 5
+STANCE, SWING = 3, 4                       # hip_1, hip_2: leg angles (the hip link level)
+LEG_STATE = [STANCE, SWING, NQ + STANCE, NQ + SWING]
+
+
 def compass_state(model: RobotModel, stance: float, swing: float, stance_rate: float,
                   swing_rate: float) -> np.ndarray:
     """``[q; qd]`` with the stance tip at the origin at rest and the hip link level: leg
@@ -74,7 +80,7 @@ def compass_state(model: RobotModel, stance: float, swing: float, stance_rate: f
     q = np.array([-np.sin(stance), np.cos(stance), 0.0, stance, swing])
     qd = np.array([-np.cos(stance) * stance_rate, -np.sin(stance) * stance_rate, 0.0,
                    stance_rate, swing_rate])
-    assert model.coordinate_names == ("x", "y", "hip", "hip_1", "hip_2")
+    assert model.coordinate_names == ("x", "y", "hip", "hip_1", "hip_2") and model.nq == NQ
     return np.concatenate([q, qd])
 
 
@@ -99,14 +105,14 @@ def test_compass_two_period_one_gaits_longer_step_stable(compass: StepSpec) -> N
     long_gait = newton_fixed_point(compass, compass_state(model, 0.25, -0.25, -1.0, -0.3))[0]
     short_gait = newton_fixed_point(compass, compass_state(model, 0.1, -0.1, -0.3, 1.0))[0]
     # The literature's stable gait (4 digits quoted).
-    np.testing.assert_allclose(long_gait[[3, 4, 8, 9]], [0.2711, -0.2711, -1.0918, -0.3772],
+    np.testing.assert_allclose(long_gait[LEG_STATE], [0.2711, -0.2711, -1.0918, -0.3772],
                                atol=1.5e-3)
-    steps = [2 * np.sin(y[3]) for y in (long_gait, short_gait)]
+    steps = [2 * np.sin(y[STANCE]) for y in (long_gait, short_gait)]
     assert steps[0] == pytest.approx(0.5355, abs=2e-3)
     assert steps[1] < steps[0] - 0.01, steps
     # Symmetric gaits: legs at +-alpha at the start of the step (both tips on the slope).
     for y in (long_gait, short_gait):
-        assert y[3] == pytest.approx(-y[4], abs=1e-8)
+        assert y[STANCE] == pytest.approx(-y[SWING], abs=1e-8)
 
     # The compass map is smooth: a larger difference step than the default suits it.
     stable = analyse_step(compass, long_gait, fd_step=1e-5)
@@ -152,9 +158,9 @@ def test_linearizing_about_knots_reproduces_the_simulated_monodromy(compass: Ste
     for a, b in zip(t[:-1], t[1:], strict=True):
         states.append(integrate_phase(compass, compass.phases[0], states[-1], until=b, tau0=a)[1])
     ys = np.array(states)
-    acc = np.array([phase_field(compass, compass.phases[0], 0.0, s)[5:] for s in ys])
+    acc = np.array([phase_field(compass, compass.phases[0], 0.0, s)[NQ:] for s in ys])
     knots = PhaseProfile(contacts=("tip_1",), duration=None, t=t,
-                         u=np.zeros((t.size, 0)), q=ys[:, :5], qd=ys[:, 5:], qdd=acc,
+                         u=np.zeros((t.size, 0)), q=ys[:, :NQ], qd=ys[:, NQ:], qdd=acc,
                          nominal_duration=step.strike_time)
     ref = reference_step(dataclasses.replace(compass, phases=(knots,), _functions={}))
     assert step.monodromy is not None and ref.monodromy is not None
