@@ -17,7 +17,7 @@ from rich import box
 from rich.table import Table
 from rich.text import Text
 
-from gaitopt import cli_gait, cli_study  # noqa: F401  (they register their subcommands)
+from gaitopt import cli_gait, cli_stability, cli_study  # noqa: F401  (they register their subcommands)
 from gaitopt.cli_base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
 from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model, model_to_yaml
 from gaitopt.robot.symmetry import SymmetryError, model_symmetry
