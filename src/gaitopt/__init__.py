@@ -32,13 +32,16 @@ _EXPORTS: dict[str, str] = {
     "load_model": "gaitopt.robot",
     "RobotModel": "gaitopt.robot",
     "ModelError": "gaitopt.robot",
+    "gait_stability": "gaitopt.analysis.stability",
+    "StabilityReport": "gaitopt.analysis.stability",
 }
 
 __all__ = ["Gait", "GaitFileError", "GaitOptions", "GaitOptionsError", "ModelError",
-           "RobotModel", "VerifyReport", "__version__", "load_model", "solve_gait",
-           "verify_gait"]
+           "RobotModel", "StabilityReport", "VerifyReport", "__version__", "gait_stability",
+           "load_model", "solve_gait", "verify_gait"]
 
 if TYPE_CHECKING:
+    from gaitopt.analysis.stability import StabilityReport, gait_stability
     from gaitopt.analysis.verify import VerifyReport, verify_gait
     from gaitopt.gait.api import solve_gait
     from gaitopt.gait.gait_file import Gait, GaitFileError
