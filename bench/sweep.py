@@ -20,19 +20,19 @@ import tempfile
 import time
 from pathlib import Path
 
-from gaitopt.analysis.executors import local_backend
-from gaitopt.analysis.summary import VARIANTS
-from gaitopt.analysis.sweep import run_sweep
-from gaitopt.analysis.sweep_plan import SweepSpec
-from gaitopt.analysis.sweep_worker import PointOutcome
 from gaitopt.cli_study import parse_speeds
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import transcription_for
 from gaitopt.robot import load_model
+from gaitopt.study.driver import run_sweep
+from gaitopt.study.executors import local_backend
+from gaitopt.study.plan import SweepSpec
+from gaitopt.study.summary import VARIANTS
+from gaitopt.study.worker import PointOutcome
 
 
 def noop(x: int) -> int:
-    import gaitopt.analysis.sweep_worker  # noqa: F401  (what a real worker imports)
+    import gaitopt.study.worker  # noqa: F401  (what a real worker imports)
 
     return os.getpid()
 

@@ -9,12 +9,12 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from gaitopt.analysis.summary import SUMMARY_FILE, VARIANTS, read_summary
-from gaitopt.analysis.sweep import prepare_directory
-from gaitopt.analysis.sweep_plan import SweepSpec
 from gaitopt.cli import UserError, cli
 from gaitopt.cli_study import parse_speeds, parse_variants, sweep_dirs
 from gaitopt.robot import load_model
+from gaitopt.study.driver import prepare_directory
+from gaitopt.study.plan import SweepSpec
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, read_summary
 from tests.viz.synthetic import synthetic_gait, synthetic_sweep
 
 

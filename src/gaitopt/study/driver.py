@@ -1,8 +1,8 @@
 """Sweeps: many walking problems on a grid, solved in parallel by continuation, resumable.
 
-``run_sweep(spec, directory)`` solves every point of :class:`~gaitopt.analysis.sweep_plan.
+``run_sweep(spec, directory)`` solves every point of :class:`~gaitopt.study.plan.
 SweepSpec` (the grid and the warm-start chains are described there) on a
-:class:`~gaitopt.analysis.executors.Backend` (local processes by default, a Dask cluster, or
+:class:`~gaitopt.study.executors.Backend` (local processes by default, a Dask cluster, or
 this process) and writes the sweep directory (``docs/outputs.md`` section 2):
 
 * ``sweep.json`` first: the settings. A directory made with other settings is refused
@@ -39,7 +39,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gaitopt.analysis.executors import (
+from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptionsError, validate_options
+from gaitopt.ocp import Result
+from gaitopt.study.executors import (
     BROKEN_ERRORS,
     Backend,
     BackendError,
@@ -47,18 +52,7 @@ from gaitopt.analysis.executors import (
     inline_backend,
     local_backend,
 )
-from gaitopt.analysis.summary import (
-    GAITS_DIR,
-    SUMMARY_FILE,
-    SummaryError,
-    SummaryRow,
-    gait_relpath,
-    read_summary,
-    summary_row,
-    variant_flags,
-    write_summary,
-)
-from gaitopt.analysis.sweep_plan import (
+from gaitopt.study.plan import (
     SETTINGS_FILE,
     SETTINGS_FORMAT,
     SweepPoint,
@@ -69,18 +63,24 @@ from gaitopt.analysis.sweep_plan import (
     sweep_settings,
     with_option_defaults,
 )
-from gaitopt.analysis.sweep_worker import (
+from gaitopt.study.summary import (
+    GAITS_DIR,
+    SUMMARY_FILE,
+    SummaryError,
+    SummaryRow,
+    gait_relpath,
+    read_summary,
+    summary_row,
+    variant_flags,
+    write_summary,
+)
+from gaitopt.study.worker import (
     PointOutcome,
     PointTask,
     failed_point_row,
     gait_file_matches,
     solve_point,
 )
-from gaitopt.dynamics.reduced import checked_biped
-from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptionsError, validate_options
-from gaitopt.ocp import Result
 
 LOCK_FILE = ".sweep.lock"
 #: Restarts of a broken process pool in a row (no point finishing between) before giving up.

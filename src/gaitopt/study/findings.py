@@ -1,6 +1,6 @@
 """Whether the paper's findings (section 6) hold for a sweep, stated with numbers.
 
-Input: the rows of a sweep's ``summary.csv`` (:class:`gaitopt.analysis.summary.SummaryRow`) and,
+Input: the rows of a sweep's ``summary.csv`` (:class:`gaitopt.study.summary.SummaryRow`) and,
 for the torque findings, some of its gaits keyed by the rows' ``file``. Each finding gets a
 verdict: ``True`` (holds), ``False`` (does not hold) or ``None`` (the sweep cannot tell:
 missing variants, too few points). The thresholds are module constants, stated in the
@@ -38,8 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gaitopt.analysis.summary import VARIANTS, SummaryRow, rows_of
 from gaitopt.gait.gait_file import Gait
+from gaitopt.study.summary import VARIANTS, SummaryRow, rows_of
 
 PAPER_OPTIMAL_SPEED_M_MIN = 12.0
 PAPER_OPTIMAL_STEP_LENGTH = 0.1

@@ -22,13 +22,13 @@ import traceback
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from gaitopt.analysis.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.solve import WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, Result
 from gaitopt.robot.model import RobotModel
+from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 
 #: Problem structures whose transcription this process has built (see module docstring).
 _BUILT: set[str] = set()

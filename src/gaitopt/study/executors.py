@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 #: Modules the forkserver imports once, so that each worker starts with them loaded.
-PRELOAD = ("gaitopt.analysis.sweep_worker",)
+PRELOAD = ("gaitopt.study.worker",)
 
 
 class BackendError(RuntimeError):

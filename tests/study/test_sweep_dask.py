@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.analysis.summary import SUMMARY_FILE, read_summary
-from gaitopt.analysis.sweep import run_sweep
-from gaitopt.analysis.sweep_plan import SweepSpec
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
+from gaitopt.study.driver import run_sweep
+from gaitopt.study.plan import SweepSpec
+from gaitopt.study.summary import SUMMARY_FILE, read_summary
 
 distributed = pytest.importorskip("distributed")
 

@@ -9,7 +9,8 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from gaitopt.analysis.findings import (
+from gaitopt.gait.gait_file import Gait
+from gaitopt.study.findings import (
     assess_findings,
     findings_html,
     findings_text,
@@ -19,8 +20,7 @@ from gaitopt.analysis.findings import (
     row_near_speed,
     saturation_fraction,
 )
-from gaitopt.analysis.summary import SummaryRow, failed_row, variant_name
-from gaitopt.gait.gait_file import Gait
+from gaitopt.study.summary import SummaryRow, failed_row, variant_name
 from tests.viz.synthetic import synthetic_cost, synthetic_gait, synthetic_step_length
 
 SPEEDS = tuple(float(v) for v in range(3, 61, 3))
