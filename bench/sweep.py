@@ -2,8 +2,8 @@
 
 Measures, in one run: the wall time of the sweep from scratch (process start, transcription
 builds, solves, file writes) and resumed (nothing left to solve), solves per minute, and where
-the time goes (summed over the points: transcription builds, IPOPT, gait records, file
-writes; process start measured separately), against references measured in the same run: a
+the time goes (summed over the points: transcription builds, IPOPT, gait records in the
+workers, gait file writes in the driver; process start measured separately), against references measured in the same run: a
 worker pool's start-up and one transcription build in this process. Target: under 60 s for
 the 80 points on the 2-core reference machine.
 
@@ -129,7 +129,7 @@ def main() -> None:
               f"{100 * busy / (args.workers * cold):.0f} % utilisation):")
         labels = {"build_and_setup_s": f"transcription builds ({nb}) and setup",
                   "ipopt_s": "IPOPT solves (all stages)", "record_s": "gait records",
-                  "write_s": "gait file writes (atomic, fsync)",
+                  "write_s": "gait file writes by the driver (atomic, fsync)",
                   "warm_start_s": "reading warm-start files"}
         for key, label in labels.items():
             value = parts.get(key, 0.0)

@@ -230,7 +230,8 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
 def _workers_option(f: Any) -> Any:
     f = click.option("--scheduler", default=None, metavar="ADDRESS",
                      help="Run on a Dask cluster (e.g. tcp://host:8786) instead of local "
-                          "processes; its workers need gaitopt and this directory.")(f)
+                          "processes; its workers need gaitopt, not this directory (this "
+                          "process writes every result).")(f)
     return click.option("--workers", type=click.IntRange(min=0), default=None,
                         help="Local worker processes (default: the CPUs available, "
                              f"{default_workers()} here; 0 = in this process).")(f)
