@@ -3,9 +3,9 @@
 Measures, in one run: the wall time of the sweep from scratch (process start, transcription
 builds, solves, file writes) and resumed (nothing left to solve), solves per minute, and where
 the time goes (summed over the points: transcription builds, IPOPT, gait records in the
-workers, gait file writes in the driver; process start measured separately), against references measured in the same run: a
-worker pool's start-up and one transcription build in this process. Target: under 60 s for
-the 80 points on the 2-core reference machine.
+workers, gait file writes in the driver; process start measured separately), against
+references measured in the same run: a worker pool's start-up and one transcription build in
+this process. Target: under 60 s for the 80 points on the 2-core reference machine.
 
     PYTHONPATH=src python bench/sweep.py [--workers 2] [--speeds 3:60:3] [--free]
         [--start-methods forkserver,spawn]

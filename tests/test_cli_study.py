@@ -119,6 +119,7 @@ def test_report_prints_where_it_is_and_the_findings(runner: CliRunner, tmp_path:
     assert (tmp_path / "r" / "report.html").stat().st_size > 10000
     assert (tmp_path / "r" / "fig3_energy.png").exists()
     assert "[holds] The energy-optimal walk is much slower" in result.output
+    assert "about 12 m/min.  (optimum.speed)" in result.output  # each finding's stable id
     assert "Energy-optimal walk per variant" in result.output
 
 
