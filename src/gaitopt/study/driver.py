@@ -83,8 +83,6 @@ from gaitopt.study.worker import (
     failed_point_row,
     gait_file_matches,
     solve_point,
-    write_gait_data,
-    written,
 )
 
 LOCK_FILE = ".sweep.lock"
@@ -445,13 +443,15 @@ class _Driver:
         if outcome.gait is None:
             return outcome
         mark = time.perf_counter()
-        try:
-            write_gait_data(self.directory / key, outcome.gait)
+        try:  # validated on the way: the file holds a gait that loads
+            Gait.from_dict(outcome.gait, source=key).save(self.directory / key)
         except (OSError, GaitFileError) as exc:
             status = f"error: cannot write the gait file: {type(exc).__name__}: {exc}"
             return replace(outcome, row=failed_point_row(self.tasks[key], status), gait=None,
                            result=None, error=repr(exc))
-        return written(outcome, time.perf_counter() - mark)
+        # the gait data is dropped once written (the report keeps every outcome)
+        return replace(outcome, gait=None,
+                       timings={**outcome.timings, "write_s": time.perf_counter() - mark})
 
     def settle(self, key: str, outcome: PointOutcome) -> None:
         outcome = self.save(key, outcome)

@@ -4,11 +4,11 @@
 the warm start), solves, and returns a :class:`PointOutcome`: the summary row, the finished
 gait as plain data in the gait-file schema (``Gait.to_dict()``) and, for the neighbours, the
 engine :class:`~gaitopt.ocp.Result` whose values and multipliers warm-start them. The worker
-writes nothing: the driver writes the gait file (:func:`write_gait_data`), so a worker needs
-no access to the sweep directory (a Dask cluster without a shared filesystem). For the same
-reason a warm start from a gait file kept from an earlier run travels as the file's text
-(:class:`SavedGait`), read by the driver. Everything in these objects pickles (the Result is
-about 10 kB, the gait data about 100 kB).
+writes nothing: the driver writes the gait file, so a worker needs no access to the sweep
+directory (a Dask cluster without a shared filesystem). For the same reason a warm start
+from a gait file kept from an earlier run travels as the file's text (:class:`SavedGait`),
+read by the driver. Everything in these objects pickles (a task with a Result to start from
+is about 13 kB, an outcome about 60 kB).
 
 Transcriptions are cached per process by :mod:`gaitopt.gait.solve`; the outcome says which
 problem structures this process has built, so the driver can send a process more points of a
@@ -25,7 +25,7 @@ import threading
 import time
 import traceback
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -202,17 +202,6 @@ def solve_point(task: PointTask) -> PointOutcome:
         stages=len(stages), iterations=sum(s.iterations for s in stages),
         wall_time_s=clock() - start, worker=worker_name(),
         structures=frozenset(_BUILT), error=error, timings=timings)
-
-
-def write_gait_data(path: str | os.PathLike[str], data: Mapping[str, Any]) -> Path:
-    """Write a solved gait (plain data in the gait-file schema, :attr:`PointOutcome.gait`)
-    atomically as its gait file, validated on the way (:class:`GaitFileError` if invalid)."""
-    return Gait.from_dict(data, source=str(path)).save(path)
-
-
-def written(outcome: PointOutcome, write_s: float) -> PointOutcome:
-    """The outcome once its gait file is written: no gait data kept, the write time added."""
-    return replace(outcome, gait=None, timings={**outcome.timings, "write_s": write_s})
 
 
 def gait_file_matches(gait: Gait, model: RobotModel, options: GaitOptions) -> str:
