@@ -1,4 +1,6 @@
-"""The same sweep on a Dask cluster (a LocalCluster of two single-threaded processes)."""
+"""The same sweep on a Dask cluster (a LocalCluster of two single-threaded processes), also
+with workers that cannot see the sweep directory (no shared disk): the driver writes every
+file."""
 
 from __future__ import annotations
 
