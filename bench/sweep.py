@@ -2,10 +2,10 @@
 
 Measures, in one run: the wall time of the sweep from scratch (process start, transcription
 builds, solves, file writes) and resumed (nothing left to solve), solves per minute, and where
-the time goes (summed over the points: transcription builds, IPOPT, gait records, file
-writes; process start measured separately), against references measured in the same run: a
-worker pool's start-up and one transcription build in this process. Target: under 60 s for
-the 80 points on the 2-core reference machine.
+the time goes (summed over the points: transcription builds, IPOPT, gait records in the
+workers, gait file writes in the driver; process start measured separately), against
+references measured in the same run: a worker pool's start-up and one transcription build in
+this process. Target: under 60 s for the 80 points on the 2-core reference machine.
 
     PYTHONPATH=src python bench/sweep.py [--workers 2] [--speeds 3:60:3] [--free]
         [--start-methods forkserver,spawn]
@@ -20,19 +20,19 @@ import tempfile
 import time
 from pathlib import Path
 
-from gaitopt.analysis.executors import local_backend
-from gaitopt.analysis.summary import VARIANTS
-from gaitopt.analysis.sweep import run_sweep
-from gaitopt.analysis.sweep_plan import SweepSpec
-from gaitopt.analysis.sweep_worker import PointOutcome
 from gaitopt.cli_study import parse_speeds
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import transcription_for
 from gaitopt.robot import load_model
+from gaitopt.study.driver import run_sweep
+from gaitopt.study.executors import local_backend
+from gaitopt.study.plan import SweepSpec
+from gaitopt.study.summary import VARIANTS
+from gaitopt.study.worker import PointOutcome
 
 
 def noop(x: int) -> int:
-    import gaitopt.analysis.sweep_worker  # noqa: F401  (what a real worker imports)
+    import gaitopt.study.worker  # noqa: F401  (what a real worker imports)
 
     return os.getpid()
 
@@ -129,7 +129,7 @@ def main() -> None:
               f"{100 * busy / (args.workers * cold):.0f} % utilisation):")
         labels = {"build_and_setup_s": f"transcription builds ({nb}) and setup",
                   "ipopt_s": "IPOPT solves (all stages)", "record_s": "gait records",
-                  "write_s": "gait file writes (atomic, fsync)",
+                  "write_s": "gait file writes by the driver (atomic, fsync)",
                   "warm_start_s": "reading warm-start files"}
         for key, label in labels.items():
             value = parts.get(key, 0.0)

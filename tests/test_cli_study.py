@@ -9,12 +9,12 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from gaitopt.analysis.summary import SUMMARY_FILE, VARIANTS, read_summary
-from gaitopt.analysis.sweep import prepare_directory
-from gaitopt.analysis.sweep_plan import SweepSpec
 from gaitopt.cli import UserError, cli
 from gaitopt.cli_study import parse_speeds, parse_variants, sweep_dirs
 from gaitopt.robot import load_model
+from gaitopt.study.driver import prepare_directory
+from gaitopt.study.plan import SweepSpec
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, read_summary
 from tests.viz.synthetic import synthetic_gait, synthetic_sweep
 
 
@@ -119,6 +119,7 @@ def test_report_prints_where_it_is_and_the_findings(runner: CliRunner, tmp_path:
     assert (tmp_path / "r" / "report.html").stat().st_size > 10000
     assert (tmp_path / "r" / "fig3_energy.png").exists()
     assert "[holds] The energy-optimal walk is much slower" in result.output
+    assert "about 12 m/min.  (optimum.speed)" in result.output  # each finding's stable id
     assert "Energy-optimal walk per variant" in result.output
 
 

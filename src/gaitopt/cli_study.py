@@ -26,9 +26,12 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from gaitopt.analysis.executors import BackendError
-from gaitopt.analysis.summary import SUMMARY_FILE, VARIANTS, SummaryError
-from gaitopt.analysis.sweep import (
+from gaitopt.cli_base import UserError, cli, make_console
+from gaitopt.cli_gait import _free_or_value, _knots
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.robot.biped import BipedStructureError
+from gaitopt.study.driver import (
     Counts,
     SweepReport,
     SweepSettingsError,
@@ -36,13 +39,10 @@ from gaitopt.analysis.sweep import (
     default_workers,
     run_sweep,
 )
-from gaitopt.analysis.sweep_plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
-from gaitopt.analysis.sweep_worker import PointOutcome
-from gaitopt.cli_base import UserError, cli, make_console
-from gaitopt.cli_gait import _free_or_value, _knots
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.robot.biped import BipedStructureError
+from gaitopt.study.executors import BackendError
+from gaitopt.study.plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, SummaryError
+from gaitopt.study.worker import PointOutcome
 
 #: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
 DEFAULT_SPEEDS = "3:60:3"
@@ -230,7 +230,8 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
 def _workers_option(f: Any) -> Any:
     f = click.option("--scheduler", default=None, metavar="ADDRESS",
                      help="Run on a Dask cluster (e.g. tcp://host:8786) instead of local "
-                          "processes; its workers need gaitopt and this directory.")(f)
+                          "processes; its workers need gaitopt, not this directory (this "
+                          "process writes every result).")(f)
     return click.option("--workers", type=click.IntRange(min=0), default=None,
                         help="Local worker processes (default: the CPUs available, "
                              f"{default_workers()} here; 0 = in this process).")(f)
@@ -290,7 +291,7 @@ def sweep_dirs(directory: Path) -> list[Path]:
 
 def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
     """Write the report of each (sub-)sweep, print where and the findings."""
-    from gaitopt.analysis.findings import findings_text
+    from gaitopt.study.findings import findings_text
     from gaitopt.viz.report import write_report
 
     pages = []
@@ -366,8 +367,8 @@ def study_command(directory: Path, model_name: str, speeds: str, workers: int | 
     """The paper's study: the four variants over the speed grid plus each speed-free
     optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
     Rerunning resumes."""
-    from gaitopt.analysis.findings import optimal_row
-    from gaitopt.analysis.summary import read_summary
+    from gaitopt.study.findings import optimal_row
+    from gaitopt.study.summary import read_summary
 
     console = make_console()
     start = time.perf_counter()

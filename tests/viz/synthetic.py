@@ -19,14 +19,6 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from gaitopt.analysis.summary import (
-    SUMMARY_FILE,
-    SpeedMode,
-    SummaryRow,
-    gait_relpath,
-    summary_row,
-    write_summary,
-)
 from gaitopt.gait.gait_file import (
     Gait,
     GaitEvent,
@@ -35,6 +27,14 @@ from gaitopt.gait.gait_file import (
     leg_swap_permutations,
 )
 from gaitopt.robot import RobotModel, load_model, model_to_dict
+from gaitopt.study.summary import (
+    SUMMARY_FILE,
+    SpeedMode,
+    SummaryRow,
+    gait_relpath,
+    summary_row,
+    write_summary,
+)
 
 Array = NDArray[np.float64]
 # q = [x, y, torso, hip_1, knee_1, hip_2, knee_2]; u = [hip_1, knee_1, ankle_1, hip_2, knee_2,

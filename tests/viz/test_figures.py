@@ -9,8 +9,8 @@ import pytest
 from matplotlib.figure import Figure
 from PIL import Image
 
-from gaitopt.analysis.summary import SummaryRow, failed_row, variant_name
 from gaitopt.gait.gait_file import Gait
+from gaitopt.study.summary import SummaryRow, failed_row, variant_name
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
 from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import png_bytes

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from gaitopt.analysis.summary import SummaryError
+from gaitopt.study.summary import SummaryError
 from gaitopt.viz.report import ReportInfo, write_report
 from tests.viz.synthetic import synthetic_sweep
 

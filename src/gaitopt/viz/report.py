@@ -1,7 +1,7 @@
 """The report of a sweep: one self-contained HTML file plus every figure as PNG and SVG.
 
 ``write_report(sweep_dir, out_dir)`` reads the sweep directory (``summary.csv`` and the gait
-files it names, layout in :mod:`gaitopt.analysis.summary`) and writes to ``out_dir``:
+files it names, layout in :mod:`gaitopt.study.summary`) and writes to ``out_dir``:
 
 * ``report.html``: headline table (the energy-optimal walk of each variant beside the
   paper's), Figs. 3-8, stick-figure strips, the solver statistics beside the paper's table,
@@ -27,7 +27,9 @@ from typing import Any
 
 from matplotlib.figure import Figure
 
-from gaitopt.analysis.findings import (
+from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.study.findings import (
     FAST_SPEED_M_MIN,
     PAPER_OPTIMAL_SPEED_M_MIN,
     PAPER_OPTIMAL_STEP_LENGTH,
@@ -37,7 +39,7 @@ from gaitopt.analysis.findings import (
     optimal_row,
     row_near_speed,
 )
-from gaitopt.analysis.summary import (
+from gaitopt.study.summary import (
     SUMMARY_COLUMNS,
     SUMMARY_FILE,
     VARIANTS,
@@ -45,8 +47,6 @@ from gaitopt.analysis.summary import (
     read_summary,
     rows_of,
 )
-from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
 from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import VARIANT_LABELS, gait_style, png_data_uri, save_figure
@@ -93,7 +93,7 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
     ``svg=False`` skips the SVG copies of the figures.
 
-    Raises :class:`gaitopt.analysis.summary.SummaryError` if ``summary.csv`` is missing or
+    Raises :class:`gaitopt.study.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
     """
     sweep, out = Path(sweep_dir), Path(out_dir)

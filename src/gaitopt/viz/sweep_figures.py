@@ -14,7 +14,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 
-from gaitopt.analysis.summary import VARIANTS, SummaryRow, rows_of
+from gaitopt.study.summary import VARIANTS, SummaryRow, rows_of
 from gaitopt.viz.style import VARIANT_LABELS, VARIANT_STYLES, new_figure
 
 COST_LABEL = "cost J = (∫uᵀu dt + P²) / step length  [N² m s]"

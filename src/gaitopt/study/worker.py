@@ -1,10 +1,14 @@
 """One sweep point, solved where the executor runs it (a local process or a Dask worker).
 
-:func:`solve_point` is the task function: it receives a :class:`PointTask` (the problem, the
-warm start and where to write), solves, writes the gait file atomically when the solve
-succeeded, and returns a :class:`PointOutcome` (the summary row and, for the neighbours, the
-engine :class:`~gaitopt.ocp.Result` whose values and multipliers warm-start them). A failed
-point writes no file. Everything in both objects pickles (the Result is about 10 kB).
+:func:`solve_point` is the task function: it receives a :class:`PointTask` (the problem and
+the warm start), solves, and returns a :class:`PointOutcome`: the summary row, the finished
+gait as plain data in the gait-file schema (``Gait.to_dict()``) and, for the neighbours, the
+engine :class:`~gaitopt.ocp.Result` whose values and multipliers warm-start them. The worker
+writes nothing: the driver writes the gait file, so a worker needs no access to the sweep
+directory (a Dask cluster without a shared filesystem). For the same reason a warm start
+from a gait file kept from an earlier run travels as the file's text (:class:`SavedGait`),
+read by the driver. Everything in these objects pickles (a task with a Result to start from
+is about 13 kB, an outcome about 60 kB).
 
 Transcriptions are cached per process by :mod:`gaitopt.gait.solve`; the outcome says which
 problem structures this process has built, so the driver can send a process more points of a
@@ -13,6 +17,7 @@ structure it already has.
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import socket
@@ -21,14 +26,16 @@ import time
 import traceback
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
-from gaitopt.analysis.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.solve import WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, Result
 from gaitopt.robot.model import RobotModel
+from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 
 #: Problem structures whose transcription this process has built (see module docstring).
 _BUILT: set[str] = set()
@@ -37,13 +44,30 @@ _BUILT: set[str] = set()
 _LOCK = threading.Lock()
 
 
+@dataclass(frozen=True)
+class SavedGait:
+    """A gait file's text as the driver read it (``source``: its path there, for messages)."""
+
+    source: str
+    text: str
+
+    @classmethod
+    def read(cls, path: str | os.PathLike[str]) -> SavedGait:
+        """The file's text; an unreadable file gives empty text (the point then starts
+        cold, its outcome says ``file unreadable``)."""
+        try:
+            return cls(str(path), Path(path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError):
+            return cls(str(path), "")
+
+
 @dataclass(frozen=True, kw_only=True)
 class PointTask:
     """What a worker needs to solve one point.
 
-    ``warm`` is the finished neighbour's Result (values and multipliers), or the path of its
-    gait file (a point kept from an earlier run), or None (cold start). ``path`` is the
-    absolute gait file to write; ``relfile`` the path the summary row names.
+    ``warm`` is the finished neighbour's Result (values and multipliers), or its gait file's
+    text (a point kept from an earlier run), or None (cold start). ``relfile`` is the gait
+    file's path relative to the sub-sweep folder (the summary row's ``file``).
     ``force_fail`` (a testing hook) solves with ``max_iter = 1`` so that the point fails
     through the real solver path.
     """
@@ -54,8 +78,7 @@ class PointTask:
     variant: str
     speed_mode: SpeedMode
     structure: str
-    warm: Result | str | None
-    path: str
+    warm: Result | SavedGait | None
     relfile: str
     force_fail: bool = False
 
@@ -64,18 +87,22 @@ class PointTask:
 class PointOutcome:
     """What came of one point.
 
-    ``row`` is the summary row (failed rows name the failed stage in ``status``); ``result``
-    the final engine result when the point succeeded (for its neighbours), else None;
+    ``row`` is the summary row (failed rows name the failed stage in ``status``); ``gait``
+    the solved gait as plain data in the gait-file schema (``Gait.to_dict()``) for the driver
+    to write, None for a failed point (and once written); ``result`` the final engine result
+    when the point succeeded (for its neighbours), else None;
     ``warm`` how it started (``result``, ``file``, ``none``, or ``file unreadable``);
     ``fell_back`` whether a warm start failed and the cold path was taken;
     ``iterations`` the IPOPT iterations over all stages; ``worker`` host:pid; ``timings``
     where the time went (s): ``warm_start_s`` (reading a gait file), ``build_and_setup_s``
     (transcription build on a process's first point of a structure, guesses), ``ipopt_s``
-    (the stages' solves), ``record_s`` (the gait record), ``write_s`` (the atomic save).
+    (the stages' solves), ``record_s`` (the gait record and its plain data), and, added by
+    the driver, ``write_s`` (the atomic save of the gait file).
     """
 
     key: str
     row: SummaryRow
+    gait: Mapping[str, Any] | None
     result: Result | None
     warm: str
     fell_back: bool
@@ -99,11 +126,12 @@ def worker_name() -> str:
 def _warm_start(task: PointTask) -> tuple[Guess | Result | None, str]:
     if isinstance(task.warm, Result):
         return task.warm, "result"
-    if isinstance(task.warm, str):
+    if isinstance(task.warm, SavedGait):
         from gaitopt.gait.api import guess_from_gait
 
         try:
-            return guess_from_gait(Gait.load(task.warm)), "file"
+            gait = Gait.from_dict(json.loads(task.warm.text), source=task.warm.source)
+            return guess_from_gait(gait), "file"
         except (GaitFileError, KeyError, ValueError):
             return None, "file unreadable"
     return None, "none"
@@ -134,6 +162,7 @@ def solve_point(task: PointTask) -> PointOutcome:
     options = task.options.replace(max_iter=1) if task.force_fail else task.options
     solution: WalkingSolution | None = None
     result: Result | None = None
+    data: dict[str, Any] | None = None
     error = ""
     try:
         with _LOCK:
@@ -143,11 +172,9 @@ def solve_point(task: PointTask) -> PointOutcome:
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt
             mark = clock()
             gait = gait_from_solution(solution) if solution.success else None
+            data = gait.to_dict() if gait is not None else None
             timings["record_s"] = clock() - mark
         if solution.success and gait is not None:
-            mark = clock()
-            gait.save(task.path)
-            timings["write_s"] = clock() - mark
             ankle, impulse = variant_flags(task.variant)
             row = summary_row(gait, ankle=ankle, impulse=impulse, speed_mode=task.speed_mode,
                               file=task.relfile)
@@ -170,7 +197,7 @@ def solve_point(task: PointTask) -> PointOutcome:
         _BUILT.add(task.structure)
     stages = solution.stages if solution is not None else ()
     return PointOutcome(
-        key=task.key, row=row, result=result, warm=how,
+        key=task.key, row=row, gait=data if row.success else None, result=result, warm=how,
         fell_back=warm is not None and bool(stages) and not stages[0].success,
         stages=len(stages), iterations=sum(s.iterations for s in stages),
         wall_time_s=clock() - start, worker=worker_name(),

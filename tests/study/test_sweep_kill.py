@@ -10,8 +10,8 @@ import sys
 import time
 from pathlib import Path
 
-from gaitopt.analysis.summary import SUMMARY_FILE, SummaryError, read_summary
 from gaitopt.gait.gait_file import Gait
+from gaitopt.study.summary import SUMMARY_FILE, SummaryError, read_summary
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 ARGS = ["sweep", "--speeds", "6:18:3", "--variants", "plain", "--no-free", "--workers", "1"]

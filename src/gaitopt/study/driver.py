@@ -1,30 +1,32 @@
 """Sweeps: many walking problems on a grid, solved in parallel by continuation, resumable.
 
-``run_sweep(spec, directory)`` solves every point of :class:`~gaitopt.analysis.sweep_plan.
+``run_sweep(spec, directory)`` solves every point of :class:`~gaitopt.study.plan.
 SweepSpec` (the grid and the warm-start chains are described there) on a
-:class:`~gaitopt.analysis.executors.Backend` (local processes by default, a Dask cluster, or
+:class:`~gaitopt.study.executors.Backend` (local processes by default, a Dask cluster, or
 this process) and writes the sweep directory (``docs/outputs.md`` section 2):
 
 * ``sweep.json`` first: the settings. A directory made with other settings is refused
   (:class:`SweepSettingsError` lists the differences); so is one where another sweep runs.
-* each point's gait file, written atomically by the worker when its solve succeeds (a failed
-  point never gets a file);
+* each point's gait file, written atomically by the driver as soon as the worker returns the
+  solved gait (a failed point never gets a file). Workers write nothing and read nothing of
+  the sweep directory, so a Dask cluster needs no filesystem shared with the driver;
 * ``summary.csv`` (of each sub-sweep), rewritten atomically after every finished point: a row
   per finished point, failed points as failed rows naming the failed stage.
 
 The driver keeps ``backend.slots`` points in flight. A point is ready when the neighbour it
 continues from (its *parent*) has finished; it is warm-started from that neighbour's engine
 Result (values and multipliers, passed in memory from task to task), or, when the neighbour
-was kept from an earlier run, from its gait file; when the neighbour failed, from what the
-neighbour was given. Among ready points the driver prefers, in order: one whose problem
-structure the process that just finished has already built; a chain's cold start; the point
-with the most points waiting on it (the longest chain first).
+was kept from an earlier run, from its gait file (whose text the driver sends); when the
+neighbour failed, from what the neighbour was given. Among ready points the driver prefers, in
+order: one whose problem structure the process that just finished has already built; a
+chain's cold start; the point with the most points waiting on it (the longest chain first).
 
 Resuming: rerunning with the same settings keeps every point whose gait file loads, converged
 and was solved with this point's options and model (its summary row is rebuilt from the
 file, so a file written just before a kill is kept too); failed and missing points are
 solved. Killing the sweep at any moment loses no finished point and corrupts no file: every
-write is atomic (temporary file + rename) and leftovers of interrupted writes are removed.
+write is atomic (temporary file + rename) and leftovers of interrupted writes are removed. On
+Ctrl-C the driver first writes every point already returned, then stops the workers.
 """
 
 from __future__ import annotations
@@ -35,11 +37,16 @@ import os
 import time
 from collections.abc import Callable, Collection, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from gaitopt.analysis.executors import (
+from gaitopt.dynamics.reduced import checked_biped
+from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import GaitOptionsError, validate_options
+from gaitopt.ocp import Result
+from gaitopt.study.executors import (
     BROKEN_ERRORS,
     Backend,
     BackendError,
@@ -47,18 +54,7 @@ from gaitopt.analysis.executors import (
     inline_backend,
     local_backend,
 )
-from gaitopt.analysis.summary import (
-    GAITS_DIR,
-    SUMMARY_FILE,
-    SummaryError,
-    SummaryRow,
-    gait_relpath,
-    read_summary,
-    summary_row,
-    variant_flags,
-    write_summary,
-)
-from gaitopt.analysis.sweep_plan import (
+from gaitopt.study.plan import (
     SETTINGS_FILE,
     SETTINGS_FORMAT,
     SweepPoint,
@@ -69,18 +65,25 @@ from gaitopt.analysis.sweep_plan import (
     sweep_settings,
     with_option_defaults,
 )
-from gaitopt.analysis.sweep_worker import (
+from gaitopt.study.summary import (
+    GAITS_DIR,
+    SUMMARY_FILE,
+    SummaryError,
+    SummaryRow,
+    gait_relpath,
+    read_summary,
+    summary_row,
+    variant_flags,
+    write_summary,
+)
+from gaitopt.study.worker import (
     PointOutcome,
     PointTask,
+    SavedGait,
     failed_point_row,
     gait_file_matches,
     solve_point,
 )
-from gaitopt.dynamics.reduced import checked_biped
-from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptionsError, validate_options
-from gaitopt.ocp import Result
 
 LOCK_FILE = ".sweep.lock"
 #: Restarts of a broken process pool in a row (no point finishing between) before giving up.
@@ -305,6 +308,8 @@ class _Driver:
     on_point: PointFn | None
     rows: dict[str, SummaryRow]
     state: dict[str, str]  # todo, running, ok, failed, kept
+    counts: Counts
+    inflight: dict[Any, tuple[str, int]] = field(default_factory=dict)  # future -> key, gen.
     offers: dict[str, Result | str | None] = field(default_factory=dict)
     given: dict[str, Result | str | None] = field(default_factory=dict)
     tasks: dict[str, PointTask] = field(default_factory=dict)
@@ -363,35 +368,49 @@ class _Driver:
 
     def task(self, key: str) -> PointTask:
         p, parent = self.points[key], self.parents[key]
-        warm = self.offers.get(parent) if parent is not None else None
-        self.given[key] = warm
+        offer = self.offers.get(parent) if parent is not None else None
+        self.given[key] = offer
+        # a kept neighbour's gait file is read here: workers may not see this directory
+        warm = SavedGait.read(offer) if isinstance(offer, str) else offer
         self.tasks[key] = PointTask(key=key, model=self.spec.model, options=self.spec.options(p),
                          variant=p.variant, speed_mode=p.speed_mode, structure=p.structure,
-                         warm=warm, path=str((self.directory / key).resolve()),
-                         relfile=p.relfile, force_fail=key in self.fail_points)
+                         warm=warm, relfile=p.relfile, force_fail=key in self.fail_points)
         return self.tasks[key]
 
-    def run(self, counts: Counts) -> Counts:
-        inflight: dict[Any, tuple[str, int]] = {}
+    def run(self) -> None:
+        """Solve every point left (``self.counts`` follows); on Ctrl-C, :meth:`drain`."""
         built: frozenset[str] = frozenset()
-        while True:
-            ready = self.ready()
-            while ready and len(inflight) < self.backend.slots:
-                key = self.pick(ready, built)
-                ready.remove(key)
-                self.state[key] = "running"
-                inflight[self.backend.submit(solve_point, self.task(key))] = (
-                    key, self.generation)
-                built = frozenset()
-            if not inflight:
-                return counts
-            future = self.backend.next_finished()
-            if future is None or future not in inflight:
-                continue
-            key, generation = inflight.pop(future)
-            outcome = self._outcome(key, future, generation)
-            built = outcome.structures
-            counts = self.settle(key, outcome, counts)
+        try:
+            while True:
+                ready = self.ready()
+                while ready and len(self.inflight) < self.backend.slots:
+                    key = self.pick(ready, built)
+                    ready.remove(key)
+                    self.state[key] = "running"
+                    self.inflight[self.backend.submit(solve_point, self.task(key))] = (
+                        key, self.generation)
+                    built = frozenset()
+                if not self.inflight:
+                    return
+                future = self.backend.next_finished()
+                if future is None or future not in self.inflight:
+                    continue
+                key, generation = self.inflight.pop(future)
+                outcome = self._outcome(key, future, generation)
+                built = outcome.structures
+                self.settle(key, outcome)
+        except KeyboardInterrupt:
+            self.drain()
+            raise
+
+    def drain(self) -> None:
+        """Settle (write) every point whose worker has already returned its outcome; the
+        others are left to a rerun."""
+        while (future := self.backend.next_finished(timeout=0.0)) is not None:
+            if future in self.inflight and not future.cancelled() and \
+                    future.exception() is None:
+                key, _ = self.inflight.pop(future)
+                self.settle(key, future.result())
 
     def _outcome(self, key: str, future: Any, generation: int) -> PointOutcome:
         try:
@@ -413,14 +432,32 @@ class _Driver:
             status = ("error: the worker process died" if isinstance(exc, BROKEN_ERRORS)
                       else f"error: {type(exc).__name__}: {exc}")
             return PointOutcome(key=key, row=failed_point_row(self.tasks[key], status),
-                                result=None,
+                                gait=None, result=None,
                                 warm="?", fell_back=False, stages=0, iterations=0,
                                 wall_time_s=math.nan, worker="?", structures=frozenset(),
                                 error=repr(exc))
 
-    def settle(self, key: str, outcome: PointOutcome, counts: Counts) -> Counts:
+    def save(self, key: str, outcome: PointOutcome) -> PointOutcome:
+        """Write the point's gait file atomically; a write that fails makes the point failed
+        (its row says why), as a failed solve would."""
+        if outcome.gait is None:
+            return outcome
+        mark = time.perf_counter()
+        try:  # validated on the way: the file holds a gait that loads
+            Gait.from_dict(outcome.gait, source=key).save(self.directory / key)
+        except (OSError, GaitFileError) as exc:
+            status = f"error: cannot write the gait file: {type(exc).__name__}: {exc}"
+            return replace(outcome, row=failed_point_row(self.tasks[key], status), gait=None,
+                           result=None, error=repr(exc))
+        # the gait data is dropped once written (the report keeps every outcome)
+        return replace(outcome, gait=None,
+                       timings={**outcome.timings, "write_s": time.perf_counter() - mark})
+
+    def settle(self, key: str, outcome: PointOutcome) -> None:
+        outcome = self.save(key, outcome)
         self.outcomes.append(outcome)
         self.rows[key] = outcome.row
+        counts = self.counts
         if outcome.success:
             self.state[key] = "ok"
             self.offers[key] = outcome.result
@@ -431,10 +468,10 @@ class _Driver:
             self.offers[key] = self.given.get(key)
             counts = Counts(counts.total, counts.kept, counts.to_solve, counts.succeeded,
                             counts.failed + 1)
+        self.counts = counts
         write_summaries(self.spec, self.directory, self.rows, {self.points[key].subdir})
         if self.on_point is not None:
             self.on_point(self.points[key], outcome, counts)
-        return counts
 
 
 def run_sweep(spec: SweepSpec, directory: str | os.PathLike[str], *,
@@ -479,15 +516,16 @@ def run_sweep(spec: SweepSpec, directory: str | os.PathLike[str], *,
                                summaries=tuple(summaries), notes=tuple(scan.notes))
         driver = _Driver(spec=spec, directory=out, backend=backend,
                          fail_points=frozenset(fail_points), on_point=on_point, rows=rows,
-                         state=state)
+                         state=state, counts=counts)
         interrupted = False
         try:
-            counts = driver.run(counts)
+            driver.run()
         except KeyboardInterrupt:
             interrupted = True
         finally:
             if owned:
                 backend.close(wait=not interrupted)
-        return SweepReport(directory=out, counts=counts, wall_time_s=time.perf_counter() - start,
+        return SweepReport(directory=out, counts=driver.counts,
+                           wall_time_s=time.perf_counter() - start,
                            summaries=tuple(summaries), interrupted=interrupted,
                            notes=tuple(scan.notes), outcomes=tuple(driver.outcomes))

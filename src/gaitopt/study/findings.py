@@ -1,32 +1,37 @@
 """Whether the paper's findings (section 6) hold for a sweep, stated with numbers.
 
-Input: the rows of a sweep's ``summary.csv`` (:class:`gaitopt.analysis.summary.SummaryRow`) and,
+Input: the rows of a sweep's ``summary.csv`` (:class:`gaitopt.study.summary.SummaryRow`) and,
 for the torque findings, some of its gaits keyed by the rows' ``file``. Each finding gets a
 verdict: ``True`` (holds), ``False`` (does not hold) or ``None`` (the sweep cannot tell:
 missing variants, too few points). The thresholds are module constants, stated in the
 evidence text.
 
-Findings checked (paper sections 1, 6, 7):
+Each finding has a stable id (:data:`FINDING_IDS`, ``<subject>.<what>``): code, tests and
+links into the report use it; the claim is prose for people and may be reworded. Its numbers
+are keyed ``<quantity>.<variant>`` (e.g. ``r2.plain``). The ids are listed in
+docs/studies.md.
 
-1. ``slow_optimum``: the energy-optimal walk is much slower than the human optimum
+Findings checked, in report order (paper sections 1, 6, 7):
+
+1. ``optimum.speed``: the energy-optimal walk is much slower than the human optimum
    (80 m/min); the paper finds about 12 m/min. Holds if every variant's optimum is below
    :data:`SLOW_LIMIT_M_MIN`.
-2. ``short_steps``: its steps are shorter than human steps (0.75 m); paper: 0.1 m. Holds if
-   every optimal step length is below :data:`SHORT_STEP_LIMIT`.
-3. ``hyperbolic``: energy per metre against speed is hyperbolic like the human curve: a fit
-   E = a/v + b v + c has R^2 >= :data:`MIN_R2`, a > 0, b > 0, and the grid minimum is inside
-   the grid (decreasing, then increasing).
-4. ``linear_step_length``: the optimal step length grows roughly linearly with speed: a line
-   fit has slope > 0 and R^2 >= :data:`MIN_R2`.
-5. ``impulse_saves_energy``: the liftoff impulse lowers the energy at every speed
+2. ``optimum.step_length``: its steps are shorter than human steps (0.75 m); paper: 0.1 m.
+   Holds if every optimal step length is below :data:`SHORT_STEP_LIMIT`.
+3. ``energy.hyperbolic_fit``: energy per metre against speed is hyperbolic like the human
+   curve: a fit E = a/v + b v + c has R^2 >= :data:`MIN_R2`, a > 0, b > 0, and the grid
+   minimum is inside the grid (decreasing, then increasing).
+4. ``step_length.linear_fit``: the optimal step length grows roughly linearly with speed: a
+   line fit has slope > 0 and R^2 >= :data:`MIN_R2`.
+5. ``impulse.energy_saving``: the liftoff impulse lowers the energy at every speed
    (never worse by more than :data:`COST_TOLERANCE`, median saving >=
    :data:`MIN_IMPULSE_SAVING`).
-6. ``impulse_keeps_optimal_speed``: with no noticeable change of the optimal speed (within
+6. ``impulse.optimal_speed``: with no noticeable change of the optimal speed (within
    :data:`SAME_SPEED_TOLERANCE` relative).
-7. ``impulse_reduces_saturation``: fast walks (near 50 m/min) reach the torque bounds, and
+7. ``impulse.torque_saturation``: fast walks (near 50 m/min) reach the torque bounds, and
    the liftoff impulse reduces the fraction of knots at a bound.
-8. ``small_ankle_effect``: ankle torques change the energy little (median relative change <=
-   :data:`SMALL_ANKLE_EFFECT`).
+8. ``ankle.energy_effect``: ankle torques change the energy little (median relative change
+   <= :data:`SMALL_ANKLE_EFFECT`).
 """
 
 from __future__ import annotations
@@ -38,8 +43,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gaitopt.analysis.summary import VARIANTS, SummaryRow, rows_of
 from gaitopt.gait.gait_file import Gait
+from gaitopt.study.summary import VARIANTS, SummaryRow, rows_of
 
 PAPER_OPTIMAL_SPEED_M_MIN = 12.0
 PAPER_OPTIMAL_STEP_LENGTH = 0.1
@@ -60,6 +65,13 @@ IMPULSE_PAIRS: tuple[tuple[str, str], ...] = (("ankle+impulse", "ankle"), ("impu
 ANKLE_PAIRS: tuple[tuple[str, str], ...] = (("ankle", "plain"), ("ankle+impulse", "impulse"))
 
 
+#: The stable id of every finding, in report order (see the module docstring).
+FINDING_IDS: tuple[str, ...] = (
+    "optimum.speed", "optimum.step_length", "energy.hyperbolic_fit", "step_length.linear_fit",
+    "impulse.energy_saving", "impulse.optimal_speed", "impulse.torque_saturation",
+    "ankle.energy_effect")
+
+
 @dataclass(frozen=True)
 class Optimum:
     """The energy-optimal walk of a variant; ``source``: 'speed-free solve' or 'grid minimum'."""
@@ -74,9 +86,10 @@ class Optimum:
 
 @dataclass(frozen=True)
 class Finding:
-    """One finding of the paper: its claim, our verdict and the numbers behind it."""
+    """One finding of the paper: its stable ``id`` (one of :data:`FINDING_IDS`), its claim
+    (prose), our verdict and the numbers behind it."""
 
-    key: str
+    id: str
     claim: str
     holds: bool | None
     evidence: str
@@ -85,14 +98,18 @@ class Finding:
 
 @dataclass(frozen=True)
 class Findings:
+    """Each variant's energy-optimal walk and the findings, in the order of
+    :data:`FINDING_IDS`; ``findings["optimum.speed"]`` is a finding by its id."""
+
     optima: Mapping[str, Optimum]
     items: tuple[Finding, ...]
 
-    def __getitem__(self, key: str) -> Finding:
+    def __getitem__(self, finding_id: str) -> Finding:
         for item in self.items:
-            if item.key == key:
+            if item.id == finding_id:
                 return item
-        raise KeyError(key)
+        raise KeyError(f"no finding {finding_id!r}; the findings are "
+                       + ", ".join(item.id for item in self.items))
 
 
 # -- selection and fits ------------------------------------------------------------------------
@@ -184,11 +201,11 @@ def _slow(optima: Mapping[str, Optimum]) -> Finding:
     claim = (f"The energy-optimal walk is much slower than the human optimum "
              f"({HUMAN_OPTIMAL_SPEED_M_MIN:g} m/min): about {PAPER_OPTIMAL_SPEED_M_MIN:g} m/min.")
     if not optima:
-        return Finding("slow_optimum", claim, None, "no successful solve")
+        return Finding("optimum.speed", claim, None, "no successful solve")
     speeds = {v: o.speed_m_min for v, o in optima.items()}
     text = "; ".join(f"{v}: {s:.1f} m/min ({optima[v].source})" for v, s in speeds.items())
     holds = all(s < SLOW_LIMIT_M_MIN for s in speeds.values())
-    return Finding("slow_optimum", claim, holds,
+    return Finding("optimum.speed", claim, holds,
                    f"optimal speeds {text}; limit for 'much slower': < {SLOW_LIMIT_M_MIN:g} "
                    f"m/min", {f"speed_m_min.{v}": s for v, s in speeds.items()})
 
@@ -197,12 +214,12 @@ def _short(optima: Mapping[str, Optimum]) -> Finding:
     claim = (f"Optimal steps are shorter than human steps ({HUMAN_STEP_LENGTH:g} m): about "
              f"{PAPER_OPTIMAL_STEP_LENGTH:g} m.")
     if not optima:
-        return Finding("short_steps", claim, None, "no successful solve")
+        return Finding("optimum.step_length", claim, None, "no successful solve")
     lengths = {v: o.step_length for v, o in optima.items()}
     text = "; ".join(f"{v}: {s:.3f} m" for v, s in lengths.items())
     holds = all(s < SHORT_STEP_LIMIT for s in lengths.values())
-    return Finding("short_steps", claim, holds, f"optimal step lengths {text}; limit for "
-                   f"'shorter': < {SHORT_STEP_LIMIT:g} m",
+    return Finding("optimum.step_length", claim, holds, f"optimal step lengths {text}; limit "
+                   f"for 'shorter': < {SHORT_STEP_LIMIT:g} m",
                    {f"step_length.{v}": s for v, s in lengths.items()})
 
 
@@ -227,9 +244,9 @@ def _hyperbolic(rows: Sequence[SummaryRow]) -> Finding:
                  f"{speeds[i_min]:g} m/min")
         parts.append(f"{v}: E = {a:.4g}/v + {b:.4g} v + {c:.4g}, R² = {r2:.3f}, {where}")
     if not verdicts:
-        return Finding("hyperbolic", claim, None,
+        return Finding("energy.hyperbolic_fit", claim, None,
                        f"fewer than {MIN_FIT_POINTS} solved fixed speeds per variant")
-    return Finding("hyperbolic", claim, all(verdicts), "; ".join(parts) +
+    return Finding("energy.hyperbolic_fit", claim, all(verdicts), "; ".join(parts) +
                    f" (holds if R² ≥ {MIN_R2}, a > 0, b > 0, interior minimum)", numbers)
 
 
@@ -250,9 +267,9 @@ def _linear(rows: Sequence[SummaryRow]) -> Finding:
         parts.append(f"{v}: L = {intercept:.3g} m + {slope * 1000:.3g} mm per m/min × v, "
                      f"R² = {r2:.3f}")
     if not verdicts:
-        return Finding("linear_step_length", claim, None,
+        return Finding("step_length.linear_fit", claim, None,
                        "; ".join(parts) or f"fewer than {MIN_FIT_POINTS} solved fixed speeds")
-    return Finding("linear_step_length", claim, all(verdicts), "; ".join(parts) +
+    return Finding("step_length.linear_fit", claim, all(verdicts), "; ".join(parts) +
                    f" (holds if slope > 0 and R² ≥ {MIN_R2})", numbers)
 
 
@@ -273,9 +290,9 @@ def _impulse_energy(rows: Sequence[SummaryRow]) -> Finding:
                      f"{np.median(savings):.1%}, range {savings.min():.1%} (at "
                      f"{pairs[worst][0]:g} m/min) to {savings.max():.1%}")
     if not verdicts:
-        return Finding("impulse_saves_energy", claim, None,
+        return Finding("impulse.energy_saving", claim, None,
                        "no speed solved both with and without the impulse")
-    return Finding("impulse_saves_energy", claim, all(verdicts), "; ".join(parts) +
+    return Finding("impulse.energy_saving", claim, all(verdicts), "; ".join(parts) +
                    f" (holds if never worse by more than {COST_TOLERANCE:.1%} and median "
                    f"saving ≥ {MIN_IMPULSE_SAVING:.0%})", numbers)
 
@@ -291,9 +308,9 @@ def _impulse_speed(optima: Mapping[str, Optimum]) -> Finding:
             numbers[f"relative_change.{with_}"] = change
             parts.append(f"{with_} {a:.1f} vs {without} {b:.1f} m/min ({change:.0%})")
     if not verdicts:
-        return Finding("impulse_keeps_optimal_speed", claim, None,
+        return Finding("impulse.optimal_speed", claim, None,
                        "optima with and without the impulse are not both available")
-    return Finding("impulse_keeps_optimal_speed", claim, all(verdicts), "; ".join(parts) +
+    return Finding("impulse.optimal_speed", claim, all(verdicts), "; ".join(parts) +
                    f" (holds if within {SAME_SPEED_TOLERANCE:.0%})", numbers)
 
 
@@ -312,9 +329,9 @@ def _saturation(rows: Sequence[SummaryRow], gaits: Mapping[str, Gait]) -> Findin
         parts.append(f"knots at a bound: {with_} {sa:.1%} at {ra.speed_m_min:g} m/min vs "
                      f"{without} {sb:.1%} at {rb.speed_m_min:g} m/min")
     if not verdicts:
-        return Finding("impulse_reduces_saturation", claim, None,
+        return Finding("impulse.torque_saturation", claim, None,
                        "no gait files near the fast speed for both impulse settings")
-    return Finding("impulse_reduces_saturation", claim, all(verdicts), "; ".join(parts) +
+    return Finding("impulse.torque_saturation", claim, all(verdicts), "; ".join(parts) +
                    " (holds if the no-impulse walk saturates and the impulse walk less)",
                    numbers)
 
@@ -333,9 +350,9 @@ def _ankle(rows: Sequence[SummaryRow]) -> Finding:
         parts.append(f"{with_} vs {without} at {len(pairs)} speeds: median |change| "
                      f"{median:.1%}, saving from {change.min():.1%} to {change.max():.1%}")
     if not verdicts:
-        return Finding("small_ankle_effect", claim, None,
+        return Finding("ankle.energy_effect", claim, None,
                        "no speed solved both with and without ankle torques")
-    return Finding("small_ankle_effect", claim, all(verdicts), "; ".join(parts) +
+    return Finding("ankle.energy_effect", claim, all(verdicts), "; ".join(parts) +
                    f" (holds if the median change ≤ {SMALL_ANKLE_EFFECT:.0%})", numbers)
 
 
@@ -345,23 +362,27 @@ VERDICT_WORDS = {True: "holds", False: "does not hold", None: "cannot tell"}
 
 
 def findings_text(findings: Findings) -> str:
-    """Plain-text rendering: the optima, then one paragraph per finding."""
+    """Plain-text rendering: the optima, then one paragraph per finding (verdict, claim,
+    id; the evidence indented)."""
     lines = ["Energy-optimal walk per variant (paper: about "
              f"{PAPER_OPTIMAL_SPEED_M_MIN:g} m/min, {PAPER_OPTIMAL_STEP_LENGTH:g} m):"]
     for v, o in findings.optima.items():
         lines.append(f"  {v:14s} {o.speed_m_min:6.1f} m/min  step {o.step_length:.3f} m  "
                      f"cost {o.cost:.4g}  ({o.source})")
     for item in findings.items:
-        lines.append(f"[{VERDICT_WORDS[item.holds]}] {item.claim}\n    {item.evidence}")
+        lines.append(f"[{VERDICT_WORDS[item.holds]}] {item.claim}  ({item.id})\n"
+                     f"    {item.evidence}")
     return "\n".join(lines)
 
 
 def findings_html(findings: Findings) -> str:
-    """An HTML table (no external resources): claim, verdict, evidence."""
+    """An HTML table (no external resources): claim and id, verdict, evidence; each row's
+    HTML id is ``finding-<id>`` (a link target: ``report.html#finding-optimum.speed``)."""
     colors = {True: "#1a7f37", False: "#b3261e", None: "#6b6b6b"}
     rows = []
     for item in findings.items:
-        rows.append(f'<tr><td>{html.escape(item.claim)}</td><td style="color:'
+        rows.append(f'<tr id="finding-{html.escape(item.id)}"><td>{html.escape(item.claim)}'
+                    f'<br><code>{html.escape(item.id)}</code></td><td style="color:'
                     f'{colors[item.holds]};font-weight:bold;white-space:nowrap">'
                     f"{VERDICT_WORDS[item.holds]}</td><td>{html.escape(item.evidence)}</td></tr>")
     return ('<table class="findings"><thead><tr><th>paper finding</th><th>ours</th>'

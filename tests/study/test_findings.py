@@ -9,7 +9,9 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from gaitopt.analysis.findings import (
+from gaitopt.gait.gait_file import Gait
+from gaitopt.study.findings import (
+    FINDING_IDS,
     assess_findings,
     findings_html,
     findings_text,
@@ -19,8 +21,7 @@ from gaitopt.analysis.findings import (
     row_near_speed,
     saturation_fraction,
 )
-from gaitopt.analysis.summary import SummaryRow, failed_row, variant_name
-from gaitopt.gait.gait_file import Gait
+from gaitopt.study.summary import SummaryRow, failed_row, variant_name
 from tests.viz.synthetic import synthetic_cost, synthetic_gait, synthetic_step_length
 
 SPEEDS = tuple(float(v) for v in range(3, 61, 3))
@@ -59,16 +60,17 @@ def test_fits_recover_exact_coefficients() -> None:
 
 def test_all_findings_hold_on_a_paper_like_sweep() -> None:
     findings = assess_findings(_sweep())
-    for key in ("slow_optimum", "short_steps", "hyperbolic", "linear_step_length",
-                "impulse_saves_energy", "impulse_keeps_optimal_speed", "small_ankle_effect"):
+    for key in ("optimum.speed", "optimum.step_length", "energy.hyperbolic_fit",
+                "step_length.linear_fit", "impulse.energy_saving", "impulse.optimal_speed",
+                "ankle.energy_effect"):
         assert findings[key].holds is True, findings[key]
-    assert findings["impulse_reduces_saturation"].holds is None  # needs gait files
+    assert findings["impulse.torque_saturation"].holds is None  # needs gait files
     opt = findings.optima["plain"]
     assert opt.source == "speed-free solve" and opt.speed_m_min == pytest.approx(12.247, 1e-3)
-    assert findings["hyperbolic"].numbers["r2.plain"] == pytest.approx(1.0)
-    assert findings["impulse_saves_energy"].numbers["median_saving.impulse"] == \
+    assert findings["energy.hyperbolic_fit"].numbers["r2.plain"] == pytest.approx(1.0)
+    assert findings["impulse.energy_saving"].numbers["median_saving.impulse"] == \
         pytest.approx(0.30)
-    assert findings["small_ankle_effect"].numbers["median_change.ankle"] == pytest.approx(0.05)
+    assert findings["ankle.energy_effect"].numbers["median_change.ankle"] == pytest.approx(0.05)
 
 
 def test_optimum_falls_back_to_the_grid_minimum() -> None:
@@ -87,10 +89,10 @@ def test_fast_optimum_and_long_steps_fail_the_first_findings() -> None:
     rows = _sweep(cost=lambda v, a, i: 3000 / v + 0.01 * v, step=lambda v: 0.2 + 0.01 * v,
                   free=False)
     findings = assess_findings(rows)
-    assert findings["slow_optimum"].holds is False
-    assert findings["short_steps"].holds is False  # 0.8 m at 60 m/min
-    assert findings["hyperbolic"].holds is False
-    assert "minimum at the grid's last speed 60" in findings["hyperbolic"].evidence
+    assert findings["optimum.speed"].holds is False
+    assert findings["optimum.step_length"].holds is False  # 0.8 m at 60 m/min
+    assert findings["energy.hyperbolic_fit"].holds is False
+    assert "minimum at the grid's last speed 60" in findings["energy.hyperbolic_fit"].evidence
 
 
 def test_nonlinear_step_length_and_costly_impulse_fail() -> None:
@@ -98,23 +100,23 @@ def test_nonlinear_step_length_and_costly_impulse_fail() -> None:
                   (1.2 if i and v > 30 else (0.5 if a else 1.0)),
                   step=lambda v: 0.3 + 0.2 * math.sin(v / 4))
     findings = assess_findings(rows)
-    assert findings["linear_step_length"].holds is False
-    assert findings["impulse_saves_energy"].holds is False
-    assert findings["small_ankle_effect"].holds is False  # ankles halve the cost
+    assert findings["step_length.linear_fit"].holds is False
+    assert findings["impulse.energy_saving"].holds is False
+    assert findings["ankle.energy_effect"].holds is False  # ankles halve the cost
 
 
 def test_fixed_step_length_cannot_tell() -> None:
     findings = assess_findings(_sweep(step=lambda v: 0.1))
-    assert findings["linear_step_length"].holds is None
-    assert "fixed at 0.1 m" in findings["linear_step_length"].evidence
+    assert findings["step_length.linear_fit"].holds is None
+    assert "fixed at 0.1 m" in findings["step_length.linear_fit"].evidence
 
 
 def test_missing_variants_cannot_tell() -> None:
     rows = [r for r in _sweep() if r.variant == "plain"]
     findings = assess_findings(rows)
-    assert findings["impulse_saves_energy"].holds is None
-    assert findings["small_ankle_effect"].holds is None
-    assert findings["hyperbolic"].holds is True
+    assert findings["impulse.energy_saving"].holds is None
+    assert findings["ankle.energy_effect"].holds is None
+    assert findings["energy.hyperbolic_fit"].holds is True
     empty = assess_findings([])
     assert all(item.holds is None for item in empty.items)
 
@@ -139,10 +141,10 @@ def _gaits_for(rows: list[SummaryRow], amplitude: Callable[[bool], float]) -> di
 def test_saturation_finding_both_ways() -> None:
     rows = _sweep()
     holds = assess_findings(rows, _gaits_for(rows, lambda imp: 20.0 if imp else 80.0))
-    assert holds["impulse_reduces_saturation"].holds is True
-    assert holds["impulse_reduces_saturation"].numbers["saturation.impulse"] == 0.0
+    assert holds["impulse.torque_saturation"].holds is True
+    assert holds["impulse.torque_saturation"].numbers["saturation.impulse"] == 0.0
     fails = assess_findings(rows, _gaits_for(rows, lambda imp: 100.0 if imp else 70.0))
-    assert fails["impulse_reduces_saturation"].holds is False
+    assert fails["impulse.torque_saturation"].holds is False
 
 
 def test_renderings_state_verdicts_and_escape_html() -> None:
@@ -152,3 +154,27 @@ def test_renderings_state_verdicts_and_escape_html() -> None:
     item = dataclasses.replace(findings.items[0], evidence="a < b & c")
     html = findings_html(dataclasses.replace(findings, items=(item,)))
     assert "a &lt; b &amp; c" in html and "<table" in html
+
+
+def test_every_finding_has_its_stable_id_in_report_order() -> None:
+    # the ids are a public contract (docs/studies.md): spelled out here, not taken from the code
+    ids = ("optimum.speed", "optimum.step_length", "energy.hyperbolic_fit",
+           "step_length.linear_fit", "impulse.energy_saving", "impulse.optimal_speed",
+           "impulse.torque_saturation", "ankle.energy_effect")
+    assert ids == FINDING_IDS
+    for rows in (_sweep(), [], [r for r in _sweep() if r.variant == "plain"]):
+        findings = assess_findings(rows)  # every finding, whatever its verdict
+        assert tuple(item.id for item in findings.items) == ids
+    with pytest.raises(KeyError, match=r"no finding 'slow_optimum'; the findings are "
+                                       r"optimum\.speed, optimum\.step_length"):
+        assess_findings(_sweep())["slow_optimum"]
+
+
+def test_renderings_name_each_finding_by_its_id() -> None:
+    findings = assess_findings(_sweep())
+    text = findings_text(findings)
+    page = findings_html(findings)
+    for item in findings.items:
+        assert f"{item.claim}  ({item.id})" in text
+        assert f'<tr id="finding-{item.id}"><td>{item.claim}' in page
+        assert f"<code>{item.id}</code>" in page

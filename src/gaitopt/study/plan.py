@@ -14,7 +14,7 @@ other point is warm-started from its finished neighbour toward that start (its *
 
 Directory layout: with one combination of step length and single-support fraction the sweep
 directory is a plain sweep (``summary.csv``, ``gaits/<variant>/...``, see
-:mod:`gaitopt.analysis.summary`); with several, each combination is such a sub-sweep in a folder
+:mod:`gaitopt.study.summary`); with several, each combination is such a sub-sweep in a folder
 named by :func:`axis_tag` (``single-support-0.85_step-free``). ``sweep.json`` at the top holds
 the settings (:func:`sweep_settings`); a sweep refuses to resume into a directory made with
 other settings.
@@ -29,9 +29,9 @@ from functools import cached_property
 from typing import Any
 
 from gaitopt import __version__
-from gaitopt.analysis.summary import VARIANTS, SpeedMode, gait_relpath, variant_flags
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot.model import RobotModel
+from gaitopt.study.summary import VARIANTS, SpeedMode, gait_relpath, variant_flags
 
 #: Speed (m/s) of the cold start of each chain: the paper's optimal 12 m/min.
 START_SPEED = 0.2
@@ -54,7 +54,7 @@ class SweepSpec:
     Attributes:
         model: the robot model.
         speeds: fixed speeds (m/s), ascending, no two with the same 0.01 m/min label.
-        variants: subset of :data:`gaitopt.analysis.summary.VARIANTS`, in that order.
+        variants: subset of :data:`gaitopt.study.summary.VARIANTS`, in that order.
         free_speed: also solve the speed-free optimal walk of every group.
         step_lengths: step lengths (m), ``None`` meaning free (optimized).
         step_times: step times (s), ``None`` meaning free; with a fixed speed a step time

@@ -11,8 +11,8 @@ itself: that is the executor's (or the Dask scheduler's) work.
   general, and a forkserver starts a worker about as fast (0.4 s against 0.7 s for spawn on
   the reference machine, see docs/studies.md).
 * :func:`dask_backend`: a ``distributed.Client`` connected to a scheduler address
-  (``tcp://host:8786``); the workers need gaitopt installed and the sweep directory on a
-  shared filesystem at the same path (they write the gait files).
+  (``tcp://host:8786``); the workers need gaitopt installed, nothing else: they return each
+  solved gait to the driver, which writes the sweep directory (no shared filesystem).
 * :func:`inline_backend`: runs each point at once in this process (``--workers 0``; handy for
   debugging and tests: the process's transcription cache is reused across sweeps).
 """
@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 #: Modules the forkserver imports once, so that each worker starts with them loaded.
-PRELOAD = ("gaitopt.analysis.sweep_worker",)
+PRELOAD = ("gaitopt.study.worker",)
 
 
 class BackendError(RuntimeError):

@@ -12,17 +12,17 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.analysis.summary import SUMMARY_FILE, read_summary
-from gaitopt.analysis.sweep import (
+from gaitopt.gait.gait_file import Gait
+from gaitopt.robot import load_model
+from gaitopt.study.driver import (
     SweepReport,
     SweepSettingsError,
     directory_lock,
     run_sweep,
     scan_directory,
 )
-from gaitopt.analysis.sweep_plan import SETTINGS_FILE, SweepSpec
-from gaitopt.gait.gait_file import Gait
-from gaitopt.robot import load_model
+from gaitopt.study.plan import SETTINGS_FILE, SweepSpec
+from gaitopt.study.summary import SUMMARY_FILE, read_summary
 
 MODEL = load_model("five-link")
 K9, K12, K15 = (f"gaits/plain/speed-{v:06.2f}m_min.gait.json" for v in (9, 12, 15))
@@ -168,12 +168,12 @@ def test_files_and_settings_written_before_an_option_existed_are_kept(
     multistart) lacks it; it was solved with the option's default, so a resume keeps it."""
     import dataclasses
 
-    from gaitopt.analysis.sweep_plan import (
+    from gaitopt.study.plan import (
         settings_differences,
         sweep_settings,
         with_option_defaults,
     )
-    from gaitopt.analysis.sweep_worker import gait_file_matches
+    from gaitopt.study.worker import gait_file_matches
 
     folder, _ = swept
     spec = plain_spec(9, 12, 15)

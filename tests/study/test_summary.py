@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.analysis.summary import (
+from gaitopt.study.summary import (
     SUMMARY_COLUMNS,
     VARIANTS,
     SummaryError,

@@ -4,17 +4,17 @@ from __future__ import annotations
 
 import pytest
 
-from gaitopt.analysis.summary import VARIANTS
-from gaitopt.analysis.sweep import check_points
-from gaitopt.analysis.sweep_plan import (
+from gaitopt.gait.options import GaitOptions
+from gaitopt.robot import load_model
+from gaitopt.study.driver import check_points
+from gaitopt.study.plan import (
     SweepSpec,
     SweepSpecError,
     settings_differences,
     start_index,
     sweep_settings,
 )
-from gaitopt.gait.options import GaitOptions
-from gaitopt.robot import load_model
+from gaitopt.study.summary import VARIANTS
 
 MODEL = load_model("five-link")
 
