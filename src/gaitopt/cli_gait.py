@@ -147,8 +147,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
-    from gaitopt.gait.api import as_model, solve_gait, warm_start_usable
-    from gaitopt.gait.record import MotionOutOfReachError
+    from gaitopt.gait.api import as_model, solve_gait_solution, warm_start_usable
+    from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 
     console = make_console()
     model = as_model(model_name)
@@ -198,19 +198,22 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         console.print("  stage " + stage.line())
 
     try:
-        gait = solve_gait(model, options, progress=progress, warm_start=start,
-                          compiled="codegen" if compiled else None)
+        solution = solve_gait_solution(model, options, progress=progress, warm_start=start,
+                                       compiled="codegen" if compiled else None)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
-    except MotionOutOfReachError as exc:
-        console.print(f"FAILED after the last stage: {exc}. No gait file written.")
+    if not solution.success:
+        from gaitopt.gait.diagnose import diagnose
+
+        console.print("FAILED: " + diagnose(solution).text())
+        console.print(f"Largest constraint violation {solution.result.constraint_violation:.3g}."
+                      " No gait file written.")
         sys.exit(1)
-    if not gait.success:
-        stages = gait.solver.get("stages", [])
-        failed = [s for s in stages if not s["success"]]
-        where = failed[-1]["name"] if failed else "solve"
-        console.print(f"FAILED at stage '{where}': {gait.status}; largest constraint "
-                      f"violation {gait.solver['max_violation']:.3g}. No gait file written.")
+    try:
+        gait = gait_from_solution(solution)
+    except MotionOutOfReachError as exc:
+        console.print(f"FAILED after the last stage, which converged: {exc}. No gait file "
+                      "written.")
         sys.exit(1)
     metrics = gait_metrics(gait)
     p = gait.parameters

@@ -121,25 +121,34 @@ def test_failed_solve_exits_1_names_the_stage_and_writes_nothing(
     result = solve("-o", str(out))
     assert result.exit_code == 1, result.output
     text = " ".join(result.output.split())
-    assert "FAILED at stage 'relaxed contact': Maximum_Iterations_Exceeded" in text
-    assert "No gait file written" in text
+    assert "failed at stage 'relaxed contact' (Maximum_Iterations_Exceeded)" in text
+    assert "What you can change" in text and "No gait file written" in text
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
 def test_motion_out_of_reach_exits_1_with_the_reason_and_writes_nothing(
         no_solve: None, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    """A solution that cannot be recorded (its motion leaves a leg's reach between knots,
-    see tests/gait/test_walking_errors.py) is a failed solve: a message, exit 1, no file."""
+    """A converged solution that cannot be recorded (its motion leaves a leg's reach between
+    knots, see tests/gait/test_walking_errors.py) is a failed solve: the message says that it
+    converged and why it is rejected, exit 1, no file."""
+    class Converged:
+        success = True
+
+    def converged(*args: object, **kwargs: object) -> object:
+        return Converged()
+
     def unrecordable(*args: object, **kwargs: object) -> Gait:
         raise MotionOutOfReachError("the solution's motion between knots leaves a leg's reach "
-                                    "in phase double_support")
+                                    "in phase double_support; solve on a finer grid")
 
-    monkeypatch.setattr("gaitopt.gait.api.solve_gait", unrecordable)
+    monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", converged)
+    monkeypatch.setattr("gaitopt.gait.record.gait_from_solution", unrecordable)
     out = tmp_path / "g.gait.json"
     result = solve("-o", str(out))
     assert result.exit_code == 1, result.output
     text = " ".join(result.output.split())
-    assert "FAILED after the last stage" in text and "leaves a leg's reach" in text
+    assert "FAILED after the last stage, which converged" in text
+    assert "leaves a leg's reach" in text and "finer grid" in text
     assert "No gait file written" in text and "Traceback" not in text
     assert not out.exists() and list(tmp_path.iterdir()) == []
 

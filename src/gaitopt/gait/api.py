@@ -26,7 +26,7 @@ import numpy as np
 
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, PhaseGuess
 from gaitopt.robot import RobotModel, load_model
@@ -92,9 +92,18 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
 
     Raises:
-        MotionOutOfReachError: the solution's motion between knots leaves a leg's reach (it
-            cannot be recorded as a gait; solve on a finer grid).
+        MotionOutOfReachError: the converged solution's motion between knots leaves a leg's
+            reach (it cannot be recorded as a gait; solve on a finer grid).
+        SolveFailedError: the solve failed and its last values cannot even be recorded; the
+            message is the diagnosis (:func:`gaitopt.gait.diagnose.diagnose`).
     """
     solution = solve_gait_solution(model, options, warm_start=warm_start, progress=progress,
                                    compiled=compiled)
-    return gait_from_solution(solution)
+    try:
+        return gait_from_solution(solution)
+    except MotionOutOfReachError:
+        if solution.success:
+            raise
+        from gaitopt.gait.diagnose import SolveFailedError, diagnose
+
+        raise SolveFailedError(diagnose(solution).text()) from None

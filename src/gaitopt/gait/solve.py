@@ -74,6 +74,10 @@ REFERENCE_SPEED = 0.2
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
+#: Largest constraint violation (in the constraints' own units) of a solution that IPOPT
+#: accepted at its "acceptable" level for it to count as converged: the tolerance to which
+#: verify checks what the transcription imposes exactly.
+ACCEPTABLE_VIOLATION = 1e-6
 #: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
 #: cost's optimum, when the requested one is finer.
 COST_SMOOTHING_START = 1.0
@@ -156,6 +160,8 @@ class WalkingSolution:
     result: Result
     stages: tuple[StageReport, ...]
     wall_time_s: float
+    stage_results: tuple[tuple[str, Result], ...] = ()
+    """Every stage's name and result, in order (for diagnosing a failure)."""
     #: The full-problem stages that converged, (knots per phase, cost), in order: the grids
     #: the cost was computed on (the cost error estimate compares the last two).
     grid_costs: tuple[tuple[tuple[int, ...], float], ...] = ()
@@ -266,6 +272,7 @@ class _Run:
             compiled
         self.stages: list[StageReport] = []
         self.results: list[Result] = []
+        self.named_results: list[tuple[str, Result]] = []
         self.grid_costs: list[tuple[tuple[int, ...], float]] = []
 
     def stage(self, name: str, knots: Grid, relax: Relaxation,
@@ -284,6 +291,7 @@ class _Run:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
                           warm_start_multipliers=isinstance(guess, Result))
+        result = converged_or_failed(result)
         full = (relax == Relaxation() and not hold_ankles
                 and dict(bounds) == dict(parameter_bounds(self.options)))
         report = StageReport(
@@ -293,6 +301,7 @@ class _Run:
             parameters=dict(result.parameters), full_problem=full)
         self.stages.append(report)
         self.results.append(result)
+        self.named_results.append((name, result))
         if full and result.success:
             self.grid_costs.append((tuple(m.size for m in result.mesh), result.objective))
         if self.progress is not None:
@@ -473,6 +482,20 @@ class _Run:
         return self.results[-1]
 
 
+def converged_or_failed(result: Result) -> Result:
+    """``result``, marked failed if IPOPT stopped at its acceptable level (which CasADi reports
+    as success) with a constraint violation above :data:`ACCEPTABLE_VIOLATION`: such a point
+    does not meet the requested tolerances. A feasible acceptable-level point stays a success
+    and keeps its status ``Solved_To_Acceptable_Level``, which the gait file records."""
+    if (result.success and result.status == "Solved_To_Acceptable_Level"
+            and result.constraint_violation > ACCEPTABLE_VIOLATION):
+        return dataclasses.replace(
+            result, success=False,
+            message=f"IPOPT stopped at its acceptable level with a constraint violation of "
+                    f"{result.constraint_violation:.2g} (more than {ACCEPTABLE_VIOLATION:g})")
+    return result
+
+
 def result_guess(result: Result) -> Guess:
     """A result's knot values and parameters as a guess (values only, no multipliers)."""
     phases = {ph.name: PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0]))
@@ -527,7 +550,8 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     final = outcome if outcome is not None and outcome.success else run.final()
     return WalkingSolution(model=model, options=options, result=final,
                            stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
-                           grid_costs=tuple(run.grid_costs))
+                           grid_costs=tuple(run.grid_costs),
+                           stage_results=tuple(run.named_results))
 
 
 def warm_start_grid(options: GaitOptions, warm_start: Guess | Result) -> Grid:
