@@ -51,6 +51,17 @@ def _step_time(text: str) -> float | None:
     return _free_or_value(text, "--step-time", "s", "time")
 
 
+def _pair(text: str, option: str) -> tuple[float, float]:
+    """Two numbers ``LO,HI`` (a usage error otherwise)."""
+    parts = text.split(",")
+    try:
+        lo, hi = (float(v) for v in parts)
+    except ValueError:
+        raise click.BadParameter(f"expected two numbers LO,HI, got {text!r}",
+                                 param_hint=option) from None
+    return lo, hi
+
+
 def _knots(text: str) -> tuple[int, int]:
     parts = text.split(",")
     try:
@@ -77,6 +88,9 @@ def _knots(text: str) -> tuple[int, int]:
               help="Liftoff impulse along the lifting leg.")
 @click.option("--single-support", type=float, default=0.85, show_default=True,
               help="Single-support fraction of the step time; 1 = no double support.")
+@click.option("--single-support-bounds", default=None,
+              help="LO,HI: the single-support fraction free within these bounds, starting "
+                   "from --single-support (needs --formulation full).")
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
@@ -139,7 +153,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str,
-                  min_knee_flexion: float | None, gait_kind: str, cost: str,
+                  min_knee_flexion: float | None, single_support_bounds: str | None,
+                  gait_kind: str, cost: str,
                   resting_power: float | None, regularization: float,
                   control_model: str, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
@@ -173,6 +188,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         clearance_profile=clearance_profile)  # type: ignore[arg-type]
     if resting_power is not None:
         options = options.replace(resting_power=resting_power)
+    if single_support_bounds is not None:
+        options = options.replace(
+            single_support_fraction_bounds=_pair(single_support_bounds,
+                                                 "--single-support-bounds"))
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     try:

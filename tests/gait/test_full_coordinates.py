@@ -220,3 +220,31 @@ def test_a_run_converges_and_is_physical(reference: RefFn, tmp_path) -> None:  #
     np.testing.assert_allclose(landing, [gait.step_length, 0.0], atol=1e-6)
     report = verify_gait(gait)
     assert report.passed, report.failed_ids
+
+
+def test_a_free_single_support_fraction(solved: SolveFn) -> None:
+    """The fraction as a decision parameter within bounds: it converges, the gait file holds
+    the solved fraction (phases, parameters and contact sequence agree), verify passes, and
+    the cost is not above the fixed fraction's (which the free problem contains)."""
+    fixed = solved(FULL).gait
+    gait = solved(FULL.replace(single_support_fraction_bounds=(0.6, 0.95))).gait
+    assert gait.success
+    f = gait.parameters["single_support_time"] / gait.parameters["step_time"]
+    assert 0.6 - 1e-6 <= f <= 0.95 + 1e-6
+    assert gait.contact_sequence is not None
+    assert gait.contact_sequence["phases"][0]["fraction"] == pytest.approx(f)
+    assert gait.phases[0].duration / gait.step_time == pytest.approx(f)
+    assert gait.cost_value <= fixed.cost_value * (1 + 1e-6)
+    assert verify_gait(gait).passed
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"single_support_fraction_bounds": (0.6, 0.95)}, "needs formulation 'full'"),
+    ({"formulation": "full", "single_support_fraction_bounds": (0.6, 1.0)}, r"\[0.05, 1\)"),
+    ({"formulation": "full", "single_support_fraction_bounds": (0.9, 0.95)},
+     "single_support_fraction = 0.85: must lie in single_support_fraction_bounds"),
+])
+def test_free_fraction_errors(changes: dict[str, object], message: str) -> None:
+    legs = biped_structure(load_model("five-link"))
+    with pytest.raises(GaitOptionsError, match=message):
+        validate_options(GaitOptions().replace(**changes), legs)

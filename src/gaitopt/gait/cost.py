@@ -89,7 +89,8 @@ def weight(model: RobotModel) -> float:
 
 def running_cost(model: RobotModel, options: GaitOptions, qd: Any, u_full: Sequence[Scalar],
                  p: Any) -> Scalar:
-    """The integrand of the cost's numerator (before division by the denominator)."""
+    """The integrand of the cost's numerator (before division by the denominator); ``p``
+    starts with ``[L, v]`` (numbers or symbols)."""
     us = list(u_full)
     total: Scalar = 0.0
     if options.cost == "paper":
@@ -104,8 +105,7 @@ def running_cost(model: RobotModel, options: GaitOptions, qd: Any, u_full: Seque
             if options.cost == "metabolic":
                 total = total + smooth_positive(-power, eps) / options.efficiency_negative
     if options.cost_regularization > 0.0:
-        ps = as_scalars(p, 3, "p")
-        step_time = ps[0] / ps[1]
+        step_time = p[0] / p[1]
         norm: Scalar = 0.0
         for u, a in zip(us, model.actuators, strict=True):
             u_max = max(abs(a.limits[0]), abs(a.limits[1])) or 1.0
@@ -134,13 +134,12 @@ def parameter_cost(model: RobotModel, options: GaitOptions, p: Any) -> Scalar:
     metabolic cost, else 0."""
     if options.cost != "metabolic":
         return 0.0
-    ps = as_scalars(p, 3, "p")
-    return options.resting_power * model.total_mass * ps[0] / ps[1]
+    return options.resting_power * model.total_mass * p[0] / p[1]
 
 
 def denominator(model: RobotModel, options: GaitOptions, p: Any) -> Scalar:
     """``L`` (paper) or ``W L`` (the costs of transport)."""
-    step = as_scalars(p, 3, "p")[0]
+    step = p[0]
     return step if options.cost == "paper" else weight(model) * step
 
 

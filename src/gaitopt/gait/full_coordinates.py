@@ -75,7 +75,7 @@ from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
-_L, _V, _P = range(3)
+_L, _V, _P, _F = range(4)
 
 #: Path constraint of the held points' positions and velocities (knots only).
 HELD = "held points: position and velocity"
@@ -132,6 +132,10 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
     names = state_names(model)
     weight = model.total_mass * 9.81
     rate = options.rate_bound
+    free_fraction = options.single_support_fraction_bounds is not None
+    if free_fraction and len(seq.phases) != 2:
+        raise ValueError(f"a free single-support fraction needs a sequence of two phases; "
+                         f"{seq.name!r} has {len(seq.phases)}")
 
     def state_bounds(held: Sequence[str]) -> dict[str, tuple[float, float]]:
         b: dict[str, tuple[float, float]] = {
@@ -206,7 +210,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
 
             path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf, scale=0.1))
         if options.swing_clearance is not None and not phases and landing:
-            path.append(_clearance_profile(model, options, landing, ph.fraction))
+            path.append(_clearance_profile(model, options, landing,
+                                           _share(0, ph.fraction, free_fraction)))
 
         def dynamics(x: Any, u: Any, p: Any, t: Any, point: Any = point) -> Any:
             return point(x, u).xdot
@@ -226,7 +231,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
                                             for n in model.coordinate_names}
         phases.append(Phase(
             name=ph.name, states=names, controls=controls, dynamics=dynamics,
-            duration=Duration.of_parameters(_step_share(ph.fraction)),
+            duration=Duration.of_parameters(
+                _step_share(_share(len(phases), ph.fraction, free_fraction))),
             state_bounds=state_bounds(held), control_bounds=control_bounds,
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
@@ -309,7 +315,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
                                          lower=-ca.inf, upper=ca.inf, scale=1.0))
 
-    from gaitopt.gait.problem import parameter_bounds
+    from gaitopt.gait.problem import FRACTION, parameter_bounds
 
     bounds = parameter_bounds(options)
     if not any(ev.impulse for ev in seq.events):
@@ -317,6 +323,9 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
     parameters = [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH], scale=0.5),
                   Parameter(SPEED, *bounds[SPEED], scale=1.0),
                   Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
+    if FRACTION in bounds:
+        parameters.append(Parameter(FRACTION, *bounds[FRACTION], scale=1.0,
+                                    guess=options.single_support_fraction))
     return Problem(
         phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
         parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
@@ -347,8 +356,16 @@ def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
     return mayer
 
 
+def _share(i: int, fraction: float, free: bool) -> Callable[[Any], Any]:
+    """``p -> `` phase ``i``'s share of the step time: its sequence fraction, or with a free
+    fraction ``f = p[3]`` for phase 0 and ``1 - f`` for phase 1."""
+    if not free:
+        return lambda p: fraction
+    return (lambda p: p[_F]) if i == 0 else (lambda p: 1.0 - p[_F])
+
+
 def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence[str],
-                       fraction: float) -> PathConstraint:
+                       share: Callable[[Any], Any]) -> PathConstraint:
     """The swing clearance of the first phase (:func:`gaitopt.gait.problem.clearance_profile`):
     each point landing at its end stays above ``profile(s)``, ``s = t v / (f L)``."""
     from gaitopt.gait.problem import clearance_profile
@@ -359,7 +376,7 @@ def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence
 
     def fn(x: Any, u: Any, p: Any, t: Any) -> Any:
         q = vector(as_scalars(x, 2 * nq, "x")[:nq])
-        s = t * p[_V] / (fraction * p[_L])
+        s = t * p[_V] / (share(p) * p[_L])
         low = clearance_profile(height, s, options.clearance_profile)
         return vector([as_scalars(contact_position(model, q, c), 2, "p")[1] - low
                        for c in points])
@@ -367,9 +384,9 @@ def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence
     return PathConstraint(CLEARANCE_PROFILE, fn, lower=0.0, upper=ca.inf, scale=0.1)
 
 
-def _step_share(fraction: float) -> Callable[[Any], Any]:
-    """``p -> fraction * L / v``: a phase's duration."""
-    return lambda p: fraction * p[_L] / p[_V]
+def _step_share(share: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    """``p -> share(p) L / v``: a phase's duration."""
+    return lambda p: share(p) * p[_L] / p[_V]
 
 
 def _periodic_controls(model: RobotModel, symmetry: Symmetry, seq: ContactSequence,

@@ -76,6 +76,10 @@ class GaitOptions:
             kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
             with the held contact points as constraints: any model with two legs; a knee may
             straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md.
+        single_support_fraction_bounds: ``None`` (the fraction is ``single_support_fraction``)
+            or ``(lower, upper)``: the fraction is free within them, a decision parameter
+            (``single_support_fraction`` is its first guess); full formulation, with double
+            support (a walk) or a flight (a run).
         gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no
@@ -129,6 +133,7 @@ class GaitOptions:
     multistart: bool = False
     formulation: Formulation = "reduced"
     gait: GaitKind = "walk"
+    single_support_fraction_bounds: tuple[float, float] | None = None
     cost: CostName = "paper"
     efficiency_positive: float = 0.25
     efficiency_negative: float = 1.2
@@ -219,6 +224,18 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         v = _finite(name, value)
         if v < lo or (strict and v == lo):
             raise GaitOptionsError(f"{name} = {v:g}: must be {'>' if strict else '>='} {lo:g}")
+    if o.single_support_fraction_bounds is not None:
+        f_lo, f_hi = _bounds("single_support_fraction_bounds", o.single_support_fraction_bounds)
+        if o.formulation != "full":
+            raise GaitOptionsError("single_support_fraction_bounds: a free single-support "
+                                   "fraction needs formulation 'full'")
+        if f_lo < 0.05 or f_hi >= 1.0:
+            raise GaitOptionsError(f"single_support_fraction_bounds = ({f_lo:g}, {f_hi:g}): "
+                                   "must lie in [0.05, 1) (1 is the single-support walk)")
+        if not f_lo <= o.single_support_fraction <= f_hi:
+            raise GaitOptionsError(f"single_support_fraction = {o.single_support_fraction:g}: "
+                                   f"must lie in single_support_fraction_bounds "
+                                   f"[{f_lo:g}, {f_hi:g}] (it is the first guess)")
     if o.gait not in ("walk", "run"):
         raise GaitOptionsError(f"gait = {o.gait!r}: must be 'walk' or 'run'")
     if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0

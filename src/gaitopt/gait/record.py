@@ -153,7 +153,19 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
         cost={"value": float(res.objective), "name": options.cost,
               "formula": cost.formula(options)},
         solver=solver, phases=phases, events=events, samples=samples,
-        contact_sequence=contact_sequence(model, options).to_dict())
+        contact_sequence=_solved_sequence(solution))
+
+
+def _solved_sequence(solution: WalkingSolution) -> dict[str, Any]:
+    """The contact sequence of the solution, with the phase fractions it solved (they are
+    decision parameters when the single-support fraction is free)."""
+    data = contact_sequence(solution.model, solution.options).to_dict()
+    durations = [ph.duration for ph in solution.result.phases]
+    total = sum(durations)
+    phases: list[dict[str, Any]] = list(data["phases"])  # type: ignore[call-overload]
+    for phase, duration in zip(phases, durations, strict=True):
+        phase["fraction"] = float(duration / total)
+    return data
 
 
 def _vec(value: Any, n: int) -> Array:

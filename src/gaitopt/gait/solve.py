@@ -55,7 +55,7 @@ from gaitopt.gait.guess import (
     naive_running_guess,
 )
 from gaitopt.gait.options import GaitOptions, validate_options
-from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
+from gaitopt.gait.problem import FRACTION, Relaxation, parameter_bounds, with_step_time
 from gaitopt.ocp import (
     Bounds,
     Guess,
@@ -315,7 +315,7 @@ class _Run:
         o, coarse = self.options, coarse_knots(self.options)
         legs = biped_of(self.model, o).legs
         r_max = min(leg.reach(-o.min_stance_knee_flexion) for leg in legs)
-        bounds = dict(parameter_bounds(o))
+        bounds = held_fraction(dict(parameter_bounds(o)), o)
         bounds["speed"] = (speed, speed)
         bounds["impulse"] = (0.0, 0.0)
         if o.step_length is not None:
@@ -337,7 +337,11 @@ class _Run:
                                     single_support_fraction=o.single_support_fraction,
                                     knots=coarse, ankle=o.ankle, r_max=r_max,
                                     ankle_torques=False, full=o.formulation == "full")
-            relaxed = self.stage("relaxed contact", coarse, RELAXED, ocp_guess(guess), bounds,
+            start = ocp_guess(guess)
+            if FRACTION in bounds:  # a free fraction starts at its guess
+                start = Guess(phases=start.phases, parameters={
+                    **start.parameters, FRACTION: o.single_support_fraction})
+            relaxed = self.stage("relaxed contact", coarse, RELAXED, start, bounds,
                                  hold_ankles=o.ankle, solver_options=COLD_START_OPTIONS)
             if not relaxed.success:
                 continue
@@ -352,7 +356,7 @@ class _Run:
     def release(self, result: Result) -> Result:
         """Free what the cold stages held fixed: the ankle torques, the impulse, the speed."""
         o, coarse = self.options, coarse_knots(self.options)
-        bounds = dict(parameter_bounds(o))
+        bounds = held_fraction(dict(parameter_bounds(o)), o, result)
         speed = result.parameters["speed"]
         if o.ankle:
             b = dict(bounds)
@@ -367,8 +371,15 @@ class _Run:
             result = self.stage("liftoff impulse free", coarse, Relaxation(), result, b)
             if not result.success:
                 return result
+        if FRACTION in bounds:
+            b = dict(parameter_bounds(o))
+            b["speed"] = (speed, speed)
+            result = self.stage("single-support fraction free", coarse, Relaxation(), result,
+                                b)
+            if not result.success:
+                return result
         if o.speed is None:
-            result = self.stage("speed free", coarse, Relaxation(), result, bounds)
+            result = self.stage("speed free", coarse, Relaxation(), result, parameter_bounds(o))
         return result
 
     def refine(self, result: Result) -> Result:
@@ -430,7 +441,7 @@ class _Run:
             return None
         speeds = np.linspace(REFERENCE_SPEED, target,
                              int(np.ceil(abs(target - REFERENCE_SPEED) / SPEED_STEP)) + 1)[1:]
-        bounds = dict(parameter_bounds(o))
+        bounds = held_fraction(dict(parameter_bounds(o)), o)
         bounds["impulse"] = (0.0, 0.0)
         for v in speeds:
             b = dict(bounds)
@@ -480,6 +491,17 @@ class _Run:
                     return _as_failed(result, self.results[-1])
                 return result
         return self.results[-1]
+
+
+def held_fraction(bounds: dict[str, Any], options: GaitOptions,
+                  result: Result | None = None) -> dict[str, Any]:
+    """``bounds`` with a free single-support fraction held (at ``result``'s value, or at its
+    first guess ``options.single_support_fraction``); unchanged if it is not free."""
+    if FRACTION in bounds:
+        value = (result.parameters[FRACTION] if result is not None
+                 else options.single_support_fraction)
+        bounds[FRACTION] = (value, value)
+    return bounds
 
 
 def converged_or_failed(result: Result) -> Result:
