@@ -11,6 +11,7 @@ from PIL import Image
 
 from gaitopt.cli import UserError, cli
 from gaitopt.cli_study import parse_speeds, parse_variants, sweep_dirs
+from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.driver import prepare_directory
 from gaitopt.study.plan import SweepSpec
@@ -179,3 +180,23 @@ def test_study_writes_the_report_and_an_animation(runner: CliRunner, tmp_path: P
     rows = read_summary(folder / SUMMARY_FILE)
     assert len(rows) == 16 and all(r.success for r in rows)
     assert f"Open {folder / 'report' / 'report.html'}" in result.output
+
+
+def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,
+                                                         tmp_path: Path) -> None:
+    """--formulation, --cost, --resting-power and --control-model reach every gait."""
+    for name, args, expected in (
+            ("full", ["--formulation", "full", "--control-model", "jumps"],
+             {"formulation": "full", "control_model": "jumps", "cost": "paper"}),
+            ("metabolic", ["--cost", "metabolic", "--resting-power", "2.0"],
+             {"formulation": "reduced", "cost": "metabolic", "resting_power": 2.0})):
+        folder = tmp_path / name
+        result = runner.invoke(cli, ["sweep", "-o", str(folder), "--speeds", "12,15",
+                                     "--variants", "ankle", "--no-free", "--workers", "0",
+                                     *args])
+        assert result.exit_code == 0, result.output
+        gaits = sorted(folder.rglob("*.gait.json"))
+        assert len(gaits) == 2
+        for path in gaits:
+            options = Gait.load(path).options
+            assert {k: options[k] for k in expected} == expected

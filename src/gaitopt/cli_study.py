@@ -135,7 +135,10 @@ def parse_fractions(text: str) -> tuple[float, ...]:
 
 
 def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
-              single_support: str, knots: str, step_time: str = "free") -> SweepSpec:
+              single_support: str, knots: str, step_time: str = "free",
+              problem: dict[str, Any] | None = None) -> SweepSpec:
+    """The sweep of the CLI's options; ``problem`` holds further :class:`GaitOptions` fields
+    shared by every point (formulation, cost, control model, ...)."""
     from gaitopt.gait.api import as_model
 
     model = as_model(model_name)
@@ -146,7 +149,7 @@ def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_l
                          step_times=parse_step_lengths(step_time, option="--step-time",
                                                        unit="s", quantity="time"),
                          single_support=parse_fractions(single_support),
-                         base=GaitOptions(knots=_knots(knots)))
+                         base=GaitOptions(knots=_knots(knots), **(problem or {})))
     except SweepSpecError as exc:
         raise UserError(str(exc)) from None
 
@@ -256,10 +259,20 @@ def _workers_option(f: Any) -> Any:
               help="Single-support fractions of the step time (comma list).")
 @click.option("--knots", default="8,5", show_default=True,
               help="Grid points per phase: single support, double support.")
+@click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
+              show_default=True, help="The coordinates of every point (docs/formulations.md).")
+@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
+              show_default=True, help="The cost of every point (docs/costs.md).")
+@click.option("--resting-power", type=float, default=None,
+              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
+@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
+              show_default=True, help="Controls continuous and periodic (paper) or free to "
+                                      "jump at the events.")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str,
-                  workers: int | None, scheduler: str | None) -> None:
+                  formulation: str, cost: str, resting_power: float | None,
+                  control_model: str, workers: int | None, scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -267,9 +280,13 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     failed.
     """
     console = make_console()
+    problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
+                               "control_model": control_model}
+    if resting_power is not None:
+        problem["resting_power"] = resting_power
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
                      step_length=step_length, single_support=single_support, knots=knots,
-                     step_time=step_time)
+                     step_time=step_time, problem=problem)
     report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
     if report.counts.failed:
         sys.exit(1)
