@@ -28,7 +28,7 @@ from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
-from gaitopt.ocp import Guess, PhaseGuess
+from gaitopt.ocp import Guess, PhaseGuess, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
 
@@ -72,10 +72,32 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`."""
     robot = as_model(model)
     opts = options or GaitOptions()
-    guess = None
+    guess: Guess | WarmStart | None = None
     if warm_start is not None and warm_start_usable(warm_start, opts):
-        guess = guess_from_gait(warm_start)
+        guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
     return solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+
+
+def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
+                  compiled: str | None = None) -> WarmStart | None:
+    """The NLP point and multipliers a gait file keeps (``solver.warm_start``), if they fit
+    the transcription ``options`` solve on (same layout, method and constraints; a fixed
+    grid): IPOPT then restarts from them as from a result in the same process. None
+    otherwise (older files keep none; the trajectories are the fallback guess)."""
+    data = gait.solver.get("warm_start")
+    if not isinstance(data, dict) or options.mesh_tol is not None:
+        return None
+    from gaitopt.gait.solve import transcription_for
+
+    try:
+        point = WarmStart(w=np.asarray(data["w"], dtype=float),
+                          lam_x=np.asarray(data["lam_x"], dtype=float),
+                          lam_g=np.asarray(data["lam_g"], dtype=float),
+                          layout=str(data["layout"]), method=str(data["method"]))
+    except (KeyError, TypeError, ValueError):
+        return None
+    tr = transcription_for(model, options, options.knots, compiled=compiled)
+    return point if point.fits(tr.layout, tr.method, tr.nlp.lbg.size) else None
 
 
 def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions | None = None,

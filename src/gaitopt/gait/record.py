@@ -26,6 +26,7 @@ from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.ocp import Result, warm_start_of
 from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
 
@@ -140,6 +141,7 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
         "evaluations": {k: int(v) for k, v in res.evaluations.items()},
         "max_violation": float(res.constraint_violation),
         "time_in_evaluations_s": float(res.times.get("evaluations", 0.0)),
+        **({"warm_start": _warm_start_data(res)} if res.success else {}),
         "stages": [{"name": s.name, "knots": list(s.knots), "status": s.status,
                     "success": s.success, "iterations": s.iterations,
                     "objective": s.objective, "wall_time_s": s.wall_time_s}
@@ -154,6 +156,14 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
               "formula": cost.formula(options)},
         solver=solver, phases=phases, events=events, samples=samples,
         contact_sequence=_solved_sequence(solution))
+
+
+def _warm_start_data(res: Result) -> dict[str, Any]:
+    """What a warm start from the file needs (:class:`gaitopt.ocp.WarmStart`): the NLP point
+    and its multipliers, with the layout and method they belong to."""
+    point = warm_start_of(res)
+    return {"w": point.w.tolist(), "lam_x": point.lam_x.tolist(),
+            "lam_g": point.lam_g.tolist(), "layout": point.layout, "method": point.method}
 
 
 def _solved_sequence(solution: WalkingSolution) -> dict[str, Any]:

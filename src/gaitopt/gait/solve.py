@@ -62,6 +62,7 @@ from gaitopt.ocp import (
     PhaseGuess,
     Result,
     Transcription,
+    WarmStart,
     refined_mesh,
     transcribe,
 )
@@ -276,7 +277,7 @@ class _Run:
         self.grid_costs: list[tuple[tuple[int, ...], float]] = []
 
     def stage(self, name: str, knots: Grid, relax: Relaxation,
-              guess: Guess | Result, bounds: dict[str, Any], *,
+              guess: Guess | Result | WarmStart, bounds: dict[str, Any], *,
               hold_ankles: bool = False, solver_options: dict[str, Any] | None = None,
               problem: GaitOptions | None = None) -> Result:
         """Solve one stage; a Result guess also passes its multipliers to IPOPT.
@@ -290,7 +291,7 @@ class _Run:
         if hold_ankles:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
-                          warm_start_multipliers=isinstance(guess, Result))
+                          warm_start_multipliers=isinstance(guess, Result | WarmStart))
         result = converged_or_failed(result)
         full = (relax == Relaxation() and not hold_ankles
                 and dict(bounds) == dict(parameter_bounds(self.options)))
@@ -538,7 +539,7 @@ def _as_failed(result: Result, failed: Result) -> Result:
 
 
 def solve_walking(model: RobotModel, options: GaitOptions, *,
-                  warm_start: Guess | Result | None = None,
+                  warm_start: Guess | Result | WarmStart | None = None,
                   progress: ProgressFn | None = None,
                   compiled: str | None = None) -> WalkingSolution:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
@@ -576,12 +577,12 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                            stage_results=tuple(run.named_results))
 
 
-def warm_start_grid(options: GaitOptions, warm_start: Guess | Result) -> Grid:
+def warm_start_grid(options: GaitOptions, warm_start: Guess | Result | WarmStart) -> Grid:
     """The grid of a warm start: ``options.knots``; with ``mesh_tol``, the warm start's own
     mesh (a refined gait's non-uniform knots), every other knot of it when each phase has an
     odd number >= 5: the mesh before the halving that ended its refinement, so that a chain
     of warm starts (a sweep) does not double the grid at every point."""
-    if options.mesh_tol is None:
+    if options.mesh_tol is None or isinstance(warm_start, WarmStart):
         return options.knots
     if isinstance(warm_start, Result):
         taus = [np.asarray(m, dtype=float) for m in warm_start.mesh]

@@ -5,7 +5,7 @@ State a :class:`Problem` of :class:`Phase` objects, then ``tr = transcribe(probl
 """
 
 from gaitopt.ocp.bounds import Bounds
-from gaitopt.ocp.guess import Guess, PhaseGuess
+from gaitopt.ocp.guess import Guess, PhaseGuess, WarmStart, warm_start_of
 from gaitopt.ocp.layout import ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.problem import (
     BoundaryConstraint,
@@ -46,8 +46,10 @@ __all__ = [
     "Refinement",
     "Result",
     "Transcription",
+    "WarmStart",
     "named",
     "refine",
     "refined_mesh",
     "transcribe",
+    "warm_start_of",
 ]

@@ -56,6 +56,38 @@ class Guess:
     parameters: Mapping[str, float] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class WarmStart:
+    """A solved NLP point to restart from exactly: the unscaled values ``w`` (n_w,) and the
+    multipliers ``lam_x`` (n_w,), ``lam_g`` (n_g,) of a transcription with the layout
+    ``layout`` (``repr`` of :meth:`~gaitopt.ocp.layout.Layout.signature`) and ``method``.
+
+    Unlike a :class:`Guess` it holds no trajectories: it fits only a transcription with the
+    same layout and method (anything else is a :class:`ProblemError`). Saved gaits keep one
+    (:func:`warm_start_of`), so a warm start from a file restarts IPOPT with its
+    multipliers, as a warm start from a Result in the same process does."""
+
+    w: Array
+    lam_x: Array
+    lam_g: Array
+    layout: str
+    method: str
+
+    def fits(self, layout: Layout, method: str, n_g: int) -> bool:
+        """Whether this point belongs to a transcription with ``layout``, ``method`` and
+        ``n_g`` constraints."""
+        return (self.layout == repr(layout.signature()) and self.method == method
+                and self.w.size == layout.size and self.lam_g.size == n_g)
+
+
+def warm_start_of(result: Result) -> WarmStart:
+    """The :class:`WarmStart` of a solved result (its values and multipliers)."""
+    return WarmStart(w=np.asarray(result.w, dtype=float), lam_x=np.asarray(result.lam_x,
+                                                                            dtype=float),
+                     lam_g=np.asarray(result.lam_g, dtype=float),
+                     layout=repr(result.layout_signature), method=result.method)
+
+
 def default_value(lo: float, hi: float) -> float:
     """Midpoint of finite bounds, else 0 clipped into them."""
     if math.isfinite(lo) and math.isfinite(hi):

@@ -21,7 +21,7 @@ from gaitopt import codegen
 from gaitopt.ocp.bounds import Bounds, variable_bounds
 from gaitopt.ocp.estimate import interval_errors
 from gaitopt.ocp.functions import PhaseFunction, build_ends_function, build_phase_function
-from gaitopt.ocp.guess import Guess, guess_vector
+from gaitopt.ocp.guess import Guess, WarmStart, guess_vector
 from gaitopt.ocp.layout import Layout
 from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
 from gaitopt.ocp.nlp import Nlp, assemble
@@ -155,8 +155,13 @@ class Transcription:
         """The statement's bounds (modify with ``Bounds.with_*`` and pass to :meth:`solve`)."""
         return self._bounds
 
-    def initial_guess(self, guess: Guess | Result | None = None) -> Array:
+    def initial_guess(self, guess: Guess | Result | WarmStart | None = None) -> Array:
         """The unscaled initial point w0 for ``guess``."""
+        if isinstance(guess, WarmStart):
+            if not guess.fits(self.layout, self.method, self.nlp.lbg.size):
+                raise ProblemError("warm start: made for another transcription (layout, "
+                                   "method or constraints differ)")
+            return np.array(guess.w, dtype=float)
         return guess_vector(self.problem, self.layout, self.mesh, guess)
 
     def nlp_size(self, bounds: Bounds | None = None) -> NlpSize:
@@ -170,7 +175,8 @@ class Transcription:
                        int(ineq.sum()))
 
     # -- solving ---------------------------------------------------------------------------
-    def solve(self, guess: Guess | Result | None = None, *, bounds: Bounds | None = None,
+    def solve(self, guess: Guess | Result | WarmStart | None = None, *,
+              bounds: Bounds | None = None,
               parameters: ParameterBounds | None = None,
               options: Mapping[str, Any] | None = None,
               warm_start_multipliers: bool = False) -> Result:
@@ -179,7 +185,8 @@ class Transcription:
         ``bounds`` replaces the statement's bounds; ``parameters`` then bounds parameters by
         name (a value fixes it, a pair bounds it). ``options`` are merged over the
         transcription's solver options. ``warm_start_multipliers`` passes a Result's
-        multipliers to IPOPT (with ``warm_start_init_point``) when its layout matches.
+        multipliers to IPOPT (with ``warm_start_init_point``) when its layout matches; a
+        :class:`WarmStart` must match (values and multipliers are taken as they are).
         """
         b = bounds or self._bounds
         if b.layout.signature() != self.layout.signature() or b.lbg.size != self.nlp.lbg.size:
@@ -196,9 +203,11 @@ class Transcription:
         d_w, d_g, s_j = self.nlp.d_w, self.nlp.d_g, self.nlp.objective_scale
         args: dict[str, Any] = dict(x0=w0 / d_w, lbx=b.lbw / d_w, ubx=b.ubw / d_w,
                                     lbg=b.lbg / d_g, ubg=b.ubg / d_g)
-        if (warm_start_multipliers and isinstance(guess, Result)
-                and guess.layout_signature == self.layout.signature()
-                and guess.method == self.method and guess.lam_g.size == d_g.size):
+        restart = isinstance(guess, WarmStart) or (
+            isinstance(guess, Result) and guess.layout_signature == self.layout.signature()
+            and guess.method == self.method and guess.lam_g.size == d_g.size)
+        if warm_start_multipliers and restart:
+            assert isinstance(guess, Result | WarmStart)
             args["lam_x0"] = guess.lam_x * d_w / s_j
             args["lam_g0"] = guess.lam_g * d_g / s_j
             opts = merge_options(opts, {"ipopt.warm_start_init_point": "yes",
