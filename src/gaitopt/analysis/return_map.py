@@ -61,6 +61,7 @@ from gaitopt.dynamics.functions import (
 )
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.gait.gait_file import leg_swap_permutations
+from gaitopt.ocp.hermite_simpson import HermiteSimpson
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -100,11 +101,9 @@ class PhaseProfile:
             return u, None, None
         if tau >= t[-1]:
             return u, self.q[-1], self.qd[-1]
-        h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-        h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-        q = h00 * self.q[k] + h * h10 * self.qd[k] + h01 * self.q[k + 1] + h * h11 * self.qd[k + 1]
-        qd = (h00 * self.qd[k] + h * h10 * self.qdd[k] + h01 * self.qd[k + 1]
-              + h * h11 * self.qdd[k + 1])
+        hermite = HermiteSimpson()  # the transcription's interpolant of q and of qd
+        q = hermite.state_at(s, self.q[k], self.q[k + 1], self.qd[k], self.qd[k + 1], h)
+        qd = hermite.state_at(s, self.qd[k], self.qd[k + 1], self.qdd[k], self.qdd[k + 1], h)
         return u, q, qd
 
 

@@ -693,21 +693,20 @@ def leg_swap_permutations(model: RobotModel) -> tuple[NDArray[np.intp], NDArray[
 # -- interpolation between knots ---------------------------------------------------------------
 
 def phase_states_at(phase: GaitPhase, t: Array) -> Array:
-    """Reduced states (M, n) at times ``t`` (M,) by cubic Hermite interpolation of the knots.
-
-    On a segment [t_k, t_k+1] of length h with s = (t - t_k)/h:
-    x(t) = h00 x_k + h h10 xdot_k + h01 x_k+1 + h h11 xdot_k+1 (standard Hermite basis).
-    """
+    """Phase states (M, n) at times ``t`` (M,) by cubic Hermite interpolation of the knots:
+    the transcription's own interpolant (:meth:`gaitopt.ocp.hermite_simpson.HermiteSimpson.
+    state_at`, with s = (t - t_k)/h on the segment [t_k, t_k+1] of length h)."""
     if phase.interpolation["states"] != "cubic_hermite":
         raise ValueError(f"unsupported state interpolation {phase.interpolation['states']!r}")
     t = np.atleast_1d(np.asarray(t, dtype=float))
     k = np.clip(np.searchsorted(phase.t, t, side="right") - 1, 0, phase.t.size - 2)
     h = (phase.t[k + 1] - phase.t[k])[:, None]
     s = ((t - phase.t[k]) / h[:, 0])[:, None]
-    h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-    h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-    return (h00 * phase.x[k] + h * h10 * phase.xdot[k] + h01 * phase.x[k + 1]
-            + h * h11 * phase.xdot[k + 1])
+    # Imported here: gaitopt.ocp loads CasADi, which reading a gait file does not need.
+    from gaitopt.ocp.hermite_simpson import HermiteSimpson
+
+    return np.asarray(HermiteSimpson().state_at(s, phase.x[k], phase.x[k + 1], phase.xdot[k],
+                                                phase.xdot[k + 1], h), dtype=float)
 
 
 def phase_controls_at(phase: GaitPhase, t: Array) -> Array:
