@@ -43,6 +43,41 @@ class _Group(click.Group):
             raise UserError(str(exc)) from None
 
 
+# -- option values shared by the commands ----------------------------------------------------
+
+def parse_free_or_value(text: str, option: str, unit: str, quantity: str) -> float | None:
+    """``free`` -> None, else a number with an optional unit suffix (``0.1m``, ``0.6s``)."""
+    if text.strip().lower() == "free":
+        return None
+    try:
+        return float(text.strip().removesuffix(unit))
+    except ValueError:
+        raise UserError(f"{option}: {text!r} is not a {quantity} in {unit} or 'free'") from None
+
+
+def parse_pair(text: str, option: str) -> tuple[float, float]:
+    """Two numbers ``LO,HI`` (a usage error otherwise)."""
+    parts = text.split(",")
+    try:
+        lo, hi = (float(v) for v in parts)
+    except ValueError:
+        raise click.BadParameter(f"expected two numbers LO,HI, got {text!r}",
+                                 param_hint=option) from None
+    return lo, hi
+
+
+def parse_knots(text: str) -> tuple[int, int]:
+    """``single,double`` knot counts (a usage error otherwise)."""
+    parts = text.split(",")
+    try:
+        values = tuple(int(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 2:
+        raise UserError(f"--knots: {text!r} must be two integers 'single,double', e.g. 8,5")
+    return (values[0], values[1])
+
+
 def make_console() -> Console:
     """A rich console on stdout; at least :data:`PIPE_WIDTH` columns when not a terminal
     (unless ``COLUMNS`` says otherwise), so piped tables are not squeezed to 80 columns.

@@ -11,7 +11,15 @@ from typing import Any
 import click
 from rich.table import Table
 
-from gaitopt.cli_base import USER_ERRORS, UserError, cli, make_console
+from gaitopt.cli_base import (
+    USER_ERRORS,
+    UserError,
+    cli,
+    make_console,
+    parse_free_or_value,
+    parse_knots,
+    parse_pair,
+)
 from gaitopt.gait.formulation import biped_of
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError, validate_options
@@ -33,44 +41,12 @@ def _speed(text: str) -> float | None:
 FAR_FROM_REFERENCE = 0.25
 
 
-def _free_or_value(text: str, option: str, unit: str, quantity: str) -> float | None:
-    """``free`` -> None, else a number with an optional unit suffix (``0.1m``, ``0.6s``)."""
-    if text.strip().lower() == "free":
-        return None
-    try:
-        return float(text.strip().removesuffix(unit))
-    except ValueError:
-        raise UserError(f"{option}: {text!r} is not a {quantity} in {unit} or 'free'") from None
-
-
 def _step(text: str) -> float | None:
-    return _free_or_value(text, "--step-length", "m", "length")
+    return parse_free_or_value(text, "--step-length", "m", "length")
 
 
 def _step_time(text: str) -> float | None:
-    return _free_or_value(text, "--step-time", "s", "time")
-
-
-def _pair(text: str, option: str) -> tuple[float, float]:
-    """Two numbers ``LO,HI`` (a usage error otherwise)."""
-    parts = text.split(",")
-    try:
-        lo, hi = (float(v) for v in parts)
-    except ValueError:
-        raise click.BadParameter(f"expected two numbers LO,HI, got {text!r}",
-                                 param_hint=option) from None
-    return lo, hi
-
-
-def _knots(text: str) -> tuple[int, int]:
-    parts = text.split(",")
-    try:
-        values = tuple(int(p) for p in parts)
-    except ValueError:
-        values = ()
-    if len(values) != 2:
-        raise UserError(f"--knots: {text!r} must be two integers 'single,double', e.g. 8,5")
-    return (values[0], values[1])
+    return parse_free_or_value(text, "--step-time", "s", "time")
 
 
 @cli.command("solve")
@@ -176,7 +152,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     options = GaitOptions(
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
-        single_support_fraction=single_support, knots=_knots(knots),
+        single_support_fraction=single_support, knots=parse_knots(knots),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
@@ -190,7 +166,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         options = options.replace(resting_power=resting_power)
     if single_support_bounds is not None:
         options = options.replace(
-            single_support_fraction_bounds=_pair(single_support_bounds,
+            single_support_fraction_bounds=parse_pair(single_support_bounds,
                                                  "--single-support-bounds"))
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)

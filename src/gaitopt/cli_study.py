@@ -26,8 +26,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from gaitopt.cli_base import UserError, cli, make_console
-from gaitopt.cli_gait import _free_or_value, _knots
+from gaitopt.cli_base import UserError, cli, make_console, parse_free_or_value, parse_knots
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
@@ -113,7 +112,7 @@ def parse_step_lengths(text: str, *, option: str = "--step-length", unit: str = 
     ``option="--step-time", unit="s", quantity="time"``, of step times in s."""
     out: list[float | None] = []
     for item in (i.strip() for i in text.split(",")):
-        value = _free_or_value(item, option, unit, quantity)
+        value = parse_free_or_value(item, option, unit, quantity)
         if value is not None and not (math.isfinite(value) and value > 0):
             raise UserError(f"{option}: {item!r} must be > 0 {unit} (or 'free')")
         out.append(value)
@@ -149,7 +148,7 @@ def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_l
                          step_times=parse_step_lengths(step_time, option="--step-time",
                                                        unit="s", quantity="time"),
                          single_support=parse_fractions(single_support),
-                         base=GaitOptions(knots=_knots(knots), **(problem or {})))
+                         base=GaitOptions(knots=parse_knots(knots), **(problem or {})))
     except SweepSpecError as exc:
         raise UserError(str(exc)) from None
 
