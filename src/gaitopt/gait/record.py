@@ -32,8 +32,6 @@ from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
 
-#: The paper's cost in words (the default cost; :mod:`gaitopt.gait.cost` has all of them).
-COST_FORMULA = cost.FORMULAS["paper"]
 #: Samples per second of step time in the dense grid (at least 101 samples per step).
 SAMPLE_RATE = 200.0
 
