@@ -11,23 +11,41 @@ from __future__ import annotations
 
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import full_coordinates as full
-from gaitopt.gait.contact_sequence import ContactSequence, running_sequence, walking_sequence
+from gaitopt.gait.contact_sequence import (
+    ContactSequence,
+    heel_toe_sequence,
+    running_sequence,
+    sequence_from_dict,
+    walking_sequence,
+)
+from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
-from gaitopt.robot.biped import BipedStructure, biped_structure
+from gaitopt.robot.biped import BipedStructure, BipedStructureError, biped_structure
 from gaitopt.robot.model import RobotModel
 
 
-def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure:
-    """The legs of ``model``: the reduced formulation needs exactly the five-link shape, the
-    full one any torso with two thigh-shank legs (other links allowed)."""
-    return checked_biped(model) if options.formulation == "reduced" else biped_structure(model)
+def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure | None:
+    """The legs of ``model``: the reduced formulation needs exactly the five-link shape; in the
+    full one, a torso with two thigh-shank legs (other links allowed), or None for any other
+    tree (feet, knee-less legs: the guess is then :mod:`gaitopt.gait.sequence_guess`)."""
+    if options.formulation == "reduced":
+        return checked_biped(model)
+    try:
+        return biped_structure(model)
+    except BipedStructureError:
+        return None
 
 
 def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
-    """The contact sequence of ``options``: the paper's walk, the single-support walk or a
-    run."""
+    """The contact sequence of ``options``: the one given as data, or the paper's walk, the
+    single-support walk, a run or a heel-toe walk."""
+    if options.contact_sequence is not None:
+        return sequence_from_dict(options.contact_sequence)
+    if options.gait == "heel-toe":
+        return heel_toe_sequence(model, model_symmetry(model).contacts,
+                                 options.single_support_fraction, impulse=options.impulse)
     if options.gait == "run":
         return running_sequence(model, options.single_support_fraction)
     return walking_sequence(model, options.single_support_fraction,
