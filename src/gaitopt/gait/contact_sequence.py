@@ -40,7 +40,7 @@ section of a YAML file; docs/formulations.md).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -122,6 +122,19 @@ class ContactSequence:
                        for e in self.events],
             "anchors": {c: a for c, a in self.anchors},
         } | ({"offsets": {c: b for c, b in self.offsets}} if self.offsets else {})
+
+
+def phase_holds(sequence: Mapping[str, Any] | None, i: int, contacts: Sequence[str]
+                ) -> tuple[str, ...]:
+    """The hold specs of phase ``i`` of a gait file: from its ``contact_sequence`` when it has
+    one (and its phase ``i`` holds the points ``contacts``), else the contact names (pins)."""
+    if sequence is not None:
+        phases = sequence.get("phases", [])
+        if i < len(phases):
+            held = tuple(str(c) for c in phases[i].get("held", ()))
+            if [hold_name(c) for c in held] == list(contacts):
+                return held
+    return tuple(contacts)
 
 
 def swap_spec(spec: str, contact_swap: Mapping[str, str]) -> str:

@@ -13,13 +13,15 @@ from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import full_coordinates as full
 from gaitopt.gait.contact_sequence import (
     ContactSequence,
+    ContactSequenceError,
+    check_sequence,
     heel_toe_sequence,
     running_sequence,
     sequence_from_dict,
     walking_sequence,
 )
 from gaitopt.gait.full_physics import model_symmetry
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
 from gaitopt.robot.biped import BipedStructure, BipedStructureError, biped_structure
@@ -38,6 +40,19 @@ def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure | None:
         return None
 
 
+def default_formulation(model: RobotModel, gait: str, custom_sequence: bool) -> str:
+    """The formulation a user gets without asking: the paper's reduced coordinates for the
+    walk of a five-link-shaped biped, else full coordinates (the only one for other models,
+    runs, heel-toe walks and given sequences)."""
+    if gait != "walk" or custom_sequence:
+        return "full"
+    try:
+        checked_biped(model)
+    except BipedStructureError:
+        return "full"
+    return "reduced"
+
+
 def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
     """The contact sequence of ``options``: the one given as data, or the paper's walk, the
     single-support walk, a run or a heel-toe walk."""
@@ -50,6 +65,19 @@ def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence
         return running_sequence(model, options.single_support_fraction)
     return walking_sequence(model, options.single_support_fraction,
                             impulse=options.impulse and options.double_support)
+
+
+def checked_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence | None:
+    """The contact sequence of ``options`` checked against ``model`` (None in the reduced
+    formulation); a bad one raises :class:`GaitOptionsError` naming what is wrong."""
+    if options.formulation != "full":
+        return None
+    try:
+        seq = contact_sequence(model, options)
+        check_sequence(model, seq, dict(model_symmetry(model).contacts))
+    except (ContactSequenceError, ValueError) as exc:
+        raise GaitOptionsError(f"contact sequence: {exc}") from None
+    return seq
 
 
 def problem_for(model: RobotModel, options: GaitOptions) -> Problem:

@@ -229,8 +229,9 @@ class GaitEvent:
     qd_after: Array
 
     def __post_init__(self) -> None:
-        if self.name not in EVENT_NAMES:
-            raise _fail("name", f"expected one of {', '.join(EVENT_NAMES)}, got {self.name!r}")
+        if not (isinstance(self.name, str) and self.name.isidentifier()):
+            raise _fail("name", f"expected an event name (letters, digits, '_'; the built-in "
+                        f"sequences use {', '.join(EVENT_NAMES)}), got {self.name!r}")
         set_ = object.__setattr__
         set_(self, "t", _number("t", self.t))
         imp = _mapping("impulses", self.impulses)

@@ -8,14 +8,15 @@ points should be and solves for the configuration:
 * every contact point gets a target over the step: where it is held (its anchor
   ``anchor L + offset``, ``y = 0``; only ``y = 0`` for a normal-only hold of a point without an
   anchor), and between two holds a smooth arc from the last ground point to the next
-  (smoothstep in ``x``, a half sine of height ``lift`` in ``y``). A point held in no phase
-  this step is found through the leg swap: point ``c`` at time ``t + T`` is point
-  ``swap(c)`` at ``t``, one step length ahead;
+  (smoothstep in ``x``, a half sine of height ``lift`` in ``y``). The holds of neighbouring
+  steps come through the leg swap: point ``c`` at time ``t + T`` is where point ``swap(c)``
+  is at ``t``, one step length ahead (and ``c`` itself two steps ahead);
 * the base moves forward at the speed ``v``, passing over the middle of the held points at
   mid-step, at about the standing height; the torso upright;
 * at each of :data:`SAMPLES` times per phase ``q`` minimises (``scipy.optimize.least_squares``,
   within the joint limits, started from the previous sample) the weighted squared distance of
-  the points to their targets plus weak terms pulling the base to its path and the joints to
+  the points to their targets (held points weigh more, and any point below the ground
+  weighs as much) plus weak terms pulling the base to its path and the joints to
   a slightly flexed pose;
 * rates, accelerations and least-squares torques as in :mod:`gaitopt.gait.guess`.
 """
@@ -35,8 +36,9 @@ from gaitopt.robot.model import RobotModel
 
 #: Samples per phase of the inverse kinematics (rates are differentiated from them).
 SAMPLES = 60
-#: Weights of the inverse-kinematics residuals: contact targets, base path, torso, joints.
-W_CONTACT, W_BASE, W_TORSO, W_JOINT = 1.0, 0.1, 0.3, 0.02
+#: Weights of the inverse-kinematics residuals: held points, swinging points, base path,
+#: torso, joints.
+W_HELD, W_SWING, W_BASE, W_TORSO, W_JOINT = 10.0, 1.0, 0.1, 0.3, 0.02
 #: The pose the joints are pulled toward (rad): knees slightly flexed so that the inverse
 #: kinematics stays on the knee-forward branch; other joints 0.
 FLEXED_KNEE = -0.3
@@ -53,15 +55,17 @@ def _held_intervals(seq: ContactSequence, ends: Array) -> dict[str, list[tuple[f
 
 def _ground_points(seq: ContactSequence, swap: Mapping[str, str], step: float, total: float
                    ) -> dict[str, list[tuple[float, float, float | None]]]:
-    """Contact -> held intervals ``(t0, t1, x)`` over three steps (the previous, this and
-    the next, through the leg swap), ``x`` its ground point or None without an anchor."""
+    """Contact -> held intervals ``(t0, t1, x)`` over five steps (two before this one, two
+    after: the point ``c`` is ``swap(c)`` one step later and ``c`` again two steps later,
+    ``L`` further each step), ``x`` its ground point or None without an anchor."""
     ends = np.concatenate([[0.0], np.cumsum([ph.fraction for ph in seq.phases])]) * total
     here = _held_intervals(seq, ends)
     anchored = dict(seq.anchors)
     out: dict[str, list[tuple[float, float, float | None]]] = {}
     for c in {*here, *swap, *swap.values()}:
         rows: list[tuple[float, float, float | None]] = []
-        for shift, name in ((-1, swap.get(c, c)), (0, c), (1, swap.get(c, c))):
+        for shift in (-2, -1, 0, 1, 2):
+            name = c if shift % 2 == 0 else swap.get(c, c)
             x = seq.ground_x(name, step) if name in anchored else None
             for t0, t1 in here.get(name, []):
                 rows.append((t0 + shift * total, t1 + shift * total,
@@ -71,11 +75,11 @@ def _ground_points(seq: ContactSequence, swap: Mapping[str, str], step: float, t
 
 
 def _target(rows: list[tuple[float, float, float | None]], t: float, lift: float
-            ) -> tuple[float | None, float] | None:
-    """``(x or None, y)`` target of a point at time ``t`` from its held intervals."""
+            ) -> tuple[float | None, float, float] | None:
+    """``(x or None, y, weight)`` target of a point at time ``t`` from its held intervals."""
     for t0, t1, x in rows:
         if t0 - 1e-12 <= t <= t1 + 1e-12:
-            return x, 0.0
+            return x, 0.0, W_HELD
     before = [r for r in rows if r[1] < t]
     after = [r for r in rows if r[0] > t]
     if not before or not after:
@@ -83,7 +87,7 @@ def _target(rows: list[tuple[float, float, float | None]], t: float, lift: float
     (_, ta, xa), (tb, _, xb) = before[-1], after[0]
     s = (t - ta) / (tb - ta)
     x = None if xa is None or xb is None else xa + (xb - xa) * float(_smoothstep(np.array(s)))
-    return x, lift * float(np.sin(np.pi * s))
+    return x, lift * float(np.sin(np.pi * s)), W_SWING
 
 
 def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, str], *,
@@ -118,16 +122,17 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
             targets = {c: _target(rows.get(c, []), float(t), lift) for c in names}
             base = (middle + v * (t - total / 2.0), 0.95 * stand)
 
-            def residual(qq: Array, targets: dict[str, tuple[float | None, float] | None] =
-                         targets, base: tuple[float, float] = base) -> Array:
+            def residual(qq: Array, targets: dict[str, tuple[float | None, float, float] | None]
+                         = targets, base: tuple[float, float] = base) -> Array:
                 r = []
                 for c, tgt in targets.items():
                     if tgt is None:
                         continue
                     p = np.asarray(contact_position(model, qq, c), dtype=float).ravel()
+                    r.append(W_HELD * min(p[1], 0.0))   # never below the ground
                     if tgt[0] is not None:
-                        r.append(W_CONTACT * (p[0] - tgt[0]))
-                    r.append(W_CONTACT * (p[1] - tgt[1]))
+                        r.append(tgt[2] * (p[0] - tgt[0]))
+                    r.append(tgt[2] * (p[1] - tgt[1]))
                 r += [W_BASE * (qq[X_COORDINATE] - base[0]), W_BASE * (qq[Y_COORDINATE] - base[1]),
                       W_TORSO * qq[BASE_ANGLE_COORDINATE]]
                 r += list(W_JOINT * (qq[3:] - pose[3:]))

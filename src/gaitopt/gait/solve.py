@@ -46,7 +46,13 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.gait.formulation import biped_of, contact_sequence, problem_for, stage_bounds
+from gaitopt.gait.formulation import (
+    biped_of,
+    checked_sequence,
+    contact_sequence,
+    problem_for,
+    stage_bounds,
+)
 from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.guess import (
     WalkingGuess,
@@ -555,6 +561,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed."""
     validate_options(options, biped_of(model, options))
+    checked_sequence(model, options)
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
