@@ -200,9 +200,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     if not solution.success:
         from gaitopt.gait.diagnose import diagnose
 
-        console.print("FAILED: " + diagnose(solution).text())
-        console.print(f"Largest constraint violation {solution.result.constraint_violation:.3g}."
-                      " No gait file written.")
+        diagnosis = diagnose(solution)
+        console.print("FAILED: " + diagnosis.text())
+        console.print(f"Largest constraint violation at that point {diagnosis.violation:.3g} "
+                      "(in the constraints' own units). No gait file written.")
         sys.exit(1)
     try:
         gait = gait_from_solution(solution)

@@ -44,10 +44,12 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from math import nan
 from typing import Any
 
 import numpy as np
 
+from gaitopt.dynamics.reduced import ReachError
 from gaitopt.gait.formulation import biped_of, stage_bounds
 from gaitopt.gait.guess import (
     WalkingGuess,
@@ -56,7 +58,7 @@ from gaitopt.gait.guess import (
     naive_guess,
     naive_running_guess,
 )
-from gaitopt.gait.options import GaitOptions, validate_options
+from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.problem import (
     FRACTION,
     IMPULSE,
@@ -124,6 +126,8 @@ class _Run:
         self.results: list[Result] = []
         self.named_results: list[tuple[str, Result]] = []
         self.grid_costs: list[tuple[tuple[int, ...], float]] = []
+        #: Naive starts no leg could reach: (step length m, longest leg reach m, why).
+        self.unplaced: list[tuple[float, float, str]] = []
 
     def stage(self, name: str, knots: Grid, relax: Relaxation,
               guess: Guess | Result | WarmStart, bounds: dict[str, Any], *,
@@ -177,16 +181,20 @@ class _Run:
             steps = [default(speed) * f for f in (1.0, 0.7, 1.4)]
         found: list[Result] = []
         for step0 in steps:
-            if o.gait == "run":
-                guess = naive_running_guess(
-                    self.model, speed=speed, step_length=step0,
-                    stance_fraction=o.single_support_fraction, knots=coarse, ankle=o.ankle,
-                    r_max=r_max, ankle_torques=False)
-            else:
-                guess = naive_guess(self.model, speed=speed, step_length=step0,
-                                    single_support_fraction=o.single_support_fraction,
-                                    knots=coarse, ankle=o.ankle, r_max=r_max,
-                                    ankle_torques=False, full=o.formulation == "full")
+            try:
+                if o.gait == "run":
+                    guess = naive_running_guess(
+                        self.model, speed=speed, step_length=step0,
+                        stance_fraction=o.single_support_fraction, knots=coarse,
+                        ankle=o.ankle, r_max=r_max, ankle_torques=False)
+                else:
+                    guess = naive_guess(self.model, speed=speed, step_length=step0,
+                                        single_support_fraction=o.single_support_fraction,
+                                        knots=coarse, ankle=o.ankle, r_max=r_max,
+                                        ankle_torques=False, full=o.formulation == "full")
+            except ReachError as exc:  # this start puts a leg beyond its reach: the next
+                self.unplaced.append((step0, r_max, str(exc)))
+                continue
             start = ocp_guess(guess)
             if FRACTION in bounds:  # a free fraction starts at its guess
                 start = Guess(phases=start.phases, parameters={
@@ -336,7 +344,12 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   progress: ProgressFn | None = None,
                   compiled: str | None = None) -> WalkingSolution:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
-    the returned solution says whether it succeeded and which stage failed."""
+    the returned solution says whether it succeeded and which stage failed.
+
+    Raises:
+        GaitOptionsError: invalid options, or a step so long that no naive start can place
+            the legs (nothing was solved; the message says what to change).
+    """
     validate_options(options, biped_of(model, options))
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)
@@ -363,11 +376,26 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                 outcome = run.refine(outcome)
     if outcome is not None and outcome.success:
         outcome = run.refine_mesh(outcome)
+    if not run.results:  # no stage ran: every naive start was beyond the legs' reach
+        raise GaitOptionsError(unplaced_message(options, run.unplaced))
     final = outcome if outcome is not None and outcome.success else run.final()
     return WalkingSolution(model=model, options=options, result=final,
                            stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
                            grid_costs=tuple(run.grid_costs),
                            stage_results=tuple(run.named_results))
+
+
+def unplaced_message(options: GaitOptions, unplaced: list[tuple[float, float, str]]) -> str:
+    """Why no naive start could be placed, and what to change. A start walks the hip at a
+    constant height and speed; at the heel strike it is ``L (1 - f/2)`` ahead of the stance
+    tip (step length ``L``, single-support fraction ``f``), which the stance leg must reach."""
+    step, r_max, why = max(unplaced, key=lambda u: u[0]) if unplaced else (nan, nan, "")
+    f = options.single_support_fraction
+    longest = r_max / (1.0 - f / 2.0)
+    return (f"step_length = {step:.3g} m: every naive start puts a leg beyond its reach "
+            f"({why}); at single-support fraction {f:g} a step of this model's legs "
+            f"(reach {r_max:.3g} m) is at most about {longest:.3g} m: a shorter step, a "
+            "lower speed or a smaller single-support fraction")
 
 
 __all__ = ["PRIMAL_WARM_OPTIONS", "REFERENCE_SPEED", "Grid", "ProgressFn", "StageReport",
