@@ -28,7 +28,7 @@ from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp import Result, warm_start_of
 from gaitopt.robot.biped import biped_structure
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_POSITION, RobotModel
 
 Array = NDArray[np.float64]
 
@@ -68,7 +68,7 @@ def _points_function(model: RobotModel) -> ca.Function:
     """``q -> (hip, knee_1, knee_2, tip_1, tip_2, torso_top)`` world positions (2, 6)."""
     legs = biped_structure(model).legs
     q = ca.SX.sym("q", model.nq)
-    cols = [q[0:2]]
+    cols = [q[BASE_POSITION]]
     for leg in legs:
         cols.append(point_position(model, q, leg.shank, (0.0, 0.0)))
     for leg in legs:

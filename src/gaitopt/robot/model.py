@@ -41,6 +41,10 @@ VERSION = 1
 
 #: Names of the three coordinates of the floating base, in order.
 BASE_COORDINATES: tuple[str, str, str] = ("x", "y", "angle")
+#: Indices in ``q`` of the base position (world frame, m) and the base angle (rad), in the
+#: order of :data:`BASE_COORDINATES`; ``BASE_POSITION`` slices ``(x, y)`` out of ``q``.
+BASE_X, BASE_Y, BASE_ANGLE = 0, 1, 2
+BASE_POSITION = slice(BASE_X, BASE_Y + 1)
 
 
 @dataclass(frozen=True)
