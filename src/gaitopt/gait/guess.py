@@ -29,6 +29,8 @@ from gaitopt.gait import walking
 from gaitopt.gait.full_physics import actuator_names
 from gaitopt.gait.full_physics import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.ocp import Guess as OcpGuess
+from gaitopt.ocp import PhaseGuess as OcpPhaseGuess
 from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import BASE_POSITION, RobotModel
 
@@ -55,6 +57,17 @@ class PhaseGuess:
 class WalkingGuess:
     phases: tuple[PhaseGuess, ...]
     parameters: dict[str, float]
+
+    def to_ocp(self) -> OcpGuess:
+        """The engine's guess object (values at normalised knot times)."""
+        phases = {}
+        for ph in self.phases:
+            span = ph.t[-1] - ph.t[0]
+            phases[ph.name] = OcpPhaseGuess(
+                x={n: ph.x[:, j] for j, n in enumerate(ph.states)},
+                u={n: ph.u[:, j] for j, n in enumerate(ph.controls)},
+                tau=(ph.t - ph.t[0]) / span)
+        return OcpGuess(phases=phases, parameters=dict(self.parameters))
 
 
 def default_step_length(speed: float) -> float:

@@ -52,7 +52,6 @@ import numpy as np
 from gaitopt.dynamics.reduced import ReachError
 from gaitopt.gait.formulation import biped_of, stage_bounds
 from gaitopt.gait.guess import (
-    WalkingGuess,
     default_running_step,
     default_step_length,
     naive_guess,
@@ -87,7 +86,7 @@ from gaitopt.gait.stages import (
     held_bounds,
 )
 from gaitopt.gait.transcriptions import Grid, grid_knots, transcription_for, warm_start_grid
-from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart, refined_mesh
+from gaitopt.ocp import Guess, Result, WarmStart, refined_mesh
 from gaitopt.ocp.mesh import split_intervals
 from gaitopt.robot.model import RobotModel
 
@@ -102,17 +101,6 @@ COST_SMOOTHING_START = 1.0
 #: (the bound of ``GaitOptions.knots``).
 MAX_REFINEMENTS = 6
 MAX_REFINED_KNOTS = 400
-
-
-def ocp_guess(guess: WalkingGuess) -> Guess:
-    """The engine's guess object from a walking guess (values at normalised knot times)."""
-    phases = {}
-    for ph in guess.phases:
-        span = ph.t[-1] - ph.t[0]
-        phases[ph.name] = PhaseGuess(
-            x={n: ph.x[:, j] for j, n in enumerate(ph.states)},
-            u={n: ph.u[:, j] for j, n in enumerate(ph.controls)}, tau=(ph.t - ph.t[0]) / span)
-    return Guess(phases=phases, parameters=dict(guess.parameters))
 
 
 class _Run:
@@ -195,7 +183,7 @@ class _Run:
             except ReachError as exc:  # this start puts a leg beyond its reach: the next
                 self.unplaced.append((step0, r_max, str(exc)))
                 continue
-            start = ocp_guess(guess)
+            start = guess.to_ocp()
             if FRACTION in bounds:  # a free fraction starts at its guess
                 start = Guess(phases=start.phases, parameters={
                     **start.parameters, FRACTION: o.single_support_fraction})
