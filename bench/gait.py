@@ -44,12 +44,12 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from gaitopt.gait import solve as gait_solve
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import gait_from_solution
 from gaitopt.gait.solve import WalkingSolution, solve_walking
+from gaitopt.gait.transcriptions import clear_cache
 from gaitopt.ocp import Result
 from gaitopt.ocp.result import METHODS
 from gaitopt.ocp.transcription import Transcription
@@ -145,7 +145,7 @@ def bench_grid(knots: tuple[int, int], repeat: int,
     model = load_model("five-link")
     options = GaitOptions(speed=SPEED, knots=knots,
                           formulation=formulation)  # type: ignore[arg-type]
-    gait_solve._CACHE.clear()  # the process-wide NLP cache: a fresh start
+    clear_cache()  # the process-wide NLP cache: a fresh start
     fresh, _ = measure("cold (fresh)", knots, lambda: solve_walking(model, options))
     cached, solution = best_of(repeat, "cold (cache built)", knots,
                                lambda: solve_walking(model, options))

@@ -20,7 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from gaitopt.cli_study import parse_speeds
+from gaitopt.cli.study import parse_speeds
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import transcription_for
 from gaitopt.robot import load_model

@@ -53,10 +53,11 @@ def _options(form: str, knots: tuple[int, int], speed: float = SPEED) -> Any:
 def worker_cold(form: str, knots: tuple[int, int], exact_fine: bool, out: str) -> dict[str, Any]:
     """A fresh process: the default cold solve; its Result is pickled to ``out``."""
     from gaitopt.gait import solve as gait_solve
+    from gaitopt.gait import stages
     from gaitopt.robot import load_model
 
     if exact_fine:
-        gait_solve.FINE_STAGE_OPTIONS = {}
+        stages.FINE_STAGE_OPTIONS = {}
     model = load_model("five-link")
     start = time.perf_counter()
     sol = gait_solve.solve_walking(model, _options(form, knots))

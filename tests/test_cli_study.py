@@ -10,7 +10,8 @@ from click.testing import CliRunner
 from PIL import Image
 
 from gaitopt.cli import UserError, cli
-from gaitopt.cli_study import parse_speeds, parse_variants, sweep_dirs
+from gaitopt.cli.report import sweep_dirs
+from gaitopt.cli.study import parse_speeds, parse_variants
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.driver import prepare_directory

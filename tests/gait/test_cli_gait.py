@@ -140,7 +140,7 @@ def test_failed_solve_exits_1_names_the_stage_and_writes_nothing(
         monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """Forced failure: 3 IPOPT iterations per stage, no continuation (the CLI has no option
     for that, so the options it builds are patched)."""
-    monkeypatch.setattr("gaitopt.cli_gait.GaitOptions",
+    monkeypatch.setattr("gaitopt.cli.gait.GaitOptions",
                         functools.partial(GaitOptions, max_iter=3, continuation=False))
     out = tmp_path / "g.gait.json"
     result = solve("-o", str(out))

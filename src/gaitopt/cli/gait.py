@@ -11,14 +11,20 @@ from typing import Any
 import click
 from rich.table import Table
 
-from gaitopt.cli_base import (
+from gaitopt.cli.base import (
     USER_ERRORS,
     UserError,
     cli,
+    control_model_option,
+    cost_option,
+    formulation_option,
+    knots_option,
     make_console,
+    model_option,
     parse_free_or_value,
     parse_knots,
     parse_pair,
+    resting_power_option,
 )
 from gaitopt.gait.formulation import biped_of, checked_sequence, default_formulation
 from gaitopt.gait.gait_file import Gait, GaitFileError
@@ -72,8 +78,7 @@ def _step_time(text: str) -> float | None:
 
 
 @cli.command("solve")
-@click.option("--model", "model_name", default="five-link", show_default=True,
-              help="Built-in model name or model file.")
+@model_option
 @click.option("--speed", default="12m/min", show_default=True,
               help="Average speed with a unit (12m/min, 0.2m/s) or 'free' (the optimal walk).")
 @click.option("--step-length", default="free", show_default=True,
@@ -89,8 +94,7 @@ def _step_time(text: str) -> float | None:
 @click.option("--single-support-bounds", default=None,
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
-@click.option("--knots", default="8,5", show_default=True,
-              help="Grid points per phase: single support, double support.")
+@knots_option
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
               default=GaitOptions().transcription, show_default=True,
               help="hermite-simpson-separated: the same scheme with the midpoint states as "
@@ -103,11 +107,11 @@ def _step_time(text: str) -> float | None:
 @click.option("--unilateral-impulses/--paper-impulse-maps", default=True, show_default=True,
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
-@click.option("--formulation", type=click.Choice(["reduced", "full"]), default=None,
+@formulation_option(
               help="reduced: the paper's coordinates (five-link biped); full: the whole "
                    "tree's q, qd with the held points as constraints (any model and contact "
                    "sequence, knees may straighten) [default: reduced for the five-link shape "
-                   "and the walk, else full].")
+                   "and the walk, else full].", default=None)
 @click.option("--min-knee-flexion", type=float, default=None,
               help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
                    "stance knee straighten, with --formulation full].")
@@ -119,17 +123,14 @@ def _step_time(text: str) -> float | None:
               type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="A YAML file with a contact sequence (phases, events, anchors; "
                    "docs/formulations.md); replaces --gait.")
-@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
-              show_default=True,
+@cost_option(
               help="paper: torque squared per metre; work: mechanical cost of transport; "
                    "metabolic: positive/negative work efficiencies and a resting power "
                    "(docs/costs.md).")
-@click.option("--resting-power", type=float, default=None,
-              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
+@resting_power_option
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="Weight of an added mean squared torque (u / u_max)^2 term.")
-@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
-              show_default=True,
+@control_model_option(
               help="Controls continuous at the heel strike and periodic (paper), or free to "
                    "jump at both events (jumps).")
 @click.option("--mesh-tol", type=float, default=None,
@@ -232,9 +233,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     if not solution.success:
         from gaitopt.gait.diagnose import diagnose
 
-        console.print("FAILED: " + diagnose(solution).text())
-        console.print(f"Largest constraint violation {solution.result.constraint_violation:.3g}."
-                      " No gait file written.")
+        diagnosis = diagnose(solution)
+        console.print("FAILED: " + diagnosis.text())
+        console.print(f"Largest constraint violation at that point {diagnosis.violation:.3g} "
+                      "(in the constraints' own units). No gait file written.")
         sys.exit(1)
     try:
         gait = gait_from_solution(solution)

@@ -1,9 +1,9 @@
-"""``gaitopt sweep``, ``report``, ``animate`` and ``study`` (the main job): many gaits.
+"""``gaitopt sweep`` and ``study`` (the main job): many gaits.
 
 ``sweep`` solves a grid (variants x speeds, optionally x step lengths x single-support
-fractions) in parallel with continuation and writes a resumable sweep directory; ``report``
-writes the paper's figures and an HTML report of a sweep; ``animate`` writes a GIF or mp4 of
-a gait; ``study`` does all three for the paper's study. See docs/studies.md.
+fractions) in parallel with continuation and writes a resumable sweep directory; ``study``
+does that for the paper's study, then ``report`` and ``animate`` (:mod:`gaitopt.cli.report`).
+See docs/studies.md.
 """
 
 from __future__ import annotations
@@ -26,8 +26,20 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from gaitopt.cli_base import UserError, cli, make_console, parse_free_or_value, parse_knots
-from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.cli.base import (
+    UserError,
+    cli,
+    control_model_option,
+    cost_option,
+    formulation_option,
+    knots_option,
+    make_console,
+    model_option,
+    parse_free_or_value,
+    parse_knots,
+    resting_power_option,
+)
+from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import (
@@ -39,8 +51,8 @@ from gaitopt.study.driver import (
     run_sweep,
 )
 from gaitopt.study.executors import BackendError
-from gaitopt.study.plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
-from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, SummaryError
+from gaitopt.study.plan import SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 from gaitopt.study.worker import PointOutcome
 
 #: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
@@ -242,8 +254,7 @@ def _workers_option(f: Any) -> Any:
 @cli.command("sweep")
 @click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
               required=True, help="Sweep directory (created; rerun to resume).")
-@click.option("--model", "model_name", default="five-link", show_default=True,
-              help="Built-in model name or model file.")
+@model_option
 @click.option("--speeds", default=DEFAULT_SPEEDS, show_default=True,
               help="Speeds in m/min: start:stop:step (stop included) and/or a comma list.")
 @click.option("--variants", default="all", show_default=True,
@@ -256,16 +267,11 @@ def _workers_option(f: Any) -> Any:
               help="Step times in s (comma list), or 'free'; not with --step-length.")
 @click.option("--single-support", default="0.85", show_default=True,
               help="Single-support fractions of the step time (comma list).")
-@click.option("--knots", default="8,5", show_default=True,
-              help="Grid points per phase: single support, double support.")
-@click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
-              show_default=True, help="The coordinates of every point (docs/formulations.md).")
-@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
-              show_default=True, help="The cost of every point (docs/costs.md).")
-@click.option("--resting-power", type=float, default=None,
-              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
-@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
-              show_default=True, help="Controls continuous and periodic (paper) or free to "
+@knots_option
+@formulation_option(help="The coordinates of every point (docs/formulations.md).")
+@cost_option(help="The cost of every point (docs/costs.md).")
+@resting_power_option
+@control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
@@ -291,90 +297,13 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
         sys.exit(1)
 
 
-# -- report and animate -------------------------------------------------------------------------
-
-def sweep_dirs(directory: Path) -> list[Path]:
-    """The (sub-)sweeps of a sweep directory: itself, or its sub-folders with a summary."""
-    if (directory / SUMMARY_FILE).exists():
-        return [directory]
-    subs = sorted(p.parent for p in directory.glob(f"*/{SUMMARY_FILE}"))
-    if not subs:
-        what = "no sweep" if not (directory / SETTINGS_FILE).exists() else "no finished point"
-        raise UserError(f"{directory}: {what} here (no {SUMMARY_FILE}); run `gaitopt sweep -o "
-                        f"{directory}` first")
-    return subs
-
-
-def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
-    """Write the report of each (sub-)sweep, print where and the findings."""
-    from gaitopt.study.findings import findings_text
-    from gaitopt.viz.report import write_report
-
-    pages = []
-    for sweep in sweep_dirs(directory):
-        target = out if sweep == directory else out / sweep.name
-        try:
-            info = write_report(sweep, target)
-        except SummaryError as exc:
-            raise UserError(str(exc)) from None
-        console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)",
-                      soft_wrap=True)
-        for problem in info.problems:
-            console.print(f"  problem: {problem}", soft_wrap=True)
-        console.print(findings_text(info.findings), soft_wrap=True)
-        pages.append(info.html)
-    return pages
-
-
-@cli.command("report")
-@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="Folder of the report (default: DIRECTORY/report).")
-def report_command(directory: Path, output: Path | None) -> None:
-    """Write the figures and the HTML report of a sweep, and print the findings."""
-    if not directory.is_dir():
-        raise UserError(f"{directory}: no such directory")
-    write_reports(make_console(), directory, output or directory / "report")
-
-
-def animate_file(console: Console, file: Path, output: Path, *, steps: int, fps: int) -> None:
-    from gaitopt.viz.animation import animate_gait
-
-    try:
-        gait = Gait.load(file)
-    except GaitFileError as exc:
-        raise UserError(str(exc)) from None
-    start = time.perf_counter()
-    try:
-        info = animate_gait(gait, output, steps=steps, fps=fps)
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
-    console.print(f"animation: {info.path} ({info.frames} frames, {info.duration_s:.2f} s at "
-                  f"{info.fps:g} fps, {steps} steps of {gait.speed * 60:.1f} m/min; written "
-                  f"in {time.perf_counter() - start:.1f} s)", soft_wrap=True)
-
-
-@cli.command("animate")
-@click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
-              default=Path("walk.gif"), show_default=True, help="A .gif or .mp4 file.")
-@click.option("--steps", type=click.IntRange(min=1, max=100), default=4, show_default=True,
-              help="Steps to show.")
-@click.option("--fps", type=click.IntRange(min=1, max=120), default=30, show_default=True,
-              help="Frames per second (the movie plays in real time).")
-def animate_command(file: Path, output: Path, steps: int, fps: int) -> None:
-    """Write an animation of a gait file: the stick figure walking, with contact forces."""
-    animate_file(make_console(), file, output, steps=steps, fps=fps)
-
-
 # -- the main job -------------------------------------------------------------------------------
 
 @cli.command("study")
 @click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
               default=STUDY_DIR, show_default=True,
               help="Study directory (the sweep; the report goes to its report/ folder).")
-@click.option("--model", "model_name", default="five-link", show_default=True,
-              help="Built-in model name or model file.")
+@model_option
 @click.option("--speeds", default=STUDY_SPEEDS, show_default=True,
               help="Speeds in m/min: start:stop:step and/or a comma list.")
 @_workers_option
@@ -407,5 +336,5 @@ def study_command(directory: Path, model_name: str, speeds: str, workers: int | 
                   soft_wrap=True)
 
 
-__all__ = ["animate_command", "parse_speeds", "parse_variants", "report_command",
-           "study_command", "sweep_command"]
+__all__ = ["make_spec", "parse_speeds", "parse_variants", "run_with_progress", "study_command",
+           "sweep_command"]

@@ -9,12 +9,14 @@ signals one by raising :class:`UserError`, or any exception type listed in
 from __future__ import annotations
 
 import os
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar, get_args
 
 import click
 from rich.console import Console
 
 from gaitopt import __version__
+from gaitopt.gait.options import ControlModel, CostName, Formulation
 from gaitopt.robot import ModelError
 
 #: Exception types that are the user's to fix: shown as one line, exit status 2.
@@ -76,6 +78,48 @@ def parse_knots(text: str) -> tuple[int, int]:
     if len(values) != 2:
         raise UserError(f"--knots: {text!r} must be two integers 'single,double', e.g. 8,5")
     return (values[0], values[1])
+
+
+# -- options used by several commands (defined once) --------------------------------------------
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def model_option(f: F) -> F:
+    """``--model NAME_OR_FILE`` (parameter ``model_name``): a built-in model or a model file."""
+    return click.option("--model", "model_name", default="five-link", show_default=True,
+                        help="Built-in model name or model file.")(f)
+
+
+def knots_option(f: F) -> F:
+    """``--knots SINGLE,DOUBLE`` (text; parse with :func:`parse_knots`)."""
+    return click.option("--knots", default="8,5", show_default=True,
+                        help="Grid points per phase: single support, double support.")(f)
+
+
+def resting_power_option(f: F) -> F:
+    """``--resting-power`` in W/kg (None: the metabolic cost's default)."""
+    return click.option("--resting-power", type=float, default=None,
+                        help="Resting power of the metabolic cost, W/kg [default: 1.2].")(f)
+
+
+def formulation_option(help: str, default: str | None = "reduced") -> Callable[[F], F]:
+    """``--formulation reduced|full`` with this help text (``default`` None: the command
+    chooses, and says how in ``help``)."""
+    return click.option("--formulation", type=click.Choice(get_args(Formulation)),
+                        default=default, show_default=default is not None, help=help)
+
+
+def cost_option(help: str) -> Callable[[F], F]:
+    """``--cost paper|work|metabolic`` with this help text."""
+    return click.option("--cost", type=click.Choice(get_args(CostName)), default="paper",
+                        show_default=True, help=help)
+
+
+def control_model_option(help: str) -> Callable[[F], F]:
+    """``--control-model paper|jumps`` with this help text."""
+    return click.option("--control-model", type=click.Choice(get_args(ControlModel)),
+                        default="paper", show_default=True, help=help)
 
 
 def make_console() -> Console:
