@@ -337,10 +337,34 @@ def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
 @click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder of the report (default: DIRECTORY/report).")
 def report_command(directory: Path, output: Path | None) -> None:
-    """Write the figures and the HTML report of a sweep, and print the findings."""
+    """Write the figures and the HTML report of a sweep (or of a cost study), and print the
+    findings."""
+    from gaitopt.study.cost_study import COST_STUDY_FILE
+
     if not directory.is_dir():
         raise UserError(f"{directory}: no such directory")
+    if (directory / COST_STUDY_FILE).exists():
+        write_cost_reports(make_console(), directory, output or directory / "report")
+        return
     write_reports(make_console(), directory, output or directory / "report")
+
+
+def write_cost_reports(console: Console, directory: Path, out: Path) -> Path:
+    """Write a cost study's report from its ``costs.csv``; print the answer and findings."""
+    from gaitopt.study.cost_findings import cost_findings_text
+    from gaitopt.study.cost_study import COST_TABLE_FILE, CostStudyError, read_cost_table
+    from gaitopt.viz.cost_report import answer_text, write_cost_report
+
+    try:
+        info = write_cost_report(directory, out)
+        rows = read_cost_table(directory / COST_TABLE_FILE)
+    except CostStudyError as exc:
+        raise UserError(f"{exc}; rerun `gaitopt study --costs -o {directory}` to finish the "
+                        "study") from None
+    console.print(f"report: {info.html}", soft_wrap=True)
+    console.print("\n".join(answer_text(rows)), soft_wrap=True)
+    console.print(cost_findings_text(info.findings), soft_wrap=True)
+    return info.html
 
 
 def animate_file(console: Console, file: Path, output: Path, *, steps: int, fps: int) -> None:
@@ -448,16 +472,16 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
     processes keep their built problems), then ``costs.csv``, the report and the findings."""
     from gaitopt.gait.api import as_model
-    from gaitopt.study.cost_findings import cost_findings_text
     from gaitopt.study.cost_study import (
         CostStudyError,
         CostStudySpec,
+        CostSweep,
         collect_rows,
+        run_direct_solves,
         write_cost_table,
         write_settings,
     )
     from gaitopt.study.driver import make_backend
-    from gaitopt.viz.cost_report import answer_text, write_cost_report
 
     start = time.perf_counter()
     powers: list[float] = []
@@ -490,16 +514,26 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                     raise UserError(str(exc)) from None
             run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
                               scheduler=scheduler, backend=backend)
+        if backend is not None:
+            def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
+                what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
+                        f" m  cost {outcome.row.cost:.4g}" if path is not None and outcome
+                        else (outcome.row.status if outcome else "the worker died"))
+                console.print(f"{'ok  ' if path else 'FAIL'} direct {sweep.model} "
+                              f"{sweep.case.tag}: {what}", soft_wrap=True)
+
+            console.print("direct (staged) solves of each case's speed-free optimum, the "
+                          "lower of the two optima is kept:", soft_wrap=True)
+            kept, solved, failed = run_direct_solves(spec, directory, backend, done)
+            console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
+                          soft_wrap=True)
     finally:
         if backend is not None:
             backend.close()
-    rows = collect_rows(spec, directory)
-    table = write_cost_table(directory, rows)
-    info = write_cost_report(directory, directory / "report")
-    console.print(f"table: {table}\nreport: {info.html}", soft_wrap=True)
-    console.print("\n".join(answer_text(rows)), soft_wrap=True)
-    console.print(cost_findings_text(info.findings), soft_wrap=True)
-    console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {info.html}",
+    table = write_cost_table(directory, collect_rows(spec, directory))
+    console.print(f"table: {table}", soft_wrap=True)
+    page = write_cost_reports(console, directory, directory / "report")
+    console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",
                   soft_wrap=True)
 
 

@@ -15,11 +15,13 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
+from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.study.cost_findings import COST_FINDING_IDS, assess_cost_findings, ranked
 from gaitopt.study.cost_study import (
     COST_STUDY_FILE,
     COST_TABLE_FILE,
+    DIRECT_FILE,
     CostCase,
     CostRow,
     CostStudyError,
@@ -32,7 +34,7 @@ from gaitopt.study.cost_study import (
 )
 from gaitopt.study.plan import START_SPEED
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, write_summary
-from gaitopt.viz.cost_report import write_cost_report
+from gaitopt.viz.cost_report import answer_text, write_cost_report
 
 COMPASS = Path(__file__).parents[1] / "analysis" / "data" / "compass.yaml"
 
@@ -272,9 +274,28 @@ def test_cli_cost_study_runs_and_resumes(tmp_path: Path) -> None:
     assert len(rows) == 1 and rows[0].success and rows[0].case == "paper"
     assert 8.0 < rows[0].speed_m_min < 15.0  # the paper's optimum, about 12 m/min
     assert (out / "report" / "report.html").exists()
-    assert (out / "five-link" / "paper" / "gaits" / "ankle+impulse" /
-            "speed-free.gait.json").exists()
+    # both starts were solved; the row is the lower optimum, the other's cost beside it
+    case = out / "five-link" / "paper"
+    costs = {start: Gait.load(case / name).cost_value for start, name in (
+        ("from 12 m/min", "gaits/ankle+impulse/speed-free.gait.json"),
+        ("direct", DIRECT_FILE))}
+    assert rows[0].cost_value == min(costs.values())
+    assert rows[0].start == min(costs, key=lambda k: costs[k])
+    assert rows[0].other_cost_value == max(costs.values())
     again = CliRunner().invoke(cli, args)
     assert again.exit_code == 0, again.output
-    assert "2 kept from an earlier run, 0 to solve" in " ".join(again.output.split())
+    text = " ".join(again.output.split())
+    assert "2 kept from an earlier run, 0 to solve" in text
+    assert "direct solves: 0 solved, 0 failed, 1 kept" in text
     assert read_cost_table(out / COST_TABLE_FILE)[0].as_csv_dict() == rows[0].as_csv_dict()
+
+
+def test_answer_prefers_peoples_settings() -> None:
+    """The answer names the nearest case with people's settings, and the nearest of all when
+    that is another (here a resting power four times people's)."""
+    rows = [_row("paper", "paper", 11.1, 0.107), _metabolic(1.2, 27.2, 0.33),
+            _metabolic(4.8, 43.9, 0.26)]
+    (text,) = answer_text(rows)
+    assert text.startswith("five-link (reduced): nearest to people's walk the "
+                           "metabolic-rest-1.2 cost, 27.2 m/min with 0.330 m steps (34% of")
+    assert "; of all cases the metabolic-rest-4.8 cost, 43.9 m/min" in text

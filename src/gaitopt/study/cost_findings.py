@@ -48,6 +48,12 @@ def _human_rest(row: CostRow) -> bool:
     return row.cost == "metabolic" and lo <= row.resting_power <= hi
 
 
+def physiological(row: CostRow) -> bool:
+    """Whether a case has people's settings: the paper's or the work cost, or the metabolic
+    cost at a human resting power (:data:`HUMAN_RESTING_POWER`)."""
+    return row.cost != "metabolic" or _human_rest(row)
+
+
 def _near(value: float, target: float) -> bool:
     return abs(value / target - 1.0) <= HUMAN_TOLERANCE
 
@@ -115,15 +121,15 @@ def _human_metabolic(rows: Sequence[CostRow], *, quantity: str) -> Finding:
 def _nearest(rows: Sequence[CostRow]) -> Finding:
     claim = ("Some cost with physiological settings (paper, work, metabolic at a human resting "
              "power) puts the optimum where people walk.")
-    physiological = [r for r in rows if r.success and (r.cost != "metabolic" or _human_rest(r))]
+    candidates = [r for r in rows if r.success and physiological(r)]
     solved = [r for r in rows if r.success]
-    if not physiological:
+    if not candidates:
         return Finding("costs.nearest_human", claim, None, "no such case solved")
     numbers = {f"human_distance.{r.case}": r.human_distance for r in solved}
-    best = min(physiological, key=lambda r: r.human_distance)
+    best = min(candidates, key=lambda r: r.human_distance)
     overall = min(solved, key=lambda r: r.human_distance)
     holds = any(_near(r.speed_m_min, HUMAN_OPTIMAL_SPEED_M_MIN)
-                and _near(r.step_length, HUMAN_STEP_LENGTH) for r in physiological)
+                and _near(r.step_length, HUMAN_STEP_LENGTH) for r in candidates)
     evidence = (f"nearest: {best.case} at {best.speed_m_min:.1f} m/min, step "
                 f"{best.step_length:.3f} m (distance {best.human_distance:.2f}; 0 is people's "
                 f"{HUMAN_OPTIMAL_SPEED_M_MIN:g} m/min and {HUMAN_STEP_LENGTH:g} m, 1.41 "

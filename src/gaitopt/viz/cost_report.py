@@ -23,7 +23,7 @@ from pathlib import Path
 from matplotlib.figure import Figure
 
 from gaitopt.fileio import write_text_atomic
-from gaitopt.study.cost_findings import assess_cost_findings, ranked
+from gaitopt.study.cost_findings import assess_cost_findings, physiological, ranked
 from gaitopt.study.cost_study import (
     COST_TABLE_FILE,
     HUMAN_RESTING_POWER,
@@ -100,7 +100,7 @@ def cost_table_html(rows: Sequence[CostRow]) -> str:
     head = ("<table><thead><tr><th>model</th><th>formulation</th><th>cost</th>"
             "<th>resting power [W/kg]</th><th>speed [m/min]</th><th>step length [m]</th>"
             "<th>step time [s]</th><th>cost value</th><th>distance from people's walk</th>"
-            "<th>status</th></tr></thead><tbody>")
+            "<th>start (the other start's cost)</th><th>status</th></tr></thead><tbody>")
     body = []
     for r in ranked(rows):
         body.append(
@@ -109,28 +109,36 @@ def cost_table_html(rows: Sequence[CostRow]) -> str:
             f"<td>{_fmt(r.resting_power, 'g')}</td><td>{_fmt(r.speed_m_min, '.1f')}</td>"
             f"<td>{_fmt(r.step_length, '.3f')}</td><td>{_fmt(r.step_time, '.3f')}</td>"
             f"<td>{_fmt(r.cost_value, '.4g')}</td><td>{_fmt(r.human_distance, '.2f')}</td>"
+            f"<td>{html.escape(r.start)} ({_fmt(r.other_cost_value, '.4g')})</td>"
             f"<td>{html.escape(r.status)}</td></tr>")
     lo, hi = HUMAN_RESTING_POWER
     body.append(f"<tr class='paper'><td>people</td><td></td><td>metabolic</td><td>{lo:g}-{hi:g}"
                 f"</td><td>≈ {HUMAN_OPTIMAL_SPEED_M_MIN:g}</td><td>≈ {HUMAN_STEP_LENGTH:g}</td>"
-                "<td></td><td></td><td>0</td><td></td></tr>")
+                "<td></td><td></td><td>0</td><td></td><td></td></tr>")
     return head + "".join(body) + "</tbody></table>"
 
 
 def answer_text(rows: Sequence[CostRow]) -> list[str]:
-    """One sentence per model: its optimum nearest to people's walk."""
+    """One sentence per model: its optimum nearest to people's walk among the cases with
+    people's settings (and among all cases, when another is nearer)."""
     out = []
     for model in dict.fromkeys(r.model for r in rows):
         solved = ranked([r for r in rows if r.model == model and r.success])
-        if not solved:
-            out.append(f"{model}: no case solved.")
+        human = [r for r in solved if physiological(r)]
+        if not human:
+            out.append(f"{model}: no case with people's settings solved.")
             continue
-        best = solved[0]
-        out.append(f"{model}: nearest to people's walk is the {best.case} cost, "
-                   f"{best.speed_m_min:.1f} m/min with {best.step_length:.3f} m steps "
-                   f"({best.speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN:.0%} of people's speed, "
-                   f"{best.step_length / HUMAN_STEP_LENGTH:.0%} of their step).")
+        text = f"{model} ({human[0].formulation}): nearest to people's walk " + _where(human[0])
+        if solved[0] is not human[0]:
+            text += "; of all cases " + _where(solved[0])
+        out.append(text + ".")
     return out
+
+
+def _where(r: CostRow) -> str:
+    return (f"the {r.case} cost, {r.speed_m_min:.1f} m/min with {r.step_length:.3f} m steps "
+            f"({r.speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN:.0%} of people's speed, "
+            f"{r.step_length / HUMAN_STEP_LENGTH:.0%} of their step)")
 
 
 def write_cost_report(study_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
