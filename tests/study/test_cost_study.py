@@ -182,6 +182,22 @@ def test_collect_write_read_and_report(five_link: RobotModel, tmp_path: Path) ->
     assert info.findings["five-link"]["costs.human_speed"].holds is False
 
 
+def test_cli_report_of_a_cost_study(five_link: RobotModel, tmp_path: Path) -> None:
+    """``gaitopt report DIR`` on a cost-study folder rewrites its report from ``costs.csv``;
+    without the table it says to finish the study (exit 2)."""
+    spec = CostStudySpec(models=(five_link,), costs=("paper",))
+    write_settings(spec, tmp_path)
+    result = CliRunner().invoke(cli, ["report", str(tmp_path)])
+    assert result.exit_code == 2, result.output
+    assert "rerun `gaitopt study --costs" in " ".join(result.output.split())
+    assert not (tmp_path / "report" / "report.html").exists()
+    write_cost_table(tmp_path, [_row("paper", "paper", 11.1, 0.107)])
+    result = CliRunner().invoke(cli, ["report", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    assert "(costs.nearest_human)" in result.output
+    assert (tmp_path / "report" / "report.html").exists()
+
+
 def test_missing_case_is_a_failed_row(five_link: RobotModel, tmp_path: Path) -> None:
     rows = collect_rows(CostStudySpec(models=(five_link,), costs=("paper",)), tmp_path)
     assert len(rows) == 1 and not rows[0].success and rows[0].status == "not solved"
