@@ -524,9 +524,21 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
 
             console.print("direct (staged) solves of each case's speed-free optimum, the "
                           "lower of the two optima is kept:", soft_wrap=True)
-            kept, solved, failed = run_direct_solves(spec, directory, backend, done)
+            try:
+                kept, solved, failed = run_direct_solves(spec, directory, backend, done)
+            except KeyboardInterrupt:
+                backend.close(wait=False)
+                backend = None
+                console.print("interrupted: every finished solve is saved; rerun the same "
+                              "command to resume", soft_wrap=True)
+                sys.exit(130)
             console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
                           soft_wrap=True)
+    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
+        if backend is not None:
+            backend.close(wait=False)
+            backend = None
+        raise
     finally:
         if backend is not None:
             backend.close()
