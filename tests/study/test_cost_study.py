@@ -79,6 +79,11 @@ def test_cases_and_their_sweeps(five_link: RobotModel) -> None:
         assert s.spec.speeds == (START_SPEED,) and s.spec.free_speed
         assert s.spec.variants == ("ankle+impulse",)
     assert [s.spec.base.resting_power for s in sweeps[2:]] == [0.0, 1.2, 2.4]
+    assert all(s.spec.base.swing_clearance is None for s in sweeps)
+    clear = CostStudySpec(models=(five_link,), costs=("work",), swing_clearance=0.02)
+    assert [s.spec.base.swing_clearance for s in clear.sweeps()] == [0.02]
+    assert clear.sweeps()[0].direct_task().options.swing_clearance == 0.02
+    assert clear.sweeps()[0].direct_task().options.speed is None
 
 
 def test_formulation_auto_is_reduced_only_for_the_five_link_shape(five_link: RobotModel) -> None:
@@ -97,6 +102,7 @@ def test_formulation_auto_is_reduced_only_for_the_five_link_shape(five_link: Rob
     ({"resting_powers": (1.2, 1.2)}, "at most once"),
     ({"resting_powers": ()}, "resting powers"),
     ({"regularization": -1.0}, "regularization"),
+    ({"swing_clearance": -0.01}, "swing clearance"),
     ({"formulation": "polar"}, "formulation"),
     ({"variant": "both"}, "variant"),
 ])

@@ -141,7 +141,9 @@ class CostStudySpec:
 
     ``costs`` a subset of paper, work, metabolic (the metabolic cost once per resting power);
     ``regularization`` the weight of ``int sum (u / u_max)^2 dt / T`` added to the work and
-    metabolic costs (``GaitOptions.cost_regularization``); ``formulation`` ``auto`` (see the
+    metabolic costs (``GaitOptions.cost_regularization``); ``swing_clearance`` (m) the least
+    mid-swing height of the swing tip in every case (``GaitOptions.swing_clearance``; None: no
+    such constraint); ``formulation`` ``auto`` (see the
     module docstring), ``reduced`` or ``full``; ``variant`` one of
     :data:`gaitopt.study.summary.VARIANTS`; ``knots`` per phase.
     """
@@ -150,6 +152,7 @@ class CostStudySpec:
     costs: tuple[str, ...] = ("paper", "work", "metabolic")
     resting_powers: tuple[float, ...] = DEFAULT_RESTING_POWERS
     regularization: float = 0.0
+    swing_clearance: float | None = None
     formulation: CostStudyFormulation = "auto"
     variant: str = "ankle+impulse"
     knots: tuple[int, int] = (8, 5)
@@ -179,6 +182,9 @@ class CostStudySpec:
                 raise CostStudyError("resting powers: each value at most once")
         if not (math.isfinite(self.regularization) and self.regularization >= 0.0):
             raise CostStudyError(f"regularization: {self.regularization!r}; allowed: >= 0")
+        if self.swing_clearance is not None and not (math.isfinite(self.swing_clearance)
+                                                     and self.swing_clearance >= 0.0):
+            raise CostStudyError(f"swing clearance: {self.swing_clearance!r} m; allowed: >= 0")
         if self.formulation not in ("auto", "reduced", "full"):
             raise CostStudyError(f"formulation: {self.formulation!r}; allowed: auto, reduced, "
                                  "full")
@@ -213,6 +219,8 @@ class CostStudySpec:
             for case in self.cases:
                 extra: dict[str, Any] = ({"cost_regularization": self.regularization}
                          if self.regularization > 0.0 and case.cost != "paper" else {})
+                if self.swing_clearance is not None:
+                    extra["swing_clearance"] = self.swing_clearance
                 base = GaitOptions(knots=self.knots, formulation=formulation, **case.options(),
                                    **extra)
                 spec = SweepSpec(model=model, speeds=(START_SPEED,), variants=(self.variant,),
@@ -227,6 +235,7 @@ class CostStudySpec:
                 "models": [{"name": m.name, "content_hash": m.content_hash(),
                             "formulation": self.formulation_of(m)} for m in self.models],
                 "cases": [c.tag for c in self.cases], "regularization": self.regularization,
+                "swing_clearance": self.swing_clearance,
                 "variant": self.variant, "knots": list(self.knots),
                 "human": {"speed_m_min": HUMAN_OPTIMAL_SPEED_M_MIN,
                           "step_length": HUMAN_STEP_LENGTH,
