@@ -422,13 +422,17 @@ def animate_command(file: Path, output: Path, steps: int, fps: int) -> None:
 @click.option("--clearance", type=float, default=None,
               help="With --costs: least mid-swing height of the swing tip in m, every case "
                    "(the work cost's optimum drags the swing tip otherwise).")
+@click.option("--gait", "gait_kind", type=click.Choice(["auto", "walk", "heel-toe"]),
+              default="auto", show_default=True,
+              help="With --costs: the contact sequence (auto: heel-toe for a model with feet, "
+                   "else the paper's walk).")
 @click.option("--formulation", type=click.Choice(["auto", "reduced", "full"]), default="auto",
               show_default=True, help="With --costs: the coordinates (auto: reduced for the "
                                       "five-link biped, full for any other model).")
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
                   cost_study: bool, costs: tuple[str, ...], resting_powers: str,
-                  regularization: float, clearance: float | None,
+                  regularization: float, clearance: float | None, gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
     optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
@@ -441,8 +445,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
         run_cost_study(console, directory or COSTS_DIR, model_names or ("five-link",),
                        costs=costs or ("paper", "work", "metabolic"),
                        resting_powers=resting_powers, regularization=regularization,
-                       clearance=clearance, formulation=formulation, workers=workers,
-                       scheduler=scheduler)
+                       clearance=clearance, gait=gait_kind, formulation=formulation,
+                       workers=workers, scheduler=scheduler)
         return
     if len(model_names) > 1:
         raise UserError("--model: the paper's study takes one model (several only with "
@@ -471,7 +475,7 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
 
 def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
                    costs: Sequence[str], resting_powers: str, regularization: float,
-                   formulation: str, clearance: float | None = None,
+                   formulation: str, clearance: float | None = None, gait: str = "auto",
                    workers: int | None, scheduler: str | None) -> None:
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
     processes keep their built problems), then ``costs.csv``, the report and the findings."""
@@ -498,7 +502,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
         spec = CostStudySpec(models=tuple(as_model(m) for m in model_names),
                              costs=tuple(dict.fromkeys(costs)),
                              resting_powers=tuple(powers), regularization=regularization,
-                             swing_clearance=clearance,
+                             swing_clearance=clearance, gait=gait,
                              formulation=formulation)  # type: ignore[arg-type]
         sweeps = spec.sweeps()
     except (CostStudyError, SweepSpecError, BipedStructureError) as exc:

@@ -17,6 +17,7 @@ from click.testing import CliRunner
 from gaitopt.cli import cli
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import RobotModel, load_model
+from gaitopt.robot.loader import model_from_dict
 from gaitopt.study.cost_findings import COST_FINDING_IDS, assess_cost_findings, ranked
 from gaitopt.study.cost_study import (
     COST_STUDY_FILE,
@@ -95,6 +96,25 @@ def test_formulation_auto_is_reduced_only_for_the_five_link_shape(five_link: Rob
         five_link) == "full"
 
 
+def test_gait_auto_is_heel_toe_for_a_model_with_feet(five_link: RobotModel) -> None:
+    """Two contact points on the first contact's link (a foot: heel and toe) make the gait
+    the heel-toe walk; the five-link model walks the paper's walk."""
+    data = five_link.to_dict()
+    data["name"] = "heeled"
+    data["contacts"] = [{"name": "heel_1", "link": "shank_1", "at": [0.5, -0.02]},
+                        {"name": "toe_1", "link": "shank_1", "at": [0.5, 0.08]},
+                        {"name": "heel_2", "link": "shank_2", "at": [0.5, -0.02]},
+                        {"name": "toe_2", "link": "shank_2", "at": [0.5, 0.08]}]
+    data["actuators"] = [a for a in data["actuators"] if a.get("contact") is None]
+    heeled = model_from_dict(data)
+    spec = CostStudySpec(models=(five_link, heeled), costs=("paper",))
+    assert (spec.gait_of(five_link), spec.gait_of(heeled)) == ("walk", "heel-toe")
+    five, feet = spec.sweeps()
+    assert (five.spec.base.gait, feet.spec.base.gait) == ("walk", "heel-toe")
+    assert feet.formulation == "full"
+    assert CostStudySpec(models=(heeled,), gait="walk").gait_of(heeled) == "walk"
+
+
 @pytest.mark.parametrize(("kwargs", "words"), [
     ({"costs": ("paper", "effort")}, "costs"),
     ({"costs": ()}, "costs"),
@@ -105,6 +125,7 @@ def test_formulation_auto_is_reduced_only_for_the_five_link_shape(five_link: Rob
     ({"swing_clearance": -0.01}, "swing clearance"),
     ({"formulation": "polar"}, "formulation"),
     ({"variant": "both"}, "variant"),
+    ({"gait": "hop"}, "gait"),
 ])
 def test_bad_requests_name_the_setting(five_link: RobotModel, kwargs: dict[str, Any],
                                        words: str) -> None:

@@ -24,7 +24,8 @@ table keeps which start won and the other's cost::
 ``<model>`` is the model's name, ``<case>`` ``paper``, ``work`` or ``metabolic-rest-1.2``
 (the resting power in W/kg). The formulation of a model is ``reduced`` (the paper's) when the
 model is the five-link biped that formulation describes and ``full`` otherwise (a model with
-feet or more links), unless one is asked for.
+feet or more links), unless one is asked for; its gait is the paper's walk, or the heel-toe
+walk for a model with feet (two contact points on a foot link).
 
 The distance of an optimum from human walking is
 ``d = sqrt((v / v_h - 1)^2 + (L / L_h - 1)^2)`` with ``v_h = 80 m/min`` and ``L_h = 0.75 m``
@@ -141,7 +142,8 @@ class CostStudySpec:
 
     ``costs`` a subset of paper, work, metabolic (the metabolic cost once per resting power);
     ``regularization`` the weight of ``int sum (u / u_max)^2 dt / T`` added to the work and
-    metabolic costs (``GaitOptions.cost_regularization``); ``swing_clearance`` (m) the least
+    metabolic costs (``GaitOptions.cost_regularization``); ``gait`` ``auto`` (see
+    :meth:`gait_of`), ``walk`` or ``heel-toe``; ``swing_clearance`` (m) the least
     mid-swing height of the swing tip in every case (``GaitOptions.swing_clearance``; None: no
     such constraint); ``formulation`` ``auto`` (see the
     module docstring), ``reduced`` or ``full``; ``variant`` one of
@@ -154,6 +156,7 @@ class CostStudySpec:
     regularization: float = 0.0
     swing_clearance: float | None = None
     formulation: CostStudyFormulation = "auto"
+    gait: str = "auto"
     variant: str = "ankle+impulse"
     knots: tuple[int, int] = (8, 5)
 
@@ -188,6 +191,8 @@ class CostStudySpec:
         if self.formulation not in ("auto", "reduced", "full"):
             raise CostStudyError(f"formulation: {self.formulation!r}; allowed: auto, reduced, "
                                  "full")
+        if self.gait not in ("auto", "walk", "heel-toe"):
+            raise CostStudyError(f"gait: {self.gait!r}; allowed: auto, walk, heel-toe")
         if self.variant not in VARIANTS:
             raise CostStudyError(f"variant: {self.variant!r}; allowed: {', '.join(VARIANTS)}")
 
@@ -211,6 +216,16 @@ class CostStudySpec:
             return "full"
         return "reduced"
 
+    def gait_of(self, model: RobotModel) -> str:
+        """``walk`` or ``heel-toe`` for ``model``: with ``gait="auto"``, ``heel-toe`` when the
+        link of the model's first contact carries two contact points (a foot with heel and
+        toe), else the paper's ``walk``."""
+        if self.gait != "auto":
+            return self.gait
+        link = model.contacts[0].link if model.contacts else None
+        on_link = [c for c in model.contacts if c.link == link]
+        return "heel-toe" if len(on_link) == 2 else "walk"
+
     def sweeps(self) -> tuple[CostSweep, ...]:
         """Every (model, case) sweep: the 12 m/min walk and the speed-free optimum."""
         out = []
@@ -221,6 +236,8 @@ class CostStudySpec:
                          if self.regularization > 0.0 and case.cost != "paper" else {})
                 if self.swing_clearance is not None:
                     extra["swing_clearance"] = self.swing_clearance
+                if self.gait_of(model) != "walk":
+                    extra["gait"] = self.gait_of(model)
                 base = GaitOptions(knots=self.knots, formulation=formulation, **case.options(),
                                    **extra)
                 spec = SweepSpec(model=model, speeds=(START_SPEED,), variants=(self.variant,),
@@ -233,7 +250,8 @@ class CostStudySpec:
         """The study's settings (``cost_study.json``)."""
         return {"format": COST_STUDY_FORMAT, "version": 1, "gaitopt_version": __version__,
                 "models": [{"name": m.name, "content_hash": m.content_hash(),
-                            "formulation": self.formulation_of(m)} for m in self.models],
+                            "formulation": self.formulation_of(m), "gait": self.gait_of(m)}
+                           for m in self.models],
                 "cases": [c.tag for c in self.cases], "regularization": self.regularization,
                 "swing_clearance": self.swing_clearance,
                 "variant": self.variant, "knots": list(self.knots),
