@@ -53,10 +53,34 @@ def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
 @click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder of the report (default: DIRECTORY/report).")
 def report_command(directory: Path, output: Path | None) -> None:
-    """Write the figures and the HTML report of a sweep, and print the findings."""
+    """Write the figures and the HTML report of a sweep (or of a cost study), and print the
+    findings."""
+    from gaitopt.study.cost_study import COST_STUDY_FILE
+
     if not directory.is_dir():
         raise UserError(f"{directory}: no such directory")
+    if (directory / COST_STUDY_FILE).exists():
+        write_cost_reports(make_console(), directory, output or directory / "report")
+        return
     write_reports(make_console(), directory, output or directory / "report")
+
+
+def write_cost_reports(console: Console, directory: Path, out: Path) -> Path:
+    """Write a cost study's report from its ``costs.csv``; print the answer and findings."""
+    from gaitopt.study.cost_findings import cost_findings_text
+    from gaitopt.study.cost_study import COST_TABLE_FILE, CostStudyError, read_cost_table
+    from gaitopt.viz.cost_report import answer_text, write_cost_report
+
+    try:
+        info = write_cost_report(directory, out)
+        rows = read_cost_table(directory / COST_TABLE_FILE)
+    except CostStudyError as exc:
+        raise UserError(f"{exc}; rerun `gaitopt study --costs -o {directory}` to finish the "
+                        "study") from None
+    console.print(f"report: {info.html}", soft_wrap=True)
+    console.print("\n".join(answer_text(rows)), soft_wrap=True)
+    console.print(cost_findings_text(info.findings), soft_wrap=True)
+    return info.html
 
 
 def animate_file(console: Console, file: Path, output: Path, *, steps: int, fps: int) -> None:

@@ -50,7 +50,7 @@ from gaitopt.study.driver import (
     default_workers,
     run_sweep,
 )
-from gaitopt.study.executors import BackendError
+from gaitopt.study.executors import Backend, BackendError
 from gaitopt.study.plan import SweepPoint, SweepSpec, SweepSpecError
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 from gaitopt.study.worker import PointOutcome
@@ -60,6 +60,9 @@ DEFAULT_SPEEDS = "3:60:3"
 #: Default speed grid of ``gaitopt study`` (m/min).
 STUDY_SPEEDS = "3:60:3"
 STUDY_DIR = Path("out/study")
+#: Default directory and resting powers (W/kg) of ``gaitopt study --costs``.
+COSTS_DIR = Path("out/costs")
+DEFAULT_RESTING_POWERS_TEXT = "0,0.6,1.2,2.4,4.8"
 MAX_SPEEDS = 2000
 
 
@@ -192,9 +195,11 @@ def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
 
 def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
                       workers: int | None, scheduler: str | None,
-                      fail_points: Sequence[str] = ()) -> SweepReport:
+                      fail_points: Sequence[str] = (),
+                      backend: Backend | None = None) -> SweepReport:
     """:func:`run_sweep` with a progress bar (done/failed/remaining, ETA) and a line per
-    finished point; errors the user can fix become :class:`UserError`."""
+    finished point; errors the user can fix become :class:`UserError`. ``backend``: run on
+    it (and leave it open) instead of starting one."""
     progress = Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
         TextColumn("failed {task.fields[failed]}  remaining {task.fields[remaining]}"),
@@ -221,7 +226,8 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
 
     try:
         report = run_sweep(spec, directory, workers=workers, scheduler=scheduler,
-                           on_start=on_start, on_point=on_point, fail_points=fail_points)
+                           on_start=on_start, on_point=on_point, fail_points=fail_points,
+                           backend=backend)
     except (SweepSpecError, SweepSettingsError, BackendError, GaitOptionsError,
             BipedStructureError) as exc:
         raise UserError(str(exc)) from None
@@ -301,24 +307,61 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 
 @cli.command("study")
 @click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
-              default=STUDY_DIR, show_default=True,
-              help="Study directory (the sweep; the report goes to its report/ folder).")
-@model_option
+              default=None, help=f"Study directory (the sweep; the report goes to its report/ "
+                                 f"folder) [default: {STUDY_DIR}; with --costs {COSTS_DIR}].")
+@click.option("--model", "model_names", multiple=True,
+              help="Built-in model name or model file [default: five-link]; with --costs "
+                   "repeat it to compare models.")
 @click.option("--speeds", default=STUDY_SPEEDS, show_default=True,
               help="Speeds in m/min: start:stop:step and/or a comma list.")
+@click.option("--costs", "cost_study", is_flag=True,
+              help="The cost study instead (docs/costs.md): each model's speed-free optimum "
+                   "of the paper's, the work and the metabolic cost at each resting power.")
+@click.option("--cost", "costs", multiple=True,
+              type=click.Choice(["paper", "work", "metabolic"]),
+              help="The cost study of these costs only (repeat it; implies --costs).")
+@click.option("--resting-powers", default=DEFAULT_RESTING_POWERS_TEXT, show_default=True,
+              help="With --costs: resting powers of the metabolic cost, W/kg (comma list).")
+@click.option("--regularization", type=float, default=0.0, show_default=True,
+              help="With --costs: weight of the torque regularisation added to the work and "
+                   "metabolic costs.")
+@click.option("--clearance", type=float, default=None,
+              help="With --costs: least mid-swing height of the swing tip in m, every case "
+                   "(the work cost's optimum drags the swing tip otherwise).")
+@click.option("--gait", "gait_kind", type=click.Choice(["auto", "walk", "heel-toe"]),
+              default="auto", show_default=True,
+              help="With --costs: the contact sequence (auto: heel-toe for a model with feet, "
+                   "else the paper's walk).")
+@click.option("--formulation", type=click.Choice(["auto", "reduced", "full"]), default="auto",
+              show_default=True, help="With --costs: the coordinates (auto: reduced for the "
+                                      "five-link biped, full for any other model).")
 @_workers_option
-def study_command(directory: Path, model_name: str, speeds: str, workers: int | None,
-                  scheduler: str | None) -> None:
+def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
+                  cost_study: bool, costs: tuple[str, ...], resting_powers: str,
+                  regularization: float, clearance: float | None, gait_kind: str,
+                  formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
     optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
-    Rerunning resumes."""
+    With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
     from gaitopt.study.summary import read_summary
 
     console = make_console()
+    if cost_study or costs:
+        run_cost_study(console, directory or COSTS_DIR, model_names or ("five-link",),
+                       costs=costs or ("paper", "work", "metabolic"),
+                       resting_powers=resting_powers, regularization=regularization,
+                       clearance=clearance, gait=gait_kind, formulation=formulation,
+                       workers=workers, scheduler=scheduler)
+        return
+    if len(model_names) > 1:
+        raise UserError("--model: the paper's study takes one model (several only with "
+                        "--costs)")
+    directory = directory or STUDY_DIR
     start = time.perf_counter()
-    spec = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
-                     step_length="free", single_support="0.85", knots="8,5")
+    spec = make_spec(model_name=model_names[0] if model_names else "five-link", speeds=speeds,
+                     variants="all", free=True, step_length="free", single_support="0.85",
+                     knots="8,5")
     run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
@@ -336,5 +379,92 @@ def study_command(directory: Path, model_name: str, speeds: str, workers: int | 
                   soft_wrap=True)
 
 
-__all__ = ["make_spec", "parse_speeds", "parse_variants", "run_with_progress", "study_command",
-           "sweep_command"]
+def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
+                   costs: Sequence[str], resting_powers: str, regularization: float,
+                   formulation: str, clearance: float | None = None, gait: str = "auto",
+                   workers: int | None, scheduler: str | None) -> None:
+    """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
+    processes keep their built problems), then ``costs.csv``, the report and the findings."""
+    from gaitopt.gait.api import as_model
+    from gaitopt.study.cost_study import (
+        CostStudyError,
+        CostStudySpec,
+        CostSweep,
+        collect_rows,
+        run_direct_solves,
+        write_cost_table,
+        write_settings,
+    )
+    from gaitopt.study.driver import make_backend
+
+    start = time.perf_counter()
+    powers: list[float] = []
+    for item in (i.strip() for i in resting_powers.split(",") if i.strip()):
+        try:
+            powers.append(float(item))
+        except ValueError:
+            raise UserError(f"--resting-powers: {item!r} is not a number (W/kg, >= 0)") from None
+    try:
+        spec = CostStudySpec(models=tuple(as_model(m) for m in model_names),
+                             costs=tuple(dict.fromkeys(costs)),
+                             resting_powers=tuple(powers), regularization=regularization,
+                             swing_clearance=clearance, gait=gait,
+                             formulation=formulation)  # type: ignore[arg-type]
+        sweeps = spec.sweeps()
+    except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
+        raise UserError(str(exc)) from None
+    write_settings(spec, directory)
+    console.print(f"cost study {directory}: {len(sweeps)} cases "
+                  f"({', '.join(m.name for m in spec.models)} x "
+                  f"{', '.join(c.tag for c in spec.cases)})", soft_wrap=True)
+    backend = None
+    try:
+        for k, sweep in enumerate(sweeps, start=1):
+            console.print(f"[{k}/{len(sweeps)}] {sweep.model} ({sweep.formulation}): "
+                          f"{sweep.case.label}", soft_wrap=True)
+            if backend is None:
+                try:
+                    backend = make_backend(workers=workers, scheduler=scheduler)
+                except BackendError as exc:
+                    raise UserError(str(exc)) from None
+            run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
+                              scheduler=scheduler, backend=backend)
+        if backend is not None:
+            def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
+                what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
+                        f" m  cost {outcome.row.cost:.4g}" if path is not None and outcome
+                        else (outcome.row.status if outcome else "the worker died"))
+                console.print(f"{'ok  ' if path else 'FAIL'} direct {sweep.model} "
+                              f"{sweep.case.tag}: {what}", soft_wrap=True)
+
+            console.print("direct (staged) solves of each case's speed-free optimum, the "
+                          "lower of the two optima is kept:", soft_wrap=True)
+            try:
+                kept, solved, failed = run_direct_solves(spec, directory, backend, done)
+            except KeyboardInterrupt:
+                backend.close(wait=False)
+                backend = None
+                console.print("interrupted: every finished solve is saved; rerun the same "
+                              "command to resume", soft_wrap=True)
+                sys.exit(130)
+            console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
+                          soft_wrap=True)
+    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
+        if backend is not None:
+            backend.close(wait=False)
+            backend = None
+        raise
+    finally:
+        if backend is not None:
+            backend.close()
+    table = write_cost_table(directory, collect_rows(spec, directory))
+    console.print(f"table: {table}", soft_wrap=True)
+    from gaitopt.cli.report import write_cost_reports
+
+    page = write_cost_reports(console, directory, directory / "report")
+    console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",
+                  soft_wrap=True)
+
+
+__all__ = ["make_spec", "parse_speeds", "parse_variants", "run_cost_study", "run_with_progress",
+           "study_command", "sweep_command"]

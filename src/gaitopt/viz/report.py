@@ -317,3 +317,12 @@ def _page(title: str, sections: Sequence[str], rows: Sequence[SummaryRow]) -> st
     return ("<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
             f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
             f"<h1>{html.escape(title)}</h1>{intro}" + "\n".join(sections) + "</body></html>\n")
+
+
+def html_page(title: str, intro_html: str, sections: Sequence[str]) -> str:
+    """A self-contained HTML page in the report's style: the title, an introduction (HTML)
+    and the sections (HTML), no external resource."""
+    return ("<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
+            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
+            f"<h1>{html.escape(title)}</h1>{intro_html}" + "\n".join(sections)
+            + "</body></html>\n")
