@@ -40,7 +40,8 @@ from gaitopt.cli.base import (
     resting_power_option,
 )
 from gaitopt.cli.report import animate_file, write_reports
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.formulation import default_formulation
+from gaitopt.gait.options import GAITS, GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import (
     Counts,
@@ -274,7 +275,12 @@ def _workers_option(f: Any) -> Any:
 @click.option("--single-support", default="0.85", show_default=True,
               help="Single-support fractions of the step time (comma list).")
 @knots_option
-@formulation_option(help="The coordinates of every point (docs/formulations.md).")
+@formulation_option(help="The coordinates of every point (docs/formulations.md) [default: "
+                         "reduced for the five-link shape and the walk, else full].",
+                    default=None)
+@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default="walk",
+              show_default=True, help="The contact sequence of every point (heel-toe: feet, "
+                                      "e.g. --model seven-link).")
 @cost_option(help="The cost of every point (docs/costs.md).")
 @resting_power_option
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
@@ -282,8 +288,9 @@ def _workers_option(f: Any) -> Any:
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str,
-                  formulation: str, cost: str, resting_power: float | None,
-                  control_model: str, workers: int | None, scheduler: str | None) -> None:
+                  formulation: str | None, gait_kind: str, cost: str,
+                  resting_power: float | None, control_model: str, workers: int | None,
+                  scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -291,8 +298,15 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     failed.
     """
     console = make_console()
+    if formulation is None:
+        from gaitopt.gait.api import as_model
+
+        try:
+            formulation = default_formulation(as_model(model_name), gait_kind, False)
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "control_model": control_model}
+                               "control_model": control_model, "gait": gait_kind}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
