@@ -78,6 +78,28 @@ def parse_knots(text: str) -> tuple[int, int]:
     return (values[0], values[1])
 
 
+def grid_choice(knots: str | None, control_model: str | None,
+                paper_grid: bool) -> dict[str, Any]:
+    """The ``knots`` and ``control_model`` of ``--knots``, ``--control-model`` and
+    ``--paper-grid`` (the paper's 8 + 5 knots and control model, ``GaitOptions.paper``);
+    unset ones keep the :class:`~gaitopt.gait.options.GaitOptions` defaults. ``--paper-grid``
+    with either of the others is a usage error."""
+    from gaitopt.gait.options import PAPER_GRID
+
+    if paper_grid:
+        given = [o for o, v in (("--knots", knots), ("--control-model", control_model)) if v]
+        if given:
+            raise UserError(f"--paper-grid sets the knots (8,5) and the control model "
+                            f"(paper); do not combine it with {' or '.join(given)}")
+        return dict(PAPER_GRID)
+    out: dict[str, Any] = {}
+    if knots is not None:
+        out["knots"] = parse_knots(knots)
+    if control_model is not None:
+        out["control_model"] = control_model
+    return out
+
+
 def make_console() -> Console:
     """A rich console on stdout; at least :data:`PIPE_WIDTH` columns when not a terminal
     (unless ``COLUMNS`` says otherwise), so piped tables are not squeezed to 80 columns.

@@ -15,9 +15,9 @@ from gaitopt.cli_base import (
     USER_ERRORS,
     UserError,
     cli,
+    grid_choice,
     make_console,
     parse_free_or_value,
-    parse_knots,
     parse_pair,
 )
 from gaitopt.gait.formulation import biped_of
@@ -67,8 +67,12 @@ def _step_time(text: str) -> float | None:
 @click.option("--single-support-bounds", default=None,
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
-@click.option("--knots", default="8,5", show_default=True,
-              help="Grid points per phase: single support, double support.")
+@click.option("--knots", default=None,
+              help="Grid points per phase: single support, double support [default: "
+                   f"{','.join(map(str, GaitOptions().knots))}].")
+@click.option("--paper-grid", is_flag=True,
+              help="The paper's setting: 8+5 knots and its control model (continuous, "
+                   "periodic controls); its cost is about 13 % above the converged one.")
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
               default=GaitOptions().transcription, show_default=True,
               help="hermite-simpson-separated: the same scheme with the midpoint states as "
@@ -101,10 +105,9 @@ def _step_time(text: str) -> float | None:
               help="Resting power of the metabolic cost, W/kg [default: 1.2].")
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="Weight of an added mean squared torque (u / u_max)^2 term.")
-@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
-              show_default=True,
-              help="Controls continuous at the heel strike and periodic (paper), or free to "
-                   "jump at both events (jumps).")
+@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default=None,
+              help="Torques free to jump at both events (jumps), or continuous at the heel "
+                   f"strike and periodic (paper) [default: {GaitOptions().control_model}].")
 @click.option("--mesh-tol", type=float, default=None,
               help="Refine the mesh until every interval's collocation error estimate is "
                    "<= TOL (e.g. 1e-4); default: the fixed grid --knots.")
@@ -126,13 +129,14 @@ def _step_time(text: str) -> float | None:
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
                   impulse: bool,
-                  single_support: float, knots: str, transcription: str,
+                  single_support: float, knots: str | None, paper_grid: bool,
+                  transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
                   gait_kind: str, cost: str,
                   resting_power: float | None, regularization: float,
-                  control_model: str, mesh_tol: float | None,
+                  control_model: str | None, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
@@ -152,14 +156,14 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     options = GaitOptions(
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
-        single_support_fraction=single_support, knots=parse_knots(knots),
+        single_support_fraction=single_support,
+        **grid_choice(knots, control_model, paper_grid),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
         formulation=formulation,  # type: ignore[arg-type]
         gait=gait_kind, cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
-        control_model=control_model,  # type: ignore[arg-type]
         mesh_tol=mesh_tol, swing_clearance=clearance,
         clearance_profile=clearance_profile)  # type: ignore[arg-type]
     if resting_power is not None:
@@ -178,8 +182,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots, {options.formulation} "
-                  "coordinates")
+                  + f", {options.knots[0]}+{options.knots[1]} knots, control model "
+                  f"{options.control_model}"
+                  + (" (the paper's grid)" if options.paper_grid else "")
+                  + f", {options.formulation} coordinates")
 
     if (start is None and not multistart and options.speed is not None
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
@@ -260,8 +266,14 @@ def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
         rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
     else:
         prev = "+".join(str(k) for k in accuracy["previous_knots"].values())
-        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s (change "
-                     f"from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+        rel = accuracy.get("cost_error_relative")
+        share = "" if rel is None else f" = {100 * rel:.2g} % of J"
+        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} "
+                     f"(change from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+        dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
+        if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
+            rows.append(("change from " + prev + " knots",
+                         f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"))
     return rows
 
 

@@ -26,7 +26,14 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from gaitopt.cli_base import UserError, cli, make_console, parse_free_or_value, parse_knots
+from gaitopt.cli_base import (
+    UserError,
+    cli,
+    grid_choice,
+    make_console,
+    parse_free_or_value,
+    parse_knots,
+)
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
@@ -134,10 +141,11 @@ def parse_fractions(text: str) -> tuple[float, ...]:
 
 
 def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
-              single_support: str, knots: str, step_time: str = "free",
+              single_support: str, knots: str | None = None, step_time: str = "free",
               problem: dict[str, Any] | None = None) -> SweepSpec:
     """The sweep of the CLI's options; ``problem`` holds further :class:`GaitOptions` fields
-    shared by every point (formulation, cost, control model, ...)."""
+    shared by every point (formulation, cost, control model, ...); ``knots`` None keeps
+    the default grid (or ``problem``'s)."""
     from gaitopt.gait.api import as_model
 
     model = as_model(model_name)
@@ -148,7 +156,8 @@ def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_l
                          step_times=parse_step_lengths(step_time, option="--step-time",
                                                        unit="s", quantity="time"),
                          single_support=parse_fractions(single_support),
-                         base=GaitOptions(knots=parse_knots(knots), **(problem or {})))
+                         base=GaitOptions(**{**(problem or {}), **(
+                             {} if knots is None else {"knots": parse_knots(knots)})}))
     except SweepSpecError as exc:
         raise UserError(str(exc)) from None
 
@@ -256,22 +265,27 @@ def _workers_option(f: Any) -> Any:
               help="Step times in s (comma list), or 'free'; not with --step-length.")
 @click.option("--single-support", default="0.85", show_default=True,
               help="Single-support fractions of the step time (comma list).")
-@click.option("--knots", default="8,5", show_default=True,
-              help="Grid points per phase: single support, double support.")
+@click.option("--knots", default=None,
+              help="Grid points per phase: single support, double support [default: "
+                   f"{','.join(map(str, GaitOptions().knots))}].")
+@click.option("--paper-grid", is_flag=True,
+              help="The paper's setting: 8+5 knots and its control model (continuous, "
+                   "periodic controls).")
 @click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
               show_default=True, help="The coordinates of every point (docs/formulations.md).")
 @click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
               show_default=True, help="The cost of every point (docs/costs.md).")
 @click.option("--resting-power", type=float, default=None,
               help="Resting power of the metabolic cost, W/kg [default: 1.2].")
-@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
-              show_default=True, help="Controls continuous and periodic (paper) or free to "
-                                      "jump at the events.")
+@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default=None,
+              help="Torques free to jump at the events (jumps) or continuous and periodic "
+                   f"(paper) [default: {GaitOptions().control_model}].")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
-                  step_length: str, step_time: str, single_support: str, knots: str,
-                  formulation: str, cost: str, resting_power: float | None,
-                  control_model: str, workers: int | None, scheduler: str | None) -> None:
+                  step_length: str, step_time: str, single_support: str, knots: str | None,
+                  paper_grid: bool, formulation: str, cost: str,
+                  resting_power: float | None, control_model: str | None,
+                  workers: int | None, scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -280,11 +294,11 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     """
     console = make_console()
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "control_model": control_model}
+                               **grid_choice(knots, control_model, paper_grid)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
-                     step_length=step_length, single_support=single_support, knots=knots,
+                     step_length=step_length, single_support=single_support,
                      step_time=step_time, problem=problem)
     report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
     if report.counts.failed:

@@ -36,10 +36,10 @@ def test_an_unknown_control_model_is_refused() -> None:
     result = CliRunner().invoke(cli, ["solve", "--control-model", "smooth"])
     assert result.exit_code == 2 and "smooth" in result.output
     with pytest.raises(GaitOptionsError, match=r"control_model = 'smooth': must be one of"):
-        validate_options(GaitOptions(control_model="smooth"),  # type: ignore[arg-type]
+        validate_options(GaitOptions.paper(control_model="smooth"),  # type: ignore[arg-type]
                          biped_structure(load_model("five-link")))
     with pytest.raises(GaitOptionsError, match=r"clearance_profile = 'sine'"):
-        validate_options(GaitOptions(swing_clearance=0.01,
+        validate_options(GaitOptions.paper(swing_clearance=0.01,
                                      clearance_profile="sine"),  # type: ignore[arg-type]
                          biped_structure(load_model("five-link")))
 

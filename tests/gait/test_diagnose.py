@@ -30,7 +30,7 @@ def _weak_biped() -> object:
 
 
 def test_infeasible_torque_bounds_are_named() -> None:
-    solution = solve_gait_solution(_weak_biped(), GaitOptions(continuation=False))
+    solution = solve_gait_solution(_weak_biped(), GaitOptions.paper(continuation=False))
     assert not solution.success
     text = diagnose(solution).text()
     assert "torque knee_1 at its bound (-5, 5 N m)" in text
