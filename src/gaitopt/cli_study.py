@@ -391,20 +391,34 @@ def animate_command(file: Path, output: Path, steps: int, fps: int) -> None:
               help="Built-in model name or model file.")
 @click.option("--speeds", default=STUDY_SPEEDS, show_default=True,
               help="Speeds in m/min: start:stop:step and/or a comma list.")
+@click.option("--paper-grid", is_flag=True,
+              help="The paper's setting: 8+5 knots and its control model (continuous, "
+                   "periodic controls); checked against 16+6 knots.")
 @_workers_option
-def study_command(directory: Path, model_name: str, speeds: str, workers: int | None,
-                  scheduler: str | None) -> None:
+def study_command(directory: Path, model_name: str, speeds: str, paper_grid: bool,
+                  workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
-    optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
-    Rerunning resumes."""
+    optimum, the same on a finer grid (DIR/check-grid) for the error estimates, then the
+    report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
+    optimal walk. Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
+    from gaitopt.study.grid_error import CHECK_DIR, check_knots
     from gaitopt.study.summary import read_summary
 
     console = make_console()
     start = time.perf_counter()
+    grid = grid_choice(None, None, paper_grid)
     spec = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
-                     step_length="free", single_support="0.85", knots="8,5")
+                     step_length="free", single_support="0.85", problem=grid)
     run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    finer = check_knots(spec.knots)
+    console.print(f"check grid {finer[0]}+{finer[1]} knots (the error estimates):",
+                  soft_wrap=True)
+    check = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
+                      step_length="free", single_support="0.85",
+                      problem={**grid, "knots": finer})
+    run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
+                      scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
     rows = read_summary(directory / SUMMARY_FILE)

@@ -37,6 +37,10 @@ CLEARANCE_PROFILES = ("parabola", "quartic")
 #: periodic): :meth:`GaitOptions.paper` and ``--paper-grid``. Its cost is about 13 % above
 #: the fine-grid limit (docs/walking.md, section 6); it is kept to reproduce the paper.
 PAPER_GRID: dict[str, Any] = {"knots": (8, 5), "control_model": "paper"}
+#: Fields whose default changed, with the value they had before: a gait file or sweep written
+#: before the field existed was solved with it (the control model arrived while the paper's
+#: was the default), so data that lacks the field means this value, not today's default.
+LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper"}
 
 
 class GaitOptionsError(ValueError):
@@ -194,14 +198,23 @@ class GaitOptions:
         return data
 
     @staticmethod
+    def saved_defaults() -> dict[str, Any]:
+        """What a field missing from saved options (a gait file, ``sweep.json``) stands for:
+        today's default, or its :data:`LEGACY_DEFAULTS` value (plain data, as
+        :meth:`to_dict`)."""
+        return {**GaitOptions().to_dict(), **LEGACY_DEFAULTS}
+
+    @staticmethod
     def from_dict(data: dict[str, Any]) -> GaitOptions:
+        """Options from saved data (:meth:`to_dict`); a missing field takes its
+        :meth:`saved_defaults` value."""
         fields = {f.name for f in dataclasses.fields(GaitOptions)}
         unknown = sorted(set(data) - fields)
         if unknown:
             raise GaitOptionsError(f"unknown gait option(s) {', '.join(unknown)}; known: "
                                    f"{', '.join(sorted(fields))}")
         clean: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v
-                                 for k, v in data.items()}
+                                 for k, v in {**LEGACY_DEFAULTS, **data}.items()}
         return GaitOptions(**clean)
 
 
