@@ -47,7 +47,7 @@ def test_an_unknown_control_model_is_refused() -> None:
 def test_the_options_reach_the_gait_file_and_the_summary(tmp_path: Path) -> None:
     out = tmp_path / "jumps.gait.json"
     result = CliRunner(env={"COLUMNS": "200"}).invoke(cli, ["solve", "--control-model", "jumps",
-                                                            "--clearance",
+                                                            "--knots", "8,5", "--clearance",
                                       "0.01", "-o", str(out)])
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())

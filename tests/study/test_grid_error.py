@@ -112,3 +112,15 @@ def test_the_report_states_each_figures_grid_and_error(tmp_path: Path) -> None:
     assert "speed +0.50 m/min, step +0.0010 m" in html  # headline, free optimum
     # Fig. 7 shows the optima without impulse (checked) and gaits at 50 m/min (not checked).
     assert f"at 2 speed-free optima): {expected}" in html
+
+
+def test_the_statement_says_where_the_estimate_exceeds_one_percent() -> None:
+    study = [row("plain", v, 1000.0, 0.3) for v in (12.0, 45.0, 60.0)]
+    check = [row("plain", 12.0, 999.0, 0.3), row("plain", 45.0, 1015.0, 0.3),
+             row("plain", 60.0, 1020.0, 0.3)]
+    errors = GridError.compare(study, check, knots=(16, 6), control_model="jumps",
+                               check=(24, 8))
+    text = errors.statement()
+    assert f"cost within {100 * 20 / 1020:.2f} %" in text
+    assert f"above 1 % at 2 of 3 points (45-60 m/min), within {100 / 999:.2f} % at the " \
+           "others" in text

@@ -31,6 +31,9 @@ from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, read_summary
 
 #: The check grid of the known study grids; any other grid is refined by half its knots.
 CHECK_KNOTS: dict[tuple[int, int], tuple[int, int]] = {(16, 6): (24, 8), (8, 5): (16, 6)}
+#: The relative cost change the statements single out: where the estimate exceeds it, they say
+#: at how many points and at which speeds.
+WITHIN = 0.01
 #: The folder of the check sweep inside the study directory.
 CHECK_DIR = "check-grid"
 
@@ -130,6 +133,14 @@ class GridError:
         else:
             worst = max(p.cost for p in chosen)
             value = f"cost within {100 * worst:.2f} %"
+            above = [p for p in chosen if p.cost > WITHIN]
+            if above:
+                speeds = sorted(p.row.speed_m_min for p in above)
+                span = (f"{speeds[0]:g} m/min" if speeds[0] == speeds[-1] else
+                        f"{speeds[0]:g}-{speeds[-1]:g} m/min")
+                below = max((p.cost for p in chosen if p.cost <= WITHIN), default=0.0)
+                value += (f"; above {100 * WITHIN:g} % at {len(above)} of {len(chosen)} "
+                          f"points ({span}), within {100 * below:.2f} % at the others")
         return (f"Grid: {self.grid}. Error estimate (change to {check} at {where}): "
                 f"{value}.")
 
