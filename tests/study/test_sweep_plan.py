@@ -135,7 +135,7 @@ def test_every_point_is_validated_before_any_solve() -> None:
 def test_settings_differences_name_each_changed_field() -> None:
     a = sweep_settings(spec())
     assert settings_differences(a, sweep_settings(spec())) == []
-    b = sweep_settings(spec(speeds=(0.2,), base=GaitOptions.paper(tol=1e-6)))
+    b = sweep_settings(spec(speeds=(0.2,), base=GaitOptions(tol=1e-6)))
     diffs = settings_differences(a, b)
     assert any(d.startswith("speeds_m_min:") for d in diffs)
     assert any(d.startswith("options.tol:") for d in diffs)
