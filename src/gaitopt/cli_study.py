@@ -402,7 +402,7 @@ def study_command(directory: Path, model_name: str, speeds: str, paper_grid: boo
     report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
     optimal walk. Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
-    from gaitopt.study.grid_error import CHECK_DIR, check_knots
+    from gaitopt.study.grid_error import CHECK_DIR, check_knots, grid_error
     from gaitopt.study.summary import read_summary
 
     console = make_console()
@@ -422,6 +422,17 @@ def study_command(directory: Path, model_name: str, speeds: str, paper_grid: boo
     out = directory / "report"
     pages = write_reports(console, directory, out)
     rows = read_summary(directory / SUMMARY_FILE)
+    errors = grid_error(directory, rows)
+    if errors is not None:
+        console.print(errors.statement(), soft_wrap=True)
+        for v in VARIANTS:
+            p = errors.free(v)
+            if p is not None:
+                console.print(f"  {v} optimum {p.row.speed_m_min:.2f} m/min, step "
+                              f"{p.row.step_length:.4f} m, cost {p.row.cost:.4g}; on the check "
+                              f"grid speed {p.speed_m_min:+.2f} m/min, step "
+                              f"{p.step_length:+.4f} m, cost {100 * p.cost:.2f} %",
+                              soft_wrap=True)
     best = next((r for v in VARIANTS if (r := optimal_row(rows, v)) is not None), None)
     if best is not None:
         animate_file(console, directory / best.file, out / "optimal-walk.gif", steps=4,
