@@ -143,7 +143,7 @@ def best_of(repeat: int, name: str, knots: tuple[int, int],
 def bench_grid(knots: tuple[int, int], repeat: int,
                formulation: str = "reduced") -> list[Measure]:
     model = load_model("five-link")
-    options = GaitOptions(speed=SPEED, knots=knots,
+    options = GaitOptions.paper(speed=SPEED, knots=knots,
                           formulation=formulation)  # type: ignore[arg-type]
     clear_cache()  # the process-wide NLP cache: a fresh start
     fresh, _ = measure("cold (fresh)", knots, lambda: solve_walking(model, options))

@@ -52,7 +52,7 @@ def pool_start_s(workers: int, method: str) -> float:
 def build_s() -> float:
     """One transcription build (the no-ankle structure) in this process."""
     start = time.perf_counter()
-    transcription_for(load_model("five-link"), GaitOptions(ankle=False), (8, 5))
+    transcription_for(load_model("five-link"), GaitOptions.paper(ankle=False), (8, 5))
     return time.perf_counter() - start
 
 
@@ -96,7 +96,8 @@ def main() -> None:
     args = parser.parse_args()
 
     spec = SweepSpec(model=load_model("five-link"), speeds=parse_speeds(args.speeds),
-                     variants=VARIANTS, free_speed=args.free)
+                     variants=VARIANTS, free_speed=args.free,
+                     base=GaitOptions.paper())  # the figures of docs/studies.md: 8+5 knots
     n = len(spec.points)
     load = os.getloadavg()[0]
     print(f"sweep benchmark: {len(spec.variants)} variants x {len(spec.speeds)} speeds"

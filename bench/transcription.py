@@ -47,7 +47,7 @@ SPEED_STEP = 1.05  # the neighbouring gait of the warm start
 def _options(form: str, knots: tuple[int, int], speed: float = SPEED) -> Any:
     from gaitopt.gait.options import GaitOptions
 
-    return GaitOptions(speed=speed, knots=knots, transcription=form)  # type: ignore[arg-type]
+    return GaitOptions.paper(speed=speed, knots=knots, transcription=form)  # type: ignore[arg-type]
 
 
 def worker_cold(form: str, knots: tuple[int, int], exact_fine: bool, out: str) -> dict[str, Any]:

@@ -53,7 +53,7 @@ GAINS = (300.0, 30.0)
 @pytest.fixture(scope="module")
 def gait() -> Gait:
     """The paper's problem at 12 m/min on the coarse grid (8 + 5 knots), a few seconds."""
-    return solve_gait("five-link", GaitOptions(speed=0.2))
+    return solve_gait("five-link", GaitOptions.paper(speed=0.2))
 
 
 @pytest.fixture(scope="module")
@@ -310,7 +310,7 @@ def test_cli_reports_a_replay_that_never_lands(gait: Gait, tmp_path: Path) -> No
 @pytest.fixture(scope="module")
 def single_support_gait() -> Gait:
     """A walk without double support (``single_support_fraction = 1``), 8 knots."""
-    return solve_gait("five-link", GaitOptions(speed=0.2, single_support_fraction=1.0))
+    return solve_gait("five-link", GaitOptions.paper(speed=0.2, single_support_fraction=1.0))
 
 
 def test_single_support_walk_strikes_and_lifts_off_at_once(single_support_gait: Gait) -> None:

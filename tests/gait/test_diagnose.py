@@ -37,7 +37,7 @@ def _weak_biped() -> object:
 
 
 def test_infeasible_torque_bounds_are_named() -> None:
-    solution = solve_gait_solution(_weak_biped(), GaitOptions(continuation=False))
+    solution = solve_gait_solution(_weak_biped(), GaitOptions.paper(continuation=False))
     assert not solution.success
     diagnosis = diagnose(solution)
     text = diagnosis.text()

@@ -92,9 +92,20 @@ def model_option(f: F) -> F:
 
 
 def knots_option(f: F) -> F:
-    """``--knots SINGLE,DOUBLE`` (text; parse with :func:`parse_knots`)."""
-    return click.option("--knots", default="8,5", show_default=True,
-                        help="Grid points per phase: single support, double support.")(f)
+    """``--knots SINGLE,DOUBLE`` (text or None: the default grid; see :func:`grid_choice`)."""
+    from gaitopt.gait.options import GaitOptions
+
+    return click.option("--knots", default=None,
+                        help="Grid points per phase: single support, double support [default: "
+                             f"{','.join(map(str, GaitOptions().knots))}].")(f)
+
+
+def paper_grid_option(f: F) -> F:
+    """``--paper-grid``: the paper's 8 + 5 knots and control model (:func:`grid_choice`)."""
+    return click.option("--paper-grid", is_flag=True,
+                        help="The paper's setting: 8+5 knots and its control model "
+                             "(continuous, periodic controls); its cost is about 13 % above "
+                             "the converged one.")(f)
 
 
 def resting_power_option(f: F) -> F:
@@ -117,9 +128,35 @@ def cost_option(help: str) -> Callable[[F], F]:
 
 
 def control_model_option(help: str) -> Callable[[F], F]:
-    """``--control-model paper|jumps`` with this help text."""
+    """``--control-model paper|jumps`` with this help text (None: the default, see
+    :func:`grid_choice`)."""
+    from gaitopt.gait.options import GaitOptions
+
     return click.option("--control-model", type=click.Choice(get_args(ControlModel)),
-                        default="paper", show_default=True, help=help)
+                        default=None,
+                        help=f"{help} [default: {GaitOptions().control_model}]")
+
+
+def grid_choice(knots: str | None, control_model: str | None,
+                paper_grid: bool) -> dict[str, Any]:
+    """The ``knots`` and ``control_model`` of ``--knots``, ``--control-model`` and
+    ``--paper-grid`` (the paper's 8 + 5 knots and control model, ``GaitOptions.paper``);
+    unset ones keep the :class:`~gaitopt.gait.options.GaitOptions` defaults. ``--paper-grid``
+    with either of the others is a usage error."""
+    from gaitopt.gait.options import PAPER_GRID
+
+    if paper_grid:
+        given = [o for o, v in (("--knots", knots), ("--control-model", control_model)) if v]
+        if given:
+            raise UserError(f"--paper-grid sets the knots (8,5) and the control model "
+                            f"(paper); do not combine it with {' or '.join(given)}")
+        return dict(PAPER_GRID)
+    out: dict[str, Any] = {}
+    if knots is not None:
+        out["knots"] = parse_knots(knots)
+    if control_model is not None:
+        out["control_model"] = control_model
+    return out
 
 
 def make_console() -> Console:

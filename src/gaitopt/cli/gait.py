@@ -18,11 +18,12 @@ from gaitopt.cli.base import (
     control_model_option,
     cost_option,
     formulation_option,
+    grid_choice,
     knots_option,
     make_console,
     model_option,
+    paper_grid_option,
     parse_free_or_value,
-    parse_knots,
     parse_pair,
     resting_power_option,
 )
@@ -95,6 +96,7 @@ def _step_time(text: str) -> float | None:
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
 @knots_option
+@paper_grid_option
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
               default=GaitOptions().transcription, show_default=True,
               help="hermite-simpson-separated: the same scheme with the midpoint states as "
@@ -154,13 +156,14 @@ def _step_time(text: str) -> float | None:
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
                   impulse: bool,
-                  single_support: float, knots: str, transcription: str,
+                  single_support: float, knots: str | None, paper_grid: bool,
+                  transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
                   gait_kind: str, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
-                  control_model: str, mesh_tol: float | None,
+                  control_model: str | None, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
@@ -184,14 +187,14 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         contact_sequence=sequence,
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
-        single_support_fraction=single_support, knots=parse_knots(knots),
+        single_support_fraction=single_support,
+        **grid_choice(knots, control_model, paper_grid),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
         formulation=formulation,  # type: ignore[arg-type]
         gait=gait_kind, cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
-        control_model=control_model,  # type: ignore[arg-type]
         mesh_tol=mesh_tol, swing_clearance=clearance,
         clearance_profile=clearance_profile)  # type: ignore[arg-type]
     if resting_power is not None:
@@ -211,8 +214,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots, {options.formulation} "
-                  "coordinates")
+                  + f", {options.knots[0]}+{options.knots[1]} knots, control model "
+                  f"{options.control_model}"
+                  + (" (the paper's grid)" if options.paper_grid else "")
+                  + f", {options.formulation} coordinates")
 
     if (start is None and not multistart and options.speed is not None
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
@@ -294,8 +299,14 @@ def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
         rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
     else:
         prev = "+".join(str(k) for k in accuracy["previous_knots"].values())
-        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s (change "
-                     f"from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+        rel = accuracy.get("cost_error_relative")
+        share = "" if rel is None else f" = {100 * rel:.2g} % of J"
+        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} "
+                     f"(change from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+        dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
+        if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
+            rows.append(("change from " + prev + " knots",
+                         f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"))
     return rows
 
 

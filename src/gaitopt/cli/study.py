@@ -32,9 +32,11 @@ from gaitopt.cli.base import (
     control_model_option,
     cost_option,
     formulation_option,
+    grid_choice,
     knots_option,
     make_console,
     model_option,
+    paper_grid_option,
     parse_free_or_value,
     parse_knots,
     resting_power_option,
@@ -150,10 +152,11 @@ def parse_fractions(text: str) -> tuple[float, ...]:
 
 
 def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
-              single_support: str, knots: str, step_time: str = "free",
+              single_support: str, knots: str | None = None, step_time: str = "free",
               problem: dict[str, Any] | None = None) -> SweepSpec:
     """The sweep of the CLI's options; ``problem`` holds further :class:`GaitOptions` fields
-    shared by every point (formulation, cost, control model, ...)."""
+    shared by every point (formulation, cost, control model, ...); ``knots`` None keeps
+    the default grid (or ``problem``'s)."""
     from gaitopt.gait.api import as_model
 
     model = as_model(model_name)
@@ -164,7 +167,8 @@ def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_l
                          step_times=parse_step_lengths(step_time, option="--step-time",
                                                        unit="s", quantity="time"),
                          single_support=parse_fractions(single_support),
-                         base=GaitOptions(knots=parse_knots(knots), **(problem or {})))
+                         base=GaitOptions(**{**(problem or {}), **(
+                             {} if knots is None else {"knots": parse_knots(knots)})}))
     except SweepSpecError as exc:
         raise UserError(str(exc)) from None
 
@@ -275,6 +279,7 @@ def _workers_option(f: Any) -> Any:
 @click.option("--single-support", default="0.85", show_default=True,
               help="Single-support fractions of the step time (comma list).")
 @knots_option
+@paper_grid_option
 @formulation_option(help="The coordinates of every point (docs/formulations.md) [default: "
                          "reduced for the five-link shape and the walk, else full].",
                     default=None)
@@ -287,10 +292,10 @@ def _workers_option(f: Any) -> Any:
                                       "jump at the events.")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
-                  step_length: str, step_time: str, single_support: str, knots: str,
-                  formulation: str | None, gait_kind: str, cost: str,
-                  resting_power: float | None, control_model: str, workers: int | None,
-                  scheduler: str | None) -> None:
+                  step_length: str, step_time: str, single_support: str, knots: str | None,
+                  paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
+                  resting_power: float | None, control_model: str | None,
+                  workers: int | None, scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -306,11 +311,11 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
         except ValueError as exc:
             raise UserError(str(exc)) from None
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "control_model": control_model, "gait": gait_kind}
+                               "gait": gait_kind, **grid_choice(knots, control_model, paper_grid)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
-                     step_length=step_length, single_support=single_support, knots=knots,
+                     step_length=step_length, single_support=single_support,
                      step_time=step_time, problem=problem)
     report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
     if report.counts.failed:
@@ -349,15 +354,21 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @click.option("--formulation", type=click.Choice(["auto", "reduced", "full"]), default="auto",
               show_default=True, help="With --costs: the coordinates (auto: reduced for the "
                                       "five-link biped, full for any other model).")
+@click.option("--paper-grid", is_flag=True,
+              help="The paper's setting: 8+5 knots and its control model (continuous, "
+                   "periodic controls); checked against 16+6 knots.")
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
-                  cost_study: bool, costs: tuple[str, ...], resting_powers: str,
+                  paper_grid: bool, cost_study: bool, costs: tuple[str, ...],
+                  resting_powers: str,
                   regularization: float, clearance: float | None, gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
-    optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
-    With --costs, the cost study (docs/costs.md). Rerunning resumes."""
+    optimum, the same on a finer grid (DIR/check-grid) for the error estimates, then the
+    report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
+    optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
+    from gaitopt.study.grid_error import CHECK_DIR, check_knots, grid_error
     from gaitopt.study.summary import read_summary
 
     console = make_console()
@@ -373,13 +384,34 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                         "--costs)")
     directory = directory or STUDY_DIR
     start = time.perf_counter()
-    spec = make_spec(model_name=model_names[0] if model_names else "five-link", speeds=speeds,
+    grid = grid_choice(None, None, paper_grid)
+    model_name = model_names[0] if model_names else "five-link"
+    spec = make_spec(model_name=model_name, speeds=speeds,
                      variants="all", free=True, step_length="free", single_support="0.85",
-                     knots="8,5")
+                     problem=grid)
     run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    finer = check_knots(spec.knots)
+    console.print(f"check grid {finer[0]}+{finer[1]} knots (the error estimates):",
+                  soft_wrap=True)
+    check = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
+                      step_length="free", single_support="0.85",
+                      problem={**grid, "knots": finer})
+    run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
+                      scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
     rows = read_summary(directory / SUMMARY_FILE)
+    errors = grid_error(directory, rows)
+    if errors is not None:
+        console.print(errors.statement(), soft_wrap=True)
+        for v in VARIANTS:
+            p = errors.free(v)
+            if p is not None:
+                console.print(f"  {v} optimum {p.row.speed_m_min:.2f} m/min, step "
+                              f"{p.row.step_length:.4f} m, cost {p.row.cost:.4g}; on the check "
+                              f"grid speed {p.speed_m_min:+.2f} m/min, step "
+                              f"{p.step_length:+.4f} m, cost {100 * p.cost:.2f} %",
+                              soft_wrap=True)
     best = next((r for v in VARIANTS if (r := optimal_row(rows, v)) is not None), None)
     if best is not None:
         animate_file(console, directory / best.file, out / "optimal-walk.gif", steps=4,
