@@ -56,7 +56,14 @@ from gaitopt.robot.model import RobotModel
 from gaitopt.study.executors import Backend
 from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH
 from gaitopt.study.plan import START_SPEED, SweepPoint, SweepSpec
-from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, SummaryError, read_summary, rows_of
+from gaitopt.study.summary import (
+    SUMMARY_FILE,
+    VARIANTS,
+    SummaryError,
+    csv_text,
+    read_summary,
+    rows_of,
+)
 from gaitopt.study.worker import PointOutcome, PointTask, gait_file_matches, solve_point
 
 CostStudyFormulation = Literal["auto", "reduced", "full"]
@@ -412,12 +419,8 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
 
 
 def cost_table_csv(rows: Sequence[CostRow]) -> str:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COST_COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow(row.as_csv_dict())
-    return buffer.getvalue()
+    """The CSV text of the rows (header: :data:`COST_COLUMNS`)."""
+    return csv_text(rows, COST_COLUMNS)
 
 
 def write_cost_table(directory: str | os.PathLike[str], rows: Sequence[CostRow]) -> Path:

@@ -133,14 +133,19 @@ def failed_row(*, ankle: bool, impulse: bool, speed_mode: SpeedMode, status: str
         iterations=iterations, wall_time_s=wall_time_s, file="")
 
 
-def summary_csv(rows: Iterable[SummaryRow]) -> str:
-    """The CSV text of the rows (header: :data:`SUMMARY_COLUMNS`)."""
+def csv_text(rows: Iterable[Any], columns: Sequence[str]) -> str:
+    """CSV text (``\\n`` line ends) of rows that have ``as_csv_dict()``, header ``columns``."""
     buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
+    writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
     writer.writeheader()
     for row in rows:
         writer.writerow(row.as_csv_dict())
     return buffer.getvalue()
+
+
+def summary_csv(rows: Iterable[SummaryRow]) -> str:
+    """The CSV text of the rows (header: :data:`SUMMARY_COLUMNS`)."""
+    return csv_text(rows, SUMMARY_COLUMNS)
 
 
 def write_summary(path: str | os.PathLike[str], rows: Iterable[SummaryRow]) -> Path:
