@@ -110,8 +110,12 @@ FINE_STAGE_OPTIONS = {"ipopt.hessian_approximation": "limited-memory"}
 def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
     """:data:`FINE_STAGE_OPTIONS` in the reduced formulation; the exact Hessian in the full
     one, where the quasi-Newton stages took 365 + 228 iterations at 16 + 6 knots and ended
-    at IPOPT's acceptable level, against 23 + 13 with the exact Hessian (12 m/min)."""
-    return dict(FINE_STAGE_OPTIONS) if options.formulation == "reduced" else {}
+    at IPOPT's acceptable level, against 23 + 13 with the exact Hessian (12 m/min), and
+    with point-assembled derivatives (:func:`evaluation_mode`), whose exact Hessian costs
+    no derivation of the whole NLP."""
+    if options.formulation != "reduced" or evaluation_mode(options, None) == "points":
+        return {}
+    return dict(FINE_STAGE_OPTIONS)
 
 
 #: Most refinement rounds after the fixed-grid stages, and most knots per phase they may make
@@ -218,10 +222,23 @@ def _structure_key(model: RobotModel, options: GaitOptions, grid: Grid,
             tuple(shaping))
 
 
+def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
+    """How the NLP of ``options`` is evaluated (``transcribe(..., compiled=...)``): the
+    separated Hermite-Simpson form always by ``"points"``, its derivatives assembled from
+    compiled functions of one grid point (:mod:`gaitopt.ocp.pointwise`: compiled once per
+    model and problem structure into the disk cache, CasADi's VM without a C compiler;
+    several times faster per iteration than the alternatives); other transcriptions as
+    ``compiled`` asks (``None``: CasADi's VM on the expanded NLP)."""
+    if options.transcription == "hermite-simpson-separated":
+        return "points"
+    return compiled
+
+
 def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
                       compiled: str | None = None) -> Transcription:
     """The (process-wide cached) transcription of the walking problem on ``knots`` (knot
     counts per phase, or a mesh: normalised knot times per phase)."""
+    compiled = evaluation_mode(options, compiled)
     key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
         counts = grid_knots(knots, options)

@@ -18,13 +18,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt import codegen
+from gaitopt.ocp import pointwise
 from gaitopt.ocp.bounds import Bounds, variable_bounds
 from gaitopt.ocp.estimate import interval_errors
 from gaitopt.ocp.functions import PhaseFunction, build_ends_function, build_phase_function
 from gaitopt.ocp.guess import Guess, WarmStart, guess_vector
 from gaitopt.ocp.layout import Layout
 from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
-from gaitopt.ocp.nlp import Nlp, assemble
+from gaitopt.ocp.nlp import Nlp, assemble, assemble_expressions
+from gaitopt.ocp.pointwise import PointwiseNlp
 from gaitopt.ocp.problem import Problem
 from gaitopt.ocp.result import METHODS, NlpSize, PhaseTrajectory, Result, point_values
 from gaitopt.ocp.scaling import state_scales, variable_scales
@@ -39,6 +41,7 @@ from gaitopt.ocp.solver import (
     merge_options,
     nlp_symbols,
     options_key,
+    solver_from_functions,
     solver_sharing_derivatives,
 )
 from gaitopt.ocp.validate import ProblemError, check_problem
@@ -97,7 +100,22 @@ class Transcription:
         self._bounds = Bounds(self.layout, self.nlp.constraints, lbw, ubw, self.nlp.lbg,
                               self.nlp.ubg, midpoint_bounds)
         self._bounds.check()
-        self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
+        self._pointwise: PointwiseNlp | None = None
+        if compiled == "points":
+            has_mid = any(pf.midpoint_rows.size > 0 for pf in self.phase_functions)
+            if not pointwise.supports(METHODS[method], has_mid):
+                raise ProblemError(f"compiled='points' needs a method that evaluates the "
+                                   f"dynamics at single grid points (hermite-simpson-separated,"
+                                   f" or trapezoidal without midpoint path constraints), not "
+                                   f"{method!r}")
+            recorder = pointwise.PointRecorder()
+            outer = assemble_expressions(problem, METHODS[method], mesh, self.layout,
+                                         self.phase_functions, ends, d_w, sx, symbols=ca.SX,
+                                         point_calls=recorder)
+            self._pointwise = pointwise.build_pointwise(outer, recorder.groups, compile_c=True)
+            self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, False)
+        else:
+            self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
         self.builds["nlp"] += 1
         # Solvers by options, and whether each has the exact Hessian (see solver()).
         self._solvers: dict[str, tuple[ca.Function, bool]] = {}
@@ -117,7 +135,10 @@ class Transcription:
             name = f"ocp_solver_{len(self._solvers)}"
             exact = exact_hessian(options)
             base = next((fn for fn, ex in self._solvers.values() if ex == exact), None)
-            if base is not None:
+            if self._pointwise is not None:
+                solver = solver_from_functions(name, self._pointwise.functions,
+                                               self.layout.size, dict(options))
+            elif base is not None:
                 solver = solver_sharing_derivatives(name, base, self.layout.size,
                                                     dict(options))
             else:
