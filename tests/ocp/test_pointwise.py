@@ -37,7 +37,8 @@ def nonlinear(gain: float = 1.0, intervals: int = 5) -> Problem:
     def f(x: ca.SX, u: ca.SX, p: ca.SX, t: ca.SX) -> ca.SX:
         return ca.vertcat(x[1] * p[0], -gain * ca.sin(x[0]) * p[1] + u[0] * ca.cos(t * x[0]))
 
-    swing = Phase("swing", ["q", "w"], ["tau"], f, Duration.of_parameters(lambda p: 0.5 + p[0] ** 2),
+    duration = Duration.of_parameters(lambda p: 0.5 + p[0] ** 2)
+    swing = Phase("swing", ["q", "w"], ["tau"], f, duration,
                   initial_state={"q": 0.0, "w": 0.0}, final_state={"q": 1.0},
                   lagrange=lambda x, u, p, t: u[0] ** 2 * (1 + x[1] ** 2) + p[0] * t,
                   path_constraints=[PathConstraint("reach", lambda x, u, p, t:
