@@ -316,7 +316,10 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
             Default: True when not compiled (fastest interpreted), False when compiled (the
             generated C loops over the grid, so compiling takes seconds at any mesh size).
         compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk; recommended for
-            repeated solves of one problem) or ``"jit"`` (CasADi's jit, not cached).
+            repeated solves of one problem), ``"jit"`` (CasADi's jit, not cached) or
+            ``"points"`` (separated Hermite-Simpson or trapezoidal without midpoint path
+            constraints: exact derivatives assembled from compiled functions of one grid
+            point, :mod:`gaitopt.ocp.pointwise`; the fastest where the dynamics are costly).
         options: solver options over the defaults (``{"ipopt.tol": 1e-10}`` or
             ``{"ipopt": {"tol": 1e-10}}``).
         scaling: scale variables and constraints from bounds or given scales.
