@@ -241,6 +241,8 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
     compiled = evaluation_mode(options, compiled)
     key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
+        # Another grid of the same problem: its symbolic functions do not depend on the grid.
+        same = [tr for k, tr in _CACHE.items() if k[0] == key[0] and k[2:] == key[2:]]
         counts = grid_knots(knots, options)
         problem = problem_for(model, options.replace(knots=counts))
         intervals: dict[str, Any] = {
@@ -251,7 +253,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
             options={"ipopt.tol": options.tol, "ipopt.max_iter": options.max_iter,
                      "ipopt.acceptable_tol": max(options.tol * 100, 1e-6),
                      "show_eval_warnings": False},
-            build_solver=False)
+            build_solver=False, functions=same[0].functions if same else None)
     return _CACHE[key]
 
 

@@ -21,7 +21,12 @@ from gaitopt import codegen
 from gaitopt.ocp import pointwise
 from gaitopt.ocp.bounds import Bounds, variable_bounds
 from gaitopt.ocp.estimate import interval_errors
-from gaitopt.ocp.functions import PhaseFunction, build_ends_function, build_phase_function
+from gaitopt.ocp.functions import (
+    EndsFunction,
+    PhaseFunction,
+    build_ends_function,
+    build_phase_function,
+)
 from gaitopt.ocp.guess import Guess, WarmStart, guess_vector
 from gaitopt.ocp.layout import Layout
 from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
@@ -65,7 +70,9 @@ class Transcription:
                  compiled: str | None = None, options: Mapping[str, Any] | None = None,
                  scaling: bool = True, cse: bool = True,
                  compile_flags: Sequence[str] | None = None, build_solver: bool = True,
-                 midpoint_bounds: bool = True) -> None:
+                 midpoint_bounds: bool = True,
+                 functions: tuple[tuple[PhaseFunction, ...], EndsFunction] | None = None
+                 ) -> None:
         check_problem(problem)
         if method not in METHODS:
             raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -87,11 +94,18 @@ class Transcription:
             [(ph.name, ph.states, ph.controls, tau.size, ph.duration_spec().kind == "free")
              for ph, tau in zip(problem.phases, mesh, strict=True)], problem.parameter_names,
             midpoint_states=METHODS[method].midpoint_variables)
-        self.phase_functions: tuple[PhaseFunction, ...] = tuple(
-            build_phase_function(ph, n_p, cse=cse) for ph in problem.phases)
         sx = tuple(state_scales(ph, scaling) for ph in problem.phases)
-        ends = build_ends_function(problem, {ph.name: s for ph, s in zip(problem.phases, sx,
-                                                                          strict=True)}, cse=cse)
+        if functions is None:
+            self.phase_functions: tuple[PhaseFunction, ...] = tuple(
+                build_phase_function(ph, n_p, cse=cse) for ph in problem.phases)
+            ends = build_ends_function(problem, {ph.name: s for ph, s in
+                                                 zip(problem.phases, sx, strict=True)}, cse=cse)
+        else:
+            self.phase_functions, ends = functions
+        #: The problem's symbolic functions, which do not depend on the mesh: another
+        #: transcription of the same problem (and scaling, cse) may take them (``functions``).
+        self.functions: tuple[tuple[PhaseFunction, ...], EndsFunction] = (
+            self.phase_functions, ends)
         d_w = variable_scales(problem, self.layout, scaling)
         self.nlp: Nlp = assemble(problem, METHODS[method], mesh, self.layout,
                                  self.phase_functions, ends, d_w, sx)
@@ -303,7 +317,9 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
                expand: bool | None = None, compiled: str | None = None,
                options: Mapping[str, Any] | None = None, scaling: bool = True,
                cse: bool = True, compile_flags: Sequence[str] | None = None,
-               build_solver: bool = True, midpoint_bounds: bool = True) -> Transcription:
+               build_solver: bool = True, midpoint_bounds: bool = True,
+               functions: tuple[tuple[PhaseFunction, ...], EndsFunction] | None = None
+               ) -> Transcription:
     """Validate ``problem``, build its NLP and solver once, and return the transcription.
 
     Args:
@@ -333,6 +349,9 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
         midpoint_bounds: separated Hermite-Simpson only: the state box bounds hold at the
             midpoint state variables too (default). ``False`` leaves them unbounded, which
             makes the NLP equivalent to the compressed one (the same optimum on every mesh).
+        functions: the symbolic functions of ``problem`` from another transcription of it
+            with the same ``scaling`` and ``cse`` (``other.functions``): they do not depend
+            on the mesh or the method, and building them is most of a build.
     """
     if method not in METHODS:
         raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -340,4 +359,5 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
     mesh = make_mesh(problem, intervals)
     return Transcription(problem, method, mesh, expand=expand, compiled=compiled,
                          options=options, scaling=scaling, cse=cse, compile_flags=compile_flags,
-                         build_solver=build_solver, midpoint_bounds=midpoint_bounds)
+                         build_solver=build_solver, midpoint_bounds=midpoint_bounds,
+                         functions=functions)
