@@ -38,14 +38,22 @@ and reused: speed, step length and impulse enter through parameter bounds only.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import functools
+import hashlib
+import pickle
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
+from gaitopt import codegen
+from gaitopt.fileio import write_bytes_atomic
 from gaitopt.gait.formulation import biped_of, problem_for, stage_bounds
 from gaitopt.gait.guess import (
     WalkingGuess,
@@ -234,15 +242,51 @@ def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
     return compiled
 
 
+#: Version of the disk cache of the walking problem's symbolic functions (part of its key).
+FUNCTIONS_FORMAT = "gaitopt-walking-functions-1"
+
+
+@functools.cache
+def source_hash() -> str:
+    """A hash of every Python file of the installed gaitopt package: the symbolic functions
+    cached on disk are those this code builds."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:20]
+
+
+def functions_file(key: tuple[Any, ...]) -> Path:
+    """Where the symbolic functions (``Transcription.functions``) of the problem of the
+    structure ``key`` (:func:`_structure_key`) are cached on disk: keyed by the model, every
+    shaping option, the gaitopt sources and CasADi's version, not the grid or the mode."""
+    text = repr((FUNCTIONS_FORMAT, source_hash(), ca.CasadiMeta.version(), key[0], key[2],
+                 key[4]))
+    name = hashlib.sha256(text.encode()).hexdigest()[:24]
+    return codegen.cache_dir() / f"walking-functions-{name}.pickle"
+
+
+def cached_functions(path: Path) -> Any:
+    """The functions pickled at ``path``, or None (missing, unreadable or stale: rebuilt)."""
+    try:
+        return pickle.loads(path.read_bytes())
+    except Exception:  # noqa: BLE001 - any unreadable cache file is rebuilt and replaced
+        return None
+
+
 def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
                       compiled: str | None = None) -> Transcription:
     """The (process-wide cached) transcription of the walking problem on ``knots`` (knot
-    counts per phase, or a mesh: normalised knot times per phase)."""
+    counts per phase, or a mesh: normalised knot times per phase). Its symbolic functions
+    (independent of the grid) come from another grid's transcription in this process, or
+    from the disk cache (:func:`functions_file`), or are built and saved there."""
     compiled = evaluation_mode(options, compiled)
     key = _structure_key(model, options, knots, compiled)
     if key not in _CACHE:
-        # Another grid of the same problem: its symbolic functions do not depend on the grid.
-        same = [tr for k, tr in _CACHE.items() if k[0] == key[0] and k[2:] == key[2:]]
+        same = [tr.functions for k, tr in _CACHE.items() if k[0] == key[0] and k[2:] == key[2:]]
+        path = functions_file(key)
+        functions = same[0] if same else cached_functions(path)
         counts = grid_knots(knots, options)
         problem = problem_for(model, options.replace(knots=counts))
         intervals: dict[str, Any] = {
@@ -253,7 +297,10 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
             options={"ipopt.tol": options.tol, "ipopt.max_iter": options.max_iter,
                      "ipopt.acceptable_tol": max(options.tol * 100, 1e-6),
                      "show_eval_warnings": False},
-            build_solver=False, functions=same[0].functions if same else None)
+            build_solver=False, functions=functions)
+        if functions is None:
+            with contextlib.suppress(OSError):  # a read-only cache: build again next time
+                write_bytes_atomic(path, pickle.dumps(_CACHE[key].functions))
     return _CACHE[key]
 
 
