@@ -199,7 +199,6 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
     sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
     lagrangian = sigma * F + ca.dot(lam, G)
     L_w, L_Y = ca.gradient(lagrangian, w), ca.gradient(lagrangian, Y)
-    outer_fg = ca.Function("outer_fg", [w, Y], [F, G])
     outer_grad = ca.Function("outer_grad", [w, Y], [F, ca.gradient(F, w), ca.gradient(F, Y)])
     outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), ca.jacobian(G, Y)])
     L_YY = ca.jacobian(L_Y, Y)
@@ -234,10 +233,16 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
         return ca.diagcat(*blocks)
 
     Yv = values()
-    f, g = outer_fg(W, Yv)
+    # The objective and constraints themselves as one SX graph (the point functions inlined
+    # at every point): a few VM instructions per point, cheaper than a call of a compiled
+    # function per point, and no derivative of it is ever taken.
+    Y_sx = ca.vertcat(*[ca.vec(stacked_point(gr.point).map(int(gr.z.shape[1]))(gr.z))
+                        for gr in groups])
+    F_sx, G_sx = ca.substitute([F, G], [Y], [ca.densify(Y_sx)])
+    P_sx = ca.SX.sym("p", 0)
     fns: dict[str, ca.Function] = {
-        "nlp_f": ca.Function("nlp_f", [W, P], [f], ["x", "p"], ["f"]),
-        "nlp_g": ca.Function("nlp_g", [W, P], [g], ["x", "p"], ["g"]),
+        "nlp_f": ca.Function("nlp_f", [w, P_sx], [F_sx], ["x", "p"], ["f"]),
+        "nlp_g": ca.Function("nlp_g", [w, P_sx], [G_sx], ["x", "p"], ["g"]),
     }
     jac_calls = [d.jacobian.map(s[2])(z) for d, s, z in zip(derivs, sizes, Zs, strict=True)]
     Yj = ca.vertcat(*[ca.vec(c[0]) for c in jac_calls])
