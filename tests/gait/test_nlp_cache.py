@@ -78,3 +78,14 @@ def test_a_changed_model_or_option_or_a_corrupt_file_builds_anew(fresh: Path) ->
     tr = gait_solve.transcription_for(model, OPTIONS, OPTIONS.knots)
     assert gait_solve.cached_functions(path) is not None       # replaced
     assert np.all(np.isfinite(evaluate(tr)[0]))
+
+
+def test_compiled_walking_nlp_is_the_point_derivatives_or_refused() -> None:
+    from gaitopt.gait.options import GaitOptionsError
+
+    separated = OPTIONS.replace(transcription="hermite-simpson-separated")
+    assert gait_solve.evaluation_mode(separated, None) == "points"
+    assert gait_solve.evaluation_mode(separated, "codegen") == "points"
+    assert gait_solve.evaluation_mode(OPTIONS, None) is None
+    with pytest.raises(GaitOptionsError, match="compiled: the 'hermite-simpson' NLP"):
+        gait_solve.solve_walking(load_model("five-link"), OPTIONS, compiled="codegen")

@@ -62,7 +62,7 @@ from gaitopt.gait.guess import (
     naive_guess,
     naive_running_guess,
 )
-from gaitopt.gait.options import GaitOptions, validate_options
+from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.problem import FRACTION, Relaxation, parameter_bounds, with_step_time
 from gaitopt.ocp import (
     Bounds,
@@ -239,6 +239,12 @@ def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
     ``compiled`` asks (``None``: CasADi's VM on the expanded NLP)."""
     if options.transcription == "hermite-simpson-separated":
         return "points"
+    if compiled == "codegen":
+        raise GaitOptionsError(
+            f"compiled: the {options.transcription!r} NLP generated as one C file does not "
+            "compile in minutes (34 MB of C at 8 + 5 knots); use transcription "
+            "'hermite-simpson-separated', whose derivatives are always compiled per grid "
+            "point")
     return compiled
 
 
@@ -611,6 +617,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed."""
     validate_options(options, biped_of(model, options))
+    evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
