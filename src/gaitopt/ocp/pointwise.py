@@ -18,7 +18,9 @@ boundary rows, scaling) are cheap expressions, linear in ``Y`` for collocation. 
     hess L  = L_ww + (L_wY J Dz) + (L_wY J Dz)^T + (J Dz)^T L_YY (J Dz)
               + Dz^T H Dz + Hess_w (nu^T z(w))                            (nw, nw)
 
-(IPOPT receives the upper triangle). Only ``phi``, its Jacobian and the weighted Hessian
+(IPOPT receives the upper triangle; ``f``, ``g`` and ``grad f`` are evaluated instead as one SX
+graph with the point functions inlined, since ``f`` reads only the cheap integrand of each
+point). Only ``phi``, its Jacobian and the weighted Hessian
 ``Hess_z (mu^T phi)`` see the dynamics; they are functions of one point, so their size and
 the time to compile them do not depend on the mesh. They are generated as C once per point
 function and compiled into the disk cache of :mod:`gaitopt.codegen` (keyed by a hash of the
@@ -199,7 +201,6 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
     sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
     lagrangian = sigma * F + ca.dot(lam, G)
     L_w, L_Y = ca.gradient(lagrangian, w), ca.gradient(lagrangian, Y)
-    outer_grad = ca.Function("outer_grad", [w, Y], [F, ca.gradient(F, w), ca.gradient(F, Y)])
     outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), ca.jacobian(G, Y)])
     L_YY = ca.jacobian(L_Y, Y)
     outer_hess = ca.Function("outer_hess", [w, Y, sigma, lam],
@@ -240,17 +241,18 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
                         for gr in groups])
     F_sx, G_sx = ca.substitute([F, G], [Y], [ca.densify(Y_sx)])
     P_sx = ca.SX.sym("p", 0)
+    # The objective's gradient by reverse AD of that graph: the objective reads only the
+    # integrand L of each point (cheap next to the dynamics), so its graph and its gradient
+    # are small, smaller than the point Jacobians the chain rule would need.
     fns: dict[str, ca.Function] = {
         "nlp_f": ca.Function("nlp_f", [w, P_sx], [F_sx], ["x", "p"], ["f"]),
         "nlp_g": ca.Function("nlp_g", [w, P_sx], [G_sx], ["x", "p"], ["g"]),
+        "nlp_grad_f": ca.Function("nlp_grad_f", [w, P_sx], [F_sx, ca.gradient(F_sx, w)],
+                                  ["x", "p"], ["f", "grad_f_x"]),
     }
     jac_calls = [d.jacobian.map(s[2])(z) for d, s, z in zip(derivs, sizes, Zs, strict=True)]
     Yj = ca.vertcat(*[ca.vec(c[0]) for c in jac_calls])
-    JB = jacobian_of_points([c[1] for c in jac_calls])
-    JD = ca.mtimes(JB, Dz)
-    f1, F_w, F_Y = outer_grad(W, Yj)
-    fns["nlp_grad_f"] = ca.Function("nlp_grad_f", [W, P], [f1, F_w + ca.mtimes(JD.T, F_Y)],
-                                    ["x", "p"], ["f", "grad_f_x"])
+    JD = ca.mtimes(jacobian_of_points([c[1] for c in jac_calls]), Dz)
     g1, G_w, G_Y = outer_jac(W, Yj)
     fns["nlp_jac_g"] = ca.Function("nlp_jac_g", [W, P], [g1, G_w + ca.mtimes(G_Y, JD)],
                                    ["x", "p"], ["g", "jac_g_x"])
