@@ -159,3 +159,16 @@ def test_walking_optimum_of_the_points_mode_is_optimal_for_the_expanded_nlp() ->
     assert again.objective == pytest.approx(solution.result.objective, rel=1e-9)
     assert again.parameters["step_length"] == pytest.approx(
         solution.result.parameters["step_length"], rel=1e-6)
+
+
+def test_a_failing_compiler_falls_back_to_the_vm(tmp_path: Path,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("CC", str(tmp_path / "broken-cc"))
+    (tmp_path / "broken-cc").write_text("#!/bin/sh\necho 'cc: internal error' >&2\nexit 1\n")
+    (tmp_path / "broken-cc").chmod(0o755)
+    with pytest.warns(RuntimeWarning, match="compiling the point functions failed"):
+        tr = transcribe(P.periodic_ratio(intervals=3), method=SEPARATED, compiled="points")
+    assert tr._pointwise is not None and not tr._pointwise.compiled
+    assert tr.solve().objective == pytest.approx(4.0, rel=1e-6)
+    assert not list(tmp_path.glob("pt_*.so"))

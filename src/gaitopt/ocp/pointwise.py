@@ -32,6 +32,7 @@ machine. The outer functions are small SX functions, always interpreted.
 from __future__ import annotations
 
 import hashlib
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -122,7 +123,8 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
                       ) -> list[PointDerivatives]:
     """The :class:`PointDerivatives` of each point function; with ``compile_c`` compiled
     (one library per point function, compiled in parallel, cached on disk by
-    :func:`library_key`), else, or when no C compiler is found, CasADi SX functions."""
+    :func:`library_key`), else, or when no C compiler is found or it fails (a warning),
+    CasADi SX functions."""
     if not (compile_c and codegen.has_compiler()):
         return [PointDerivatives.of(PointDerivatives.derive(p), compiled=False) for p in points]
     libs = {f"pt_{p.name()}": p for p in points}
@@ -131,8 +133,13 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
     if missing:
         sources = {lib: codegen.generate_source(PointDerivatives.derive(libs[lib]), lib)
                    for lib in missing}
-        codegen.compile_libraries(sources, flags=POINT_FLAGS,
-                                  targets={lib: paths[lib] for lib in missing})
+        try:
+            codegen.compile_libraries(sources, flags=POINT_FLAGS,
+                                      targets={lib: paths[lib] for lib in missing})
+        except codegen.CompileError as exc:
+            warnings.warn(f"compiling the point functions failed, evaluating them in CasADi's "
+                          f"VM instead: {str(exc)[:300]}", RuntimeWarning, stacklevel=2)
+            return point_derivatives(points, compile_c=False)
     out = []
     for lib, p in libs.items():
         base = stacked_name(p)
