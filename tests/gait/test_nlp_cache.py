@@ -18,7 +18,9 @@ from gaitopt.robot import load_model
 from gaitopt.robot.loader import builtin_text
 from gaitopt.robot.schema import model_from_dict
 
-OPTIONS = GaitOptions(speed=0.2, knots=(4, 3))
+# The compressed form: its transcription compiles nothing (the separated one would compile its
+# point libraries into each test's empty cache).
+OPTIONS = GaitOptions(speed=0.2, knots=(4, 3), transcription="hermite-simpson")
 
 
 @pytest.fixture
