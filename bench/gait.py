@@ -240,20 +240,22 @@ def run_child(src: Path, *args: str) -> tuple[dict[str, Any], float]:
     return json.loads(proc.stdout.strip().splitlines()[-1]), wall
 
 
-def run_cli(src: Path, transcription: str, knots: str, out: Path) -> float:
+def run_cli(src: Path, transcription: str, knots: str, out: Path,
+            formulation: str = "reduced") -> float:
     """Wall time of a whole ``gaitopt solve`` process (12 m/min)."""
     env = dict(os.environ, PYTHONPATH=str(src))
     start = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "gaitopt", "solve", "--speed", "12m/min",
                            "--knots", knots, "--transcription", transcription,
-                           "-o", str(out)], env=env, capture_output=True, text=True)
+                           "--formulation", formulation, "-o", str(out)],
+                          env=env, capture_output=True, text=True)
     wall = time.perf_counter() - start
     if proc.returncode != 0:
         raise RuntimeError(f"gaitopt solve failed:\n{proc.stderr[-3000:]}")
     return wall
 
 
-def targets(reference: str, repeat: int) -> None:
+def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
     """Every row of the issue's table for the reference revision (the paper's compressed
     form, as main solves it by default) and this branch (:data:`FAST`), each row measured
     for both one after the other, and the ratios."""
@@ -272,7 +274,8 @@ def targets(reference: str, repeat: int) -> None:
             grid = knots.replace(",", "+")
             for name, src, form in variants:
                 gait_file = tmp / f"{name.replace(' ', '_')}-{grid}.gait.json"
-                out, _ = run_child(src, "warm", knots, form, str(repeat), str(gait_file))
+                out, _ = run_child(src, "warm", knots, form, str(repeat), str(gait_file),
+                                   formulation)
                 record(f"warm {grid}", name, out["warm_s"])
                 record(f"share {grid}", name, out["cold_eval_s"] / max(out["cold_ipopt_s"],
                                                                        1e-12))
@@ -284,7 +287,8 @@ def targets(reference: str, repeat: int) -> None:
                              f"evaluations)")
                 print(notes[-1], flush=True)
                 if grid == "40+10":
-                    first, proc = run_child(src, "first-warm", knots, form, str(gait_file))
+                    first, proc = run_child(src, "first-warm", knots, form, str(gait_file),
+                                            formulation)
                     record("first warm 40+10", name, first["first_warm_s"])
                     notes.append(f"{name} 40+10 fresh process: first warm start "
                                  f"{first['first_warm_s']:.2f} s ({first['iterations']} it), "
@@ -294,7 +298,7 @@ def targets(reference: str, repeat: int) -> None:
         for knots in ("8,5", "40,10"):
             grid = knots.replace(",", "+")
             for name, src, form in variants:
-                runs = [run_cli(src, form, knots, tmp / "cli.gait.json")
+                runs = [run_cli(src, form, knots, tmp / "cli.gait.json", formulation)
                         for _ in range(1 + repeat)]
                 record(f"cli {grid}", name, min(runs[1:]))
                 notes.append(f"{name} gaitopt solve --knots {knots}: "
@@ -311,6 +315,7 @@ def targets(reference: str, repeat: int) -> None:
         "share 40+10": "the same, 40+10",
     }
     print()
+    print(f"formulation: {formulation}")
     print(f"| figure | reference ({reference}, {PAPER_FORM}) | this branch ({FAST}) | "
           "this / reference | target | met |")
     print("| --- | ---: | ---: | ---: | ---: | :---: |")
@@ -341,7 +346,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.targets:
         print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
-        targets(args.reference, args.repeat)
+        targets(args.reference, args.repeat, args.formulation)
         print(f"load average after: {load_average()}")
         return
     grids = [tuple(int(k) for k in g.split(",")) for g in args.grids]

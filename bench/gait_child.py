@@ -3,8 +3,8 @@ fresh NLP caches) with whichever gaitopt sources are first on PYTHONPATH: this b
 the reference revision's. Only the public API is used, so both can run it. Prints one JSON
 line.
 
-    python bench/gait_child.py warm KNOTS TRANSCRIPTION REPEAT GAIT_FILE
-    python bench/gait_child.py first-warm KNOTS TRANSCRIPTION GAIT_FILE
+    python bench/gait_child.py warm KNOTS TRANSCRIPTION REPEAT GAIT_FILE [FORMULATION]
+    python bench/gait_child.py first-warm KNOTS TRANSCRIPTION GAIT_FILE [FORMULATION]
 """
 
 from __future__ import annotations
@@ -32,7 +32,8 @@ def timed(run: Any) -> tuple[float, Any]:
     return time.perf_counter() - start, out
 
 
-def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str) -> dict[str, Any]:
+def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str,
+         formulation: str = "reduced") -> dict[str, Any]:
     """Cold solve (NLPs built in this process), the same again, the gait saved to ``path``,
     then the warm start from it at +5 % speed (best of ``repeat``)."""
     from gaitopt.gait.api import solve_gait_solution
@@ -42,7 +43,8 @@ def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str) -> 
     from gaitopt.robot import load_model
 
     model = load_model("five-link")
-    options = GaitOptions(speed=SPEED, knots=knots, transcription=transcription)  # type: ignore
+    options = GaitOptions(speed=SPEED, knots=knots, transcription=transcription,  # type: ignore
+                          formulation=formulation)  # type: ignore[arg-type]
     out: dict[str, Any] = {}
     wall, sol = timed(lambda: solve_gait_solution(model, options))
     out["cold_first_s"] = wall
@@ -67,7 +69,8 @@ def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str) -> 
     return out
 
 
-def first_warm(knots: tuple[int, int], transcription: str, path: str) -> dict[str, Any]:
+def first_warm(knots: tuple[int, int], transcription: str, path: str,
+               formulation: str = "reduced") -> dict[str, Any]:
     """The first warm start in this process from the gait file ``path`` (+5 % speed)."""
     start = time.perf_counter()
     from gaitopt.gait.api import solve_gait_solution
@@ -77,8 +80,9 @@ def first_warm(knots: tuple[int, int], transcription: str, path: str) -> dict[st
 
     imports = time.perf_counter() - start
     model = load_model("five-link")
-    options = GaitOptions(speed=SPEED * SPEED_STEP, knots=knots,
-                          transcription=transcription)  # type: ignore[arg-type]
+    options = GaitOptions(speed=SPEED * SPEED_STEP, knots=knots,  # type: ignore[arg-type]
+                          transcription=transcription,  # type: ignore[arg-type]
+                          formulation=formulation)  # type: ignore[arg-type]
     wall, sol = timed(lambda: solve_gait_solution(model, options, warm_start=Gait.load(path)))
     it, ev, tot = share(sol)
     return dict(imports_s=imports, first_warm_s=wall, iterations=it, eval_s=ev, ipopt_s=tot,
@@ -90,9 +94,9 @@ def main() -> None:
     k = tuple(int(v) for v in knots_text.split(","))
     knots = (k[0], k[1])
     if task == "warm":
-        out = warm(knots, transcription, int(sys.argv[4]), sys.argv[5])
+        out = warm(knots, transcription, int(sys.argv[4]), sys.argv[5], *sys.argv[6:7])
     elif task == "first-warm":
-        out = first_warm(knots, transcription, sys.argv[4])
+        out = first_warm(knots, transcription, sys.argv[4], *sys.argv[5:6])
     else:
         raise SystemExit(f"unknown task {task!r}")
     print(json.dumps(out))
