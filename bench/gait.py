@@ -50,6 +50,7 @@ import argparse
 import contextlib
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -241,18 +242,20 @@ def run_child(src: Path, *args: str) -> tuple[dict[str, Any], float]:
 
 
 def run_cli(src: Path, transcription: str, knots: str, out: Path,
-            formulation: str = "reduced") -> float:
-    """Wall time of a whole ``gaitopt solve`` process (12 m/min)."""
+            formulation: str = "reduced") -> tuple[float, float]:
+    """Wall and CPU time (user + system) of a whole ``gaitopt solve`` process (12 m/min)."""
     env = dict(os.environ, PYTHONPATH=str(src))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "gaitopt", "solve", "--speed", "12m/min",
                            "--knots", knots, "--transcription", transcription,
                            "--formulation", formulation, "-o", str(out)],
                           env=env, capture_output=True, text=True)
     wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode != 0:
         raise RuntimeError(f"gaitopt solve failed:\n{proc.stderr[-3000:]}")
-    return wall
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
@@ -265,10 +268,13 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
         ref = reference_sources(reference, tmp)
         variants = (("reference", ref, PAPER_FORM), ("this branch", here, FAST))
         rows: dict[str, dict[str, float]] = {}
+        cpu: dict[str, dict[str, float]] = {}
         notes: list[str] = []
 
-        def record(row: str, name: str, value: float) -> None:
+        def record(row: str, name: str, value: float, cpu_s: float | None = None) -> None:
             rows.setdefault(row, {})[name] = value
+            if cpu_s is not None:
+                cpu.setdefault(row, {})[name] = cpu_s
 
         for knots in ("8,5", "40,10"):
             grid = knots.replace(",", "+")
@@ -276,7 +282,7 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
                 gait_file = tmp / f"{name.replace(' ', '_')}-{grid}.gait.json"
                 out, _ = run_child(src, "warm", knots, form, str(repeat), str(gait_file),
                                    formulation)
-                record(f"warm {grid}", name, out["warm_s"])
+                record(f"warm {grid}", name, out["warm_s"], out["warm_cpu_s"])
                 record(f"share {grid}", name, out["cold_eval_s"] / max(out["cold_ipopt_s"],
                                                                        1e-12))
                 notes.append(f"{name} {grid}: cold {out['cold_first_s']:.2f} s (NLPs built), "
@@ -289,7 +295,8 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
                 if grid == "40+10":
                     first, proc = run_child(src, "first-warm", knots, form, str(gait_file),
                                             formulation)
-                    record("first warm 40+10", name, first["first_warm_s"])
+                    record("first warm 40+10", name, first["first_warm_s"],
+                           first["first_warm_cpu_s"])
                     notes.append(f"{name} 40+10 fresh process: first warm start "
                                  f"{first['first_warm_s']:.2f} s ({first['iterations']} it), "
                                  f"imports {first['imports_s']:.2f} s, whole process "
@@ -300,10 +307,12 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
             for name, src, form in variants:
                 runs = [run_cli(src, form, knots, tmp / "cli.gait.json", formulation)
                         for _ in range(1 + repeat)]
-                record(f"cli {grid}", name, min(runs[1:]))
+                best_run = min(runs[1:])
+                record(f"cli {grid}", name, best_run[0], best_run[1])
                 notes.append(f"{name} gaitopt solve --knots {knots}: "
-                             + ", ".join(f"{r:.2f}" for r in runs) + " s (first run, then "
-                             "with the disk caches warm; best of the latter)")
+                             + ", ".join(f"{r[0]:.2f} ({r[1]:.2f} CPU)" for r in runs)
+                             + " s (first run, then with the disk caches warm; best of the "
+                               "latter)")
                 print(notes[-1], flush=True)
     labels = {
         "warm 8+5": "warm start from a saved gait, +5 % speed, 8+5 knots (public API), s",
@@ -317,14 +326,16 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
     print()
     print(f"formulation: {formulation}")
     print(f"| figure | reference ({reference}, {PAPER_FORM}) | this branch ({FAST}) | "
-          "this / reference | target | met |")
-    print("| --- | ---: | ---: | ---: | ---: | :---: |")
+          "this / reference | target | met | CPU s: reference, this branch |")
+    print("| --- | ---: | ---: | ---: | ---: | :---: | ---: |")
     for row, label in labels.items():
         r, b = rows[row]["reference"], rows[row]["this branch"]
         fmt = "{:.0%}" if row.startswith("share") else "{:.3f}"
         target = ISSUE_TARGETS[row]
+        c = cpu.get(row)
+        cpu_text = f"{c['reference']:.3f}, {c['this branch']:.3f}" if c else ""
         print(f"| {label} | {fmt.format(r)} | {fmt.format(b)} | {b / r:.2f} | "
-              f"{fmt.format(target)} | {'yes' if b <= target else 'no'} |")
+              f"{fmt.format(target)} | {'yes' if b <= target else 'no'} | {cpu_text} |")
     print("| 80-point sweep, 2 workers | see `bench/sweep.py --reference` | | | 8 | |")
 
 
