@@ -20,9 +20,15 @@ from gaitopt.cli_base import (
     parse_knots,
     parse_pair,
 )
-from gaitopt.gait.formulation import biped_of
+from gaitopt.gait.formulation import biped_of, checked_sequence, default_formulation
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.options import (
+    GAITS,
+    TRANSCRIPTIONS,
+    GaitOptions,
+    GaitOptionsError,
+    validate_options,
+)
 from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
@@ -39,6 +45,22 @@ def _speed(text: str) -> float | None:
 
 #: Speeds (m/s) this far from 12 m/min get the multistart hint (15 m/min).
 FAR_FROM_REFERENCE = 0.25
+
+
+def read_sequence(path: Path) -> dict[str, Any]:
+    """A contact sequence file (YAML): its data, checked for form (the model check comes with
+    the options)."""
+    from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
+    from gaitopt.robot.loader import parse_yaml
+
+    try:
+        data = parse_yaml(path.read_text(encoding="utf-8"), source=str(path))
+        sequence_from_dict(data)
+    except OSError as exc:
+        raise UserError(f"--contact-sequence {path}: {exc.strerror or exc}") from None
+    except (ContactSequenceError, ValueError) as exc:
+        raise UserError(f"--contact-sequence {path}: {exc}") from None
+    return dict(data)
 
 
 def _step(text: str) -> float | None:
@@ -81,17 +103,22 @@ def _step_time(text: str) -> float | None:
 @click.option("--unilateral-impulses/--paper-impulse-maps", default=True, show_default=True,
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
-@click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
-              show_default=True,
+@click.option("--formulation", type=click.Choice(["reduced", "full"]), default=None,
               help="reduced: the paper's coordinates (five-link biped); full: the whole "
-                   "tree's q, qd with the held points as constraints (any two-legged model, "
-                   "knees may straighten).")
+                   "tree's q, qd with the held points as constraints (any model and contact "
+                   "sequence, knees may straighten) [default: reduced for the five-link shape "
+                   "and the walk, else full].")
 @click.option("--min-knee-flexion", type=float, default=None,
               help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
                    "stance knee straighten, with --formulation full].")
-@click.option("--gait", "gait_kind", type=click.Choice(["walk", "run"]), default="walk",
-              show_default=True, help="The contact sequence: walk, or run (stance then flight; "
-                                      "needs --formulation full --no-impulse).")
+@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default="walk",
+              show_default=True,
+              help="The contact sequence: walk, run (stance then flight; needs --no-impulse) "
+                   "or heel-toe (feet with heel and toe points, e.g. --model seven-link).")
+@click.option("--contact-sequence", "sequence_file",
+              type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="A YAML file with a contact sequence (phases, events, anchors; "
+                   "docs/formulations.md); replaces --gait.")
 @click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
               show_default=True,
               help="paper: torque squared per metre; work: mechanical cost of transport; "
@@ -128,9 +155,9 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   impulse: bool,
                   single_support: float, knots: str, transcription: str,
                   periodic_controls: bool, friction: float | None,
-                  unilateral_impulses: bool, formulation: str,
+                  unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
-                  gait_kind: str, cost: str,
+                  gait_kind: str, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
                   control_model: str, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
@@ -149,7 +176,11 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
             start = Gait.load(warm_start)
         except GaitFileError as exc:
             raise UserError(f"--warm-start: {exc}") from None
+    sequence = None if sequence_file is None else read_sequence(sequence_file)
+    if formulation is None:
+        formulation = default_formulation(model, gait_kind, sequence is not None)
     options = GaitOptions(
+        contact_sequence=sequence,
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
         single_support_fraction=single_support, knots=parse_knots(knots),
@@ -172,6 +203,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     try:
         validate_options(options, biped_of(model, options))
+        checked_sequence(model, options)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     console.print(f"solving {options.variant} on model {model.name}: speed "

@@ -71,7 +71,32 @@ BAD_REQUESTS: dict[str, tuple[list[str], tuple[str, ...]]] = {
     "single support fraction zero": (["--single-support", "0"], ("single_support_fraction",)),
     "negative friction": (["--friction", "-0.5"], ("friction",)),
     "unknown model": (["--model", "no-such-model"], ("no-such-model",)),
+    "heel-toe without feet": (["--gait", "heel-toe"], ("heel-toe", "two contact points on the "
+                                                                  "foot")),
+    "missing sequence file": (["--contact-sequence", "/no/such.yaml"], ("--contact-sequence",
+                                                                        "No such file")),
 }
+
+
+@pytest.mark.parametrize(("text", "words"), [
+    ("phases: [{name: a, held: [tip_1], fraction: 1.0}]\nevents: []\nanchors: {tip_1: 0}\n",
+     ("contact sequence", "one event per phase")),
+    ("phases: [{name: a, held: [foot_9], fraction: 1.0}]\n"
+     "events: [{name: e, touchdown: [tip_2], release: [tip_1]}]\nanchors: {tip_1: 0}\n",
+     ("'foot_9', not a contact",)),
+    ("phases: oops\nevents: []\nanchors: {}\n", ("--contact-sequence", "phases = 'oops'")),
+    ("phases: [\n", ("--contact-sequence", "not valid YAML")),
+])
+def test_bad_contact_sequence_file_exits_2_naming_it(no_solve: None, tmp_path: Path,
+                                                     text: str, words: tuple[str, ...]) -> None:
+    file = tmp_path / "seq.yaml"
+    file.write_text(text)
+    result = solve("--contact-sequence", str(file), "-o", str(tmp_path / "g.gait.json"))
+    assert result.exit_code == 2, (result.output, result.exception)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
 
 
 @pytest.mark.parametrize("case", list(BAD_REQUESTS))

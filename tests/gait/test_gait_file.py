@@ -106,7 +106,7 @@ def _corrupt(gait: Gait, tmp_path: Path, edit: object) -> Path:
     (lambda d: d["phases"][0].update(t=d["phases"][0]["t"][::-1]), "phases[0].t", "increasing"),
     (lambda d: d["samples"]["points"].pop("knee_1"), "samples.points", "knee_1"),
     (lambda d: d["events"][0].update(leg="foot_9"), "events[0].leg", "not a contact"),
-    (lambda d: d["events"][1].update(name="jump"), "events[1].name", "heel_strike"),
+    (lambda d: d["events"][1].update(name="a jump!"), "events[1].name", "heel_strike"),
     (lambda d: d["parameters"].update(step_time=9.0), "parameters.step_time", "span"),
     (lambda d: d["parameters"].update(speed=-1.0), "parameters.speed", ">= 0"),
     (lambda d: d["parameters"].pop("liftoff_impulse"), "parameters", "liftoff_impulse"),

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from gaitopt.gait.gait_file import Gait
 
@@ -40,6 +41,23 @@ class GaitMetrics:
     friction_required: float
 
 
+def swing_heights(gait: Gait) -> NDArray[np.float64]:
+    """Heights (m) of the swing foot at the samples where a leg has no point on the ground:
+    the lowest of that leg's contact points (names ending ``_1`` / ``_2``; the swing tip of a
+    point-foot walk in single support)."""
+    from gaitopt.analysis.checks.samples import phase_of_samples
+
+    s = gait.samples
+    contacts = [c.name for c in gait.model.contacts]
+    out = []
+    for ph, mask in zip(gait.phases, phase_of_samples(gait), strict=True):
+        for leg in ("_1", "_2"):
+            points = [c for c in contacts if c.endswith(leg) and c in s.points]
+            if points and not any(c in ph.contacts for c in points) and mask.any():
+                out.append(np.min(np.stack([s.points[c][mask, 1] for c in points]), axis=0))
+    return np.concatenate(out) if out else np.zeros(1)
+
+
 def gait_metrics(gait: Gait) -> GaitMetrics:
     """The :class:`GaitMetrics` of ``gait``."""
     model = gait.model
@@ -55,9 +73,7 @@ def gait_metrics(gait: Gait) -> GaitMetrics:
     ratios += [np.array([abs(i[0]) / max(i[1], NORMAL_FLOOR)]) for i in impulses
                if abs(i[0]) > NORMAL_FLOOR or i[1] > NORMAL_FLOOR]
     friction = float(max((np.max(r) for r in ratios), default=0.0))
-    t1 = gait.parameters["single_support_time"]
-    t0 = gait.samples.t[0]
-    swing = gait.samples.points["tip_2"][gait.samples.t <= t0 + t1 + 1e-12, 1]
+    swing = swing_heights(gait)
     return GaitMetrics(peak_torques=peaks, torque_bounds=bounds, min_normal_force=min_force,
                        min_normal_impulse=min_impulse,
                        swing_clearance=float(np.max(swing)),

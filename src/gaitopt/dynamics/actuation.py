@@ -16,13 +16,13 @@ from typing import Any
 
 from gaitopt.dynamics.backend import Scalars, as_scalars, dot, matrix, vector
 from gaitopt.dynamics.kinematics import coordinates
-from gaitopt.dynamics.tree import contact_names
+from gaitopt.dynamics.tree import holds
 from gaitopt.robot.model import RobotModel
 
 
 def actuation_rows(model: RobotModel, contacts_held: Sequence[str]) -> list[list[float]]:
     """``B`` ``(nq, nu)`` as a list of rows of floats (it does not depend on ``q``)."""
-    held = contact_names(model, contacts_held, "contacts_held")
+    held = [h.name for h in holds(model, contacts_held, "contacts_held")]
     b = [[0.0] * model.nu for _ in range(model.nq)]
     for j, act in enumerate(model.actuators):
         if act.joint is not None:

@@ -1,7 +1,9 @@
 """The Contact Algorithm (paper Appendix 1, eqs. 7-10): dynamics with tips held on the ground.
 
-Each held contact point is a 2-d pin constraint ``c(q) = p_tip_world - p_ground = 0``. With
-``J`` the stacked contact Jacobians ``(2 nc, nq)`` (rows ``x_1, y_1, x_2, y_2, ...``):
+Each held contact point is a 2-d pin constraint ``c(q) = p_tip_world - p_ground = 0``, or with
+the hold spec ``name:y`` its normal row only (:class:`gaitopt.dynamics.tree.Hold`; the second
+point of a flat foot). With ``J`` the stacked rows ``(m, nq)`` (``m = 2 nc`` for pins, rows
+``x_1, y_1, x_2, y_2, ...``; a normal-only hold contributes its ``y`` row alone):
 
 * ``qdd_free = M^-1 (tau - C - G)`` (ABA),
 * ``Lambda = (J M^-1 J^T)^-1`` ``(2 nc, 2 nc)``, the operational-space inertia,
@@ -40,7 +42,7 @@ from gaitopt.dynamics.kinematics import (
     point_jacobian_rows,
 )
 from gaitopt.dynamics.rnea import gravity_acceleration
-from gaitopt.dynamics.tree import contact_names, contact_point
+from gaitopt.dynamics.tree import contact_point, hold_specs, holds
 from gaitopt.robot.model import RobotModel
 
 
@@ -80,9 +82,10 @@ def constraint_system(model: RobotModel, q: Scalars, names: Sequence[str],
         art = articulated_inertias(model, q)
     poses = link_poses(model, q, art.x)
     jac: list[Scalars] = []
-    for name in names:
-        i, p = contact_point(model, name)
-        jac.extend(point_jacobian_rows(model, poses, i, poses[i].to_world(p)))
+    for hold in holds(model, names):
+        i, p = contact_point(model, hold.name)
+        rows = point_jacobian_rows(model, poses, i, poses[i].to_world(p))
+        jac.extend(rows[a] for a in hold.axes)
     minv_jt = [aba_sweep(art, row) for row in jac]
     lam_inv = [[dot(jr, col) for col in minv_jt] for jr in jac]
     what = f"J M^-1 J^T of contacts {', '.join(names)}"
@@ -96,10 +99,11 @@ def contact_bias_accelerations(model: RobotModel, system: ConstraintSystem,
     tree, x = system.art.tree, system.art.x
     a = body_accelerations(tree, x, terms.c, [0.0] * len(tree))
     out: Scalars = []
-    for name in system.names:
-        i, p = contact_point(model, name)
+    for hold in holds(model, system.names):
+        i, p = contact_point(model, hold.name)
         b = model.coordinate_of_link(i)
-        out.extend(point_acceleration_world(system.poses[i], terms.v[b], a[b], p))
+        acc = point_acceleration_world(system.poses[i], terms.v[b], a[b], p)
+        out.extend(acc[k] for k in hold.axes)
     return out
 
 
@@ -142,7 +146,7 @@ def contact_dynamics(model: RobotModel, q: Any, qd: Any, tau: Any,
     hip, knee and ankle torques with the same held contacts). With no contacts this is the
     free dynamics (empty ``forces``).
     """
-    names = contact_names(model, contacts)
+    names = hold_specs(model, contacts)
     qdd, forces, lam = contact_dynamics_scalars(
         model, coordinates(model, q), coordinates(model, qd, "qd"),
         coordinates(model, tau, "tau"), names)

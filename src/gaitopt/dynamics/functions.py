@@ -39,7 +39,7 @@ from gaitopt.dynamics.actuation import generalized_forces_scalars
 from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.contact import contact_dynamics_scalars
 from gaitopt.dynamics.impact import impact_scalars, liftoff_impulse
-from gaitopt.dynamics.tree import contact_names
+from gaitopt.dynamics.tree import contact_names, hold_specs
 from gaitopt.robot.model import RobotModel
 
 Inputs = Literal["tau", "u"]
@@ -106,8 +106,8 @@ def forward_dynamics_function(model: RobotModel, *, inputs: Inputs = "tau",
 def contact_dynamics_function(model: RobotModel, contacts: Sequence[str], *,
                               inputs: Inputs = "tau", compiled: bool = False) -> ca.Function:
     """``contact_dynamics_<contacts>(q, qd, tau|u) -> (qdd, forces, Lambda)`` with the tips
-    ``contacts`` held (see :func:`.contact.contact_dynamics`)."""
-    names = contact_names(model, contacts)
+    ``contacts`` held (see :func:`.contact.contact_dynamics`; hold specs allowed)."""
+    names = hold_specs(model, contacts)
 
     def build() -> ca.Function:
         q, qd = ca.SX.sym("q", model.nq), ca.SX.sym("qd", model.nq)
@@ -129,8 +129,9 @@ def contact_dynamics_function(model: RobotModel, contacts: Sequence[str], *,
 
 def impact_function(model: RobotModel, contacts: Sequence[str], *,
                     compiled: bool = False) -> ca.Function:
-    """``impact_<contacts>(q, qd_minus) -> (qd_plus, impulses)`` (see :func:`.impact.impact`)."""
-    names = contact_names(model, contacts)
+    """``impact_<contacts>(q, qd_minus) -> (qd_plus, impulses)`` (see :func:`.impact.impact`;
+    hold specs allowed)."""
+    names = hold_specs(model, contacts)
     if not names:
         raise ValueError("impact_function needs at least one contact")
 
@@ -151,7 +152,7 @@ def liftoff_function(model: RobotModel, lifting: str, held: Sequence[str] = (), 
     impulses_held)`` (see :func:`.impact.liftoff_impulse`; the sign of ``magnitude`` is not
     checked inside the Function: bound it ``>= 0`` in the optimization)."""
     (lift,) = contact_names(model, (lifting,), "lifting")
-    held_names = contact_names(model, held, "held")
+    held_names = hold_specs(model, held, "held")
 
     def build() -> ca.Function:
         q, qd = ca.SX.sym("q", model.nq), ca.SX.sym("qd_minus", model.nq)

@@ -40,7 +40,7 @@ from gaitopt.dynamics.backend import (
 )
 from gaitopt.dynamics.contact import constraint_system
 from gaitopt.dynamics.kinematics import coordinates, link_poses, point_jacobian_rows
-from gaitopt.dynamics.tree import contact_names, contact_point
+from gaitopt.dynamics.tree import contact_names, contact_point, hold_name, hold_specs
 from gaitopt.robot.model import RobotModel
 
 
@@ -78,7 +78,7 @@ def impact_scalars(model: RobotModel, q: Scalars, qd_minus: Scalars,
 def impact(model: RobotModel, q: Any, qd_minus: Any, contacts: Sequence[str]) -> ImpactSolution:
     """Inelastic impact at configuration ``q``: afterwards every contact in ``contacts`` has
     zero velocity. ``qd_minus`` ``(nq,)`` is the velocity just before."""
-    names = contact_names(model, contacts)
+    names = hold_specs(model, contacts)
     qd_plus, impulses = impact_scalars(model, coordinates(model, q),
                                        coordinates(model, qd_minus, "qd_minus"), names)
     return ImpactSolution(vector(qd_plus), vector(impulses))
@@ -126,8 +126,8 @@ def liftoff_impulse(model: RobotModel, q: Any, qd_minus: Any, lifting: str, magn
     """Velocity jump from a liftoff impulse of ``magnitude`` (N s, >= 0) at the tip
     ``lifting`` along its leg axis toward the hip, with the ``held`` tips kept fixed."""
     (lift,) = contact_names(model, (lifting,), "lifting")
-    held_names = contact_names(model, held, "held")
-    if lift in held_names:
+    held_names = hold_specs(model, held, "held")
+    if lift in (hold_name(h) for h in held_names):
         raise ValueError(f"liftoff: the lifting contact {lift!r} cannot also be held "
                          f"(held = {list(held_names)})")
     p = as_scalar(magnitude, "liftoff magnitude")

@@ -31,8 +31,8 @@ from gaitopt.dynamics.tree import (
     Y_COORDINATE,
     Body,
     bodies,
-    contact_names,
     contact_point,
+    holds,
     joint_transforms,
     link_index,
 )
@@ -251,12 +251,13 @@ def contact_acceleration(model: RobotModel, q: Any, qd: Any, qdd: Any, contact: 
 
 def contact_jacobian(model: RobotModel, q: Any, contacts: str | Sequence[str]) -> Any:
     """Stacked Jacobian ``(2 * n_contacts, nq)`` of the listed contact points (rows
-    ``x_1, y_1, x_2, y_2, ...``, world frame). A single name gives ``(2, nq)``."""
-    names = contact_names(model, contacts)
+    ``x_1, y_1, x_2, y_2, ...``, world frame). A single name gives ``(2, nq)``; a hold spec
+    ``name:y`` contributes its ``y`` row only (:func:`gaitopt.dynamics.tree.holds`)."""
     q_s = coordinates(model, q)
     poses = link_poses(model, q_s, joint_transforms(bodies(model), q_s))
     rows: list[Scalars] = []
-    for name in names:
-        i, p = contact_point(model, name)
-        rows.extend(point_jacobian_rows(model, poses, i, poses[i].to_world(p)))
+    for hold in holds(model, contacts):
+        i, p = contact_point(model, hold.name)
+        point_rows = point_jacobian_rows(model, poses, i, poses[i].to_world(p))
+        rows.extend(point_rows[a] for a in hold.axes)
     return matrix(rows, model.nq)

@@ -106,6 +106,60 @@ def contact_names(model: RobotModel, contacts: Sequence[str] | str, what: str = 
     return out
 
 
+#: How a held contact point may be held: ``"xy"`` pins it (both world axes), ``"y"`` holds it
+#: along the ground normal only (it may not move vertically but may slide; the second point of
+#: a flat foot whose first point is pinned, so that the constraints stay independent).
+HOLD_AXES: dict[str, tuple[int, ...]] = {"xy": (0, 1), "y": (1,)}
+
+
+@dataclass(frozen=True)
+class Hold:
+    """A contact point held on the ground along some world axes (indices into its position
+    ``(x, y)``): the rows of the constraint ``p_c(q)[axes] = const``."""
+
+    name: str
+    axes: tuple[int, ...] = (0, 1)
+
+    @property
+    def spec(self) -> str:
+        """The text form: ``name`` for a pin, ``name:y`` for a normal-only hold."""
+        return self.name if self.axes == (0, 1) else f"{self.name}:y"
+
+
+def hold_name(spec: str) -> str:
+    """The contact name of a hold spec (``"toe_1:y"`` -> ``"toe_1"``)."""
+    return spec.split(":", 1)[0]
+
+
+def holds(model: RobotModel, specs: Sequence[str] | str, what: str = "contacts"
+          ) -> tuple[Hold, ...]:
+    """Parse hold specs: ``"name"`` or ``"name:xy"`` (pinned) and ``"name:y"`` (held along
+    the normal only). Names are validated like :func:`contact_names`."""
+    if isinstance(specs, str):
+        specs = (specs,)
+    out = []
+    for spec in specs:
+        name, _, axes = spec.partition(":")
+        if axes and axes not in HOLD_AXES:
+            raise ValueError(f"{what}: hold {spec!r}: the axes after ':' must be one of "
+                             f"{', '.join(HOLD_AXES)}")
+        out.append(Hold(name, HOLD_AXES[axes or "xy"]))
+    contact_names(model, [h.name for h in out], what)
+    return tuple(out)
+
+
+def hold_specs(model: RobotModel, specs: Sequence[str] | str, what: str = "contacts"
+               ) -> tuple[str, ...]:
+    """Validated, normalised hold specs (``"name:xy"`` -> ``"name"``)."""
+    return tuple(h.spec for h in holds(model, specs, what))
+
+
+def hold_rows(model: RobotModel, specs: Sequence[str]) -> int:
+    """Number of constraint rows of the held points ``specs`` (2 per pin, 1 per normal-only
+    hold)."""
+    return sum(len(h.axes) for h in holds(model, specs))
+
+
 def contact_point(model: RobotModel, name: str) -> tuple[int, tuple[float, float]]:
     """``(link index, point in the link frame)`` of a contact point."""
     contact_names(model, (name,), "contact")

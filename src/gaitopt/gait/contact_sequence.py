@@ -13,22 +13,38 @@ leaves at that instant). After the last event the legs swap roles (the mapping o
 :func:`~gaitopt.gait.gait_file.leg_swap_permutations`) and the gait moves on by one step length,
 and the next step starts again with phase 0.
 
-A held point stands still at its *anchor* on the ground: ``x = anchor * L`` (``L`` the step
-length), ``y = 0``. Leg 1 stands at ``x = 0`` and leg 2 lands at ``x = L``. Phase durations
-are fractions of the step time ``L / v``.
+A held point stands still at its *anchor* on the ground: ``x = anchor * L + offset`` (``L``
+the step length, ``offset`` in metres, 0 unless given), ``y = 0``. Leg 1 stands at ``x = 0``
+and leg 2 lands at ``x = L``. Phase durations are fractions of the step time ``L / v``.
+
+A phase holds each point by a *hold spec* (:func:`gaitopt.dynamics.tree.holds`): ``name``
+pins it (x and y), ``name:y`` holds it along the ground normal only. A flat foot is its heel
+pinned and its toe held by ``toe:y``: pinning both would state the foot's three constraints
+four times (a singular contact problem). A normal-only hold needs no anchor. A point may change
+how it is held at an event (the toe of a flat foot becomes pinned when the heel rises): the
+foot stands still before the event, so no impact is needed.
 
 The three built-in sequences (:data:`SEQUENCES`) are instances of this one mechanism:
 
 * ``walk`` (the paper's): single support on tip 1 -> tip 2 touches down (tip 1 held) ->
   double support -> tip 1 released with the liftoff impulse;
 * ``walk-single-support``: single support on tip 1 -> tip 2 touches down and tip 1 releases;
-* ``run``: stance on tip 1 -> tip 1 released (no impulse) -> flight -> tip 2 touches down.
+* ``run``: stance on tip 1 -> tip 1 released (no impulse) -> flight -> tip 2 touches down;
+* ``heel-toe`` (feet with heel and toe points): foot 1 flat -> heel 1 rises -> toe 1 rolls ->
+  heel 2 strikes -> double support on toe 1 and heel 2 -> toe 1 leaves (optional impulse) ->
+  foot 2 rolls on its heel -> toe 2 strikes (foot flat).
+
+A user gives any other sequence as data (:func:`sequence_from_dict`, the ``contact_sequence``
+section of a YAML file; docs/formulations.md).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
+from gaitopt.dynamics.tree import hold_name, holds
 from gaitopt.robot.model import RobotModel
 
 
@@ -66,16 +82,34 @@ class ContactSequence:
     phases: tuple[PhaseSpec, ...]
     events: tuple[EventSpec, ...]
     anchors: tuple[tuple[str, float], ...]
+    #: Ground x offsets (m) added to ``anchor * L``; points not listed have none.
+    offsets: tuple[tuple[str, float], ...] = ()
 
     def anchor(self, contact: str) -> float:
         """The anchor of ``contact`` (its ground x in step lengths)."""
-        return dict(self.anchors)[contact]
+        return dict(self.anchors)[hold_name(contact)]
+
+    def offset(self, contact: str) -> float:
+        """The ground x offset (m) of ``contact``'s anchor."""
+        return dict(self.offsets).get(hold_name(contact), 0.0)
+
+    def ground_x(self, contact: str, step_length: Any) -> Any:
+        """Where ``contact`` is held on the ground: ``anchor * L + offset`` (m)."""
+        return self.anchor(contact) * step_length + self.offset(contact)
 
     def held_after(self, i: int) -> tuple[str, ...]:
-        """The points held just after event ``i`` (before any leg swap)."""
-        ev, held = self.events[i], self.phases[i].held
+        """The names of the points held just after event ``i`` (before any leg swap)."""
+        ev, held = self.events[i], [hold_name(c) for c in self.phases[i].held]
         kept = tuple(c for c in held if c not in ev.release)
         return kept + tuple(c for c in ev.touchdown if c not in kept)
+
+    def holds_after(self, i: int, contact_swap: Mapping[str, str]) -> tuple[str, ...]:
+        """The hold specs in force just after event ``i``: those of the next phase, in this
+        step's names (after the last event, mapped back through the leg swap)."""
+        nxt = self.phases[(i + 1) % len(self.phases)].held
+        if i < len(self.events) - 1:
+            return nxt
+        return tuple(swap_spec(c, contact_swap) for c in nxt)
 
     def to_dict(self) -> dict[str, object]:
         """Plain data for the gait file."""
@@ -87,7 +121,26 @@ class ContactSequence:
                         "release": list(e.release), "impulse": e.impulse}
                        for e in self.events],
             "anchors": {c: a for c, a in self.anchors},
-        }
+        } | ({"offsets": {c: b for c, b in self.offsets}} if self.offsets else {})
+
+
+def phase_holds(sequence: Mapping[str, Any] | None, i: int, contacts: Sequence[str]
+                ) -> tuple[str, ...]:
+    """The hold specs of phase ``i`` of a gait file: from its ``contact_sequence`` when it has
+    one (and its phase ``i`` holds the points ``contacts``), else the contact names (pins)."""
+    if sequence is not None:
+        phases = sequence.get("phases", [])
+        if i < len(phases):
+            held = tuple(str(c) for c in phases[i].get("held", ()))
+            if [hold_name(c) for c in held] == list(contacts):
+                return held
+    return tuple(contacts)
+
+
+def swap_spec(spec: str, contact_swap: Mapping[str, str]) -> str:
+    """A hold spec with its contact renamed by the leg swap (the axes kept)."""
+    name, sep, axes = spec.partition(":")
+    return contact_swap.get(name, name) + sep + axes
 
 
 def walking_sequence(model: RobotModel, single_support_fraction: float, *,
@@ -123,6 +176,124 @@ def running_sequence(model: RobotModel, stance_fraction: float) -> ContactSequen
         ((c1, 0.0), (c2, 1.0)))
 
 
+def feet(model: RobotModel, contact_swap: Mapping[str, str]
+         ) -> tuple[tuple[str, str], tuple[str, str]]:
+    """``((heel_1, toe_1), (heel_2, toe_2))``: the two contact points on the link of the
+    model's first contact (its foot), rear one first in the standing pose (all coordinates
+    0), and their counterparts on the other foot by the leg swap."""
+    from gaitopt.dynamics.kinematics import contact_position
+
+    link = model.contacts[0].link
+    on_foot = [c.name for c in model.contacts if c.link == link]
+    if len(on_foot) != 2:
+        raise ContactSequenceError(
+            f"model {model.name!r}: a heel-toe gait needs exactly two contact points on the "
+            f"foot {link!r} (heel and toe); it has {len(on_foot)}")
+    zero = [0.0] * model.nq
+    heel, toe = sorted(on_foot, key=lambda c: float(contact_position(model, zero, c)[0]))
+    other = (contact_swap.get(heel, heel), contact_swap.get(toe, toe))
+    if other[0] == heel or other[1] == toe:
+        raise ContactSequenceError(f"model {model.name!r}: the leg swap maps the foot "
+                                   f"points {heel!r}, {toe!r} to themselves")
+    return (heel, toe), other
+
+
+def foot_length(model: RobotModel, heel: str, toe: str) -> float:
+    """Distance (m) from the heel point to the toe point (on one link)."""
+    a, b = model.contact(heel).at, model.contact(toe).at
+    return float(((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2) ** 0.5)
+
+
+def heel_toe_sequence(model: RobotModel, contact_swap: Mapping[str, str],
+                      single_support_fraction: float, *, impulse: bool) -> ContactSequence:
+    """A walk with feet (module docstring): heel 1 pinned at ``x = 0`` and its toe held
+    normal-only while foot 1 is flat; toe 1 pinned at ``x = d`` (``d`` the foot length) once
+    the heel rises; heel 2 strikes at ``x = L``; toe 1 leaves (with the liftoff impulse when
+    ``impulse``); foot 2 rolls on its heel until its toe strikes. Shares of the step time:
+    double support ``1 - f``; of the single support ``f``: foot flat 0.5, heel off 0.35, heel
+    rocker 0.15."""
+    (h1, t1), (h2, t2) = feet(model, contact_swap)
+    f = single_support_fraction
+    if f >= 1.0:
+        raise ContactSequenceError("the heel-toe gait has a double support: "
+                                   "single_support_fraction must be < 1")
+    return ContactSequence(
+        "heel-toe",
+        (PhaseSpec("foot_flat", (h1, f"{t1}:y"), 0.5 * f),
+         PhaseSpec("heel_off", (t1,), 0.35 * f),
+         PhaseSpec("double_support", (t1, h2), 1.0 - f),
+         PhaseSpec("heel_rocker", (h2,), 0.15 * f)),
+        (EventSpec("heel_rise", release=(h1,)),
+         EventSpec("heel_strike", touchdown=(h2,)),
+         EventSpec("toe_off", release=(t1,), impulse=impulse),
+         EventSpec("foot_flat", touchdown=(t2,))),
+        ((h1, 0.0), (t1, 0.0), (h2, 1.0)),
+        ((t1, foot_length(model, h1, t1)),))
+
+
+def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSequence:
+    """A sequence from plain data (the form :meth:`ContactSequence.to_dict` writes, as in a
+    YAML file): ``name``, ``phases`` (``name``, ``held``, ``fraction``), ``events`` (``name``,
+    optional ``touchdown``, ``release``, ``impulse``), ``anchors`` (contact -> step
+    lengths), optional ``offsets`` (contact -> m). Check it against a model with
+    :func:`check_sequence`."""
+    def fail(field: str, value: Any, expected: str) -> ContactSequenceError:
+        return ContactSequenceError(f"{where}.{field} = {value!r}: {expected}")
+
+    def mapping(field: str, value: Any, keys: tuple[str, ...], required: tuple[str, ...]
+                ) -> dict[str, Any]:
+        if not isinstance(value, dict):
+            raise fail(field, value, "must be a mapping")
+        extra = sorted(set(value) - set(keys))
+        if extra:
+            raise fail(field, value, f"unknown keys {extra} (allowed: {', '.join(keys)})")
+        missing = [k for k in required if k not in value]
+        if missing:
+            raise fail(field, value, f"missing {', '.join(missing)}")
+        return value
+
+    def names(field: str, value: Any) -> tuple[str, ...]:
+        if not isinstance(value, list | tuple) or not all(isinstance(v, str) for v in value):
+            raise fail(field, value, "must be a list of contact names")
+        return tuple(value)
+
+    def number(field: str, value: Any) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise fail(field, value, "must be a number")
+        return float(value)
+
+    top = mapping("", data, ("name", "phases", "events", "anchors", "offsets"),
+                  ("phases", "events", "anchors"))
+    if not isinstance(top["phases"], list) or not top["phases"]:
+        raise fail("phases", top["phases"], "must be a non-empty list")
+    if not isinstance(top["events"], list):
+        raise fail("events", top["events"], "must be a list (one event per phase)")
+    phases = []
+    for k, ph in enumerate(top["phases"]):
+        e = mapping(f"phases[{k}]", ph, ("name", "held", "fraction"),
+                    ("name", "held", "fraction"))
+        phases.append(PhaseSpec(str(e["name"]), names(f"phases[{k}].held", e["held"]),
+                                number(f"phases[{k}].fraction", e["fraction"])))
+    events = []
+    for k, ev in enumerate(top["events"]):
+        e = mapping(f"events[{k}]", ev, ("name", "touchdown", "release", "impulse"),
+                    ("name",))
+        if not isinstance(e.get("impulse", False), bool):
+            raise fail(f"events[{k}].impulse", e["impulse"], "must be true or false")
+        events.append(EventSpec(str(e["name"]),
+                                names(f"events[{k}].touchdown", e.get("touchdown", [])),
+                                names(f"events[{k}].release", e.get("release", [])),
+                                bool(e.get("impulse", False))))
+    anchors, offsets = top["anchors"], top.get("offsets", {}) or {}
+    for field, value in (("anchors", anchors), ("offsets", offsets)):
+        if not isinstance(value, dict):
+            raise fail(field, value, "must be a mapping of contact names to numbers")
+    return ContactSequence(
+        str(top.get("name", "custom")), tuple(phases), tuple(events),
+        tuple((str(c), number(f"anchors.{c}", a)) for c, a in anchors.items()),
+        tuple((str(c), number(f"offsets.{c}", b)) for c, b in offsets.items()))
+
+
 def _two_contacts(model: RobotModel) -> tuple[str, str]:
     if len(model.contacts) < 2:
         raise ContactSequenceError(
@@ -139,15 +310,30 @@ def check_sequence(model: RobotModel, seq: ContactSequence,
     names = {c.name for c in model.contacts}
     if not seq.phases or len(seq.events) != len(seq.phases):
         raise ContactSequenceError(f"sequence {seq.name!r}: needs one event per phase")
+    if len({ph.name for ph in seq.phases}) != len(seq.phases):
+        raise ContactSequenceError(f"sequence {seq.name!r}: phase names must be distinct")
     anchors = dict(seq.anchors)
+    for c in list(anchors) + [c for c, _ in seq.offsets]:
+        if c not in names:
+            raise ContactSequenceError(f"sequence {seq.name!r}: anchor of {c!r}, not a "
+                                       f"contact of model {model.name!r}")
     for ph in seq.phases:
-        for c in ph.held:
+        for spec in ph.held:
+            c = hold_name(spec)
             if c not in names:
                 raise ContactSequenceError(f"sequence {seq.name!r}: phase {ph.name!r} holds "
                                            f"{c!r}, not a contact of model {model.name!r}")
-            if c not in anchors:
+            try:
+                (hold,) = holds(model, (spec,), f"phase {ph.name!r}")
+            except ValueError as exc:
+                raise ContactSequenceError(f"sequence {seq.name!r}: {exc}") from None
+            if 0 in hold.axes and c not in anchors:
                 raise ContactSequenceError(f"sequence {seq.name!r}: contact {c!r} has no "
                                            "anchor")
+        held_names = [hold_name(c) for c in ph.held]
+        if len(set(held_names)) != len(held_names):
+            raise ContactSequenceError(f"sequence {seq.name!r}: phase {ph.name!r} holds a "
+                                       "point twice")
         if not ph.fraction > 0.0:
             raise ContactSequenceError(f"sequence {seq.name!r}: phase {ph.name!r} fraction "
                                        f"{ph.fraction:g} must be > 0")
@@ -156,20 +342,21 @@ def check_sequence(model: RobotModel, seq: ContactSequence,
         raise ContactSequenceError(f"sequence {seq.name!r}: phase fractions sum to "
                                    f"{total:g}, not 1")
     for i, ev in enumerate(seq.events):
-        held = seq.phases[i].held
+        held = [hold_name(c) for c in seq.phases[i].held]
         for c in ev.release:
             if c not in held:
                 raise ContactSequenceError(f"sequence {seq.name!r}: event {ev.name!r} "
                                            f"releases {c!r}, which is not held")
         for c in ev.touchdown:
-            if c in held or c not in anchors:
+            if c in held or c not in names:
                 raise ContactSequenceError(f"sequence {seq.name!r}: event {ev.name!r} "
-                                           f"touches down {c!r}, which is held or unanchored")
+                                           f"touches down {c!r}, which is held or not a "
+                                           "contact of the model")
         if ev.impulse and len(ev.release) != 1:
             raise ContactSequenceError(f"sequence {seq.name!r}: event {ev.name!r} has an "
                                        "impulse but does not release exactly one point")
         after = set(seq.held_after(i))
-        nxt = seq.phases[(i + 1) % len(seq.phases)].held
+        nxt = [hold_name(c) for c in seq.phases[(i + 1) % len(seq.phases)].held]
         if i == len(seq.events) - 1:
             after = {contact_swap.get(c, c) for c in after}
         if after != set(nxt):

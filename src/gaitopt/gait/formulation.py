@@ -11,27 +11,73 @@ from __future__ import annotations
 
 from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import full_coordinates as full
-from gaitopt.gait.contact_sequence import ContactSequence, running_sequence, walking_sequence
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.contact_sequence import (
+    ContactSequence,
+    ContactSequenceError,
+    check_sequence,
+    heel_toe_sequence,
+    running_sequence,
+    sequence_from_dict,
+    walking_sequence,
+)
+from gaitopt.gait.full_physics import model_symmetry
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
-from gaitopt.robot.biped import BipedStructure, biped_structure
+from gaitopt.robot.biped import BipedStructure, BipedStructureError, biped_structure
 from gaitopt.robot.model import RobotModel
 
 
-def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure:
-    """The legs of ``model``: the reduced formulation needs exactly the five-link shape, the
-    full one any torso with two thigh-shank legs (other links allowed)."""
-    return checked_biped(model) if options.formulation == "reduced" else biped_structure(model)
+def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure | None:
+    """The legs of ``model``: the reduced formulation needs exactly the five-link shape; in the
+    full one, a torso with two thigh-shank legs (other links allowed), or None for any other
+    tree (feet, knee-less legs: the guess is then :mod:`gaitopt.gait.sequence_guess`)."""
+    if options.formulation == "reduced":
+        return checked_biped(model)
+    try:
+        return biped_structure(model)
+    except BipedStructureError:
+        return None
+
+
+def default_formulation(model: RobotModel, gait: str, custom_sequence: bool) -> str:
+    """The formulation a user gets without asking: the paper's reduced coordinates for the
+    walk of a five-link-shaped biped, else full coordinates (the only one for other models,
+    runs, heel-toe walks and given sequences)."""
+    if gait != "walk" or custom_sequence:
+        return "full"
+    try:
+        checked_biped(model)
+    except BipedStructureError:
+        return "full"
+    return "reduced"
 
 
 def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
-    """The contact sequence of ``options``: the paper's walk, the single-support walk or a
-    run."""
+    """The contact sequence of ``options``: the one given as data, or the paper's walk, the
+    single-support walk, a run or a heel-toe walk."""
+    if options.contact_sequence is not None:
+        return sequence_from_dict(options.contact_sequence)
+    if options.gait == "heel-toe":
+        return heel_toe_sequence(model, model_symmetry(model).contacts,
+                                 options.single_support_fraction, impulse=options.impulse)
     if options.gait == "run":
         return running_sequence(model, options.single_support_fraction)
     return walking_sequence(model, options.single_support_fraction,
                             impulse=options.impulse and options.double_support)
+
+
+def checked_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence | None:
+    """The contact sequence of ``options`` checked against ``model`` (None in the reduced
+    formulation); a bad one raises :class:`GaitOptionsError` naming what is wrong."""
+    if options.formulation != "full":
+        return None
+    try:
+        seq = contact_sequence(model, options)
+        check_sequence(model, seq, dict(model_symmetry(model).contacts))
+    except (ContactSequenceError, ValueError) as exc:
+        raise GaitOptionsError(f"contact sequence: {exc}") from None
+    return seq
 
 
 def problem_for(model: RobotModel, options: GaitOptions) -> Problem:

@@ -13,10 +13,12 @@ works for any planar tree with contact points and any :class:`ContactSequence`:
       q'  = qd  + J(q)^T gamma
       qd' = qdd + J(q)^T nu
 
-  ``gamma, nu`` (2 per held point, named ``gamma_<c>_x`` ...) are free controls that only move
-  the state back onto the constraint manifold. The held points' positions ``p_c(q) = (a_c L,
-  0)`` and velocities ``J qd = 0`` are enforced at every knot after the first (at the first
-  they follow from the event map and the previous phase, so they are not stated twice), and
+  ``gamma, nu`` (one per constraint row: 2 per pinned point, 1 per normal-only hold ``c:y``;
+  named ``gamma_<c>_x`` ...) are free controls that only move the state back onto the
+  constraint manifold. The held points' positions ``p_c(q) = (a_c L + b_c, 0)`` (only ``y``
+  for a normal-only hold) and velocities ``J qd = 0`` are enforced at every knot after the
+  first (at the first they follow from the event map and the previous phase, so they are not
+  stated twice), and
   ``gamma = nu = 0`` at the first knot. This makes the NLP square in the constraint
   directions: the projection is the discrete correction of the collocation's drift (as in
   Posa, Kuindersma and Tedrake 2016) and vanishes as the grid is refined. The contact points
@@ -44,6 +46,7 @@ import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
+from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait import cost
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, check_sequence
 from gaitopt.gait.full_physics import (
@@ -53,6 +56,7 @@ from gaitopt.gait.full_physics import (
     event_impulses,
     event_map,
     full_controls,
+    hold_axes,
     model_symmetry,
     phase_point,
     projection_names,
@@ -159,6 +163,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         acts = actuator_names(model, held, ankle=options.ankle)
         actuators_of[ph.name] = acts
         proj = projection_names(held)
+        n_rows = len(hold_axes(held))
         controls = acts + proj
         cache: dict[str, Any] = {}
 
@@ -175,29 +180,31 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
             def held_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held) -> Any:
                 xs = as_scalars(x, 2 * nq, "x")
                 q, qd = vector(xs[:nq]), vector(xs[nq:])
-                rows: list[Any] = []
-                for c in held:
+                rows, speeds = [], []
+                for c, a in hold_axes(held):
                     pos = as_scalars(contact_position(model, q, c), 2, "p")
-                    rows += [pos[0] - seq.anchor(c) * p[_L], pos[1]]
-                for c in held:
-                    rows += as_scalars(contact_velocity(model, q, qd, c), 2, "v")
-                return vector(rows)
+                    vel = as_scalars(contact_velocity(model, q, qd, c), 2, "v")
+                    rows.append(pos[a] - seq.ground_x(c, p[_L]) if a == 0 else pos[a])
+                    speeds.append(vel[a])
+                return vector(rows + speeds)
 
             def force_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held,
                            point: Any = point) -> Any:
                 f = as_scalars(point(x, u).forces, 2 * len(held), "forces")
                 rows = [f[2 * k + 1] for k in range(len(held))]
                 if mu is not None:
-                    for k in range(len(held)):
-                        rows += [mu * f[2 * k + 1] - f[2 * k], mu * f[2 * k + 1] + f[2 * k]]
+                    for k, spec in enumerate(held):
+                        if ":" not in spec:  # pinned: a friction cone
+                            rows += [mu * f[2 * k + 1] - f[2 * k], mu * f[2 * k + 1] + f[2 * k]]
                 return vector(rows)
 
             path.append(PathConstraint(HELD, held_rows, lower=0.0, upper=0.0, at="knots",
-                                       scale=[0.1] * (2 * len(held)) + [1.0] * (2 * len(held))))
+                                       scale=[0.1] * n_rows + [1.0] * n_rows))
             path.append(PathConstraint(FORCES, force_rows, lower=0.0, upper=ca.inf,
                                        scale=weight))
         landing = seq.events[len(phases)].touchdown
-        free = [c.name for c in model.contacts if c.name not in held]
+        held_names = [hold_name(c) for c in held]
+        free = [c.name for c in model.contacts if c.name not in held_names]
         for label, points in ((CLEARANCE, [c for c in free if c not in landing]),
                               (LANDING_CLEARANCE, [c for c in free if c in landing])):
             if not points:
@@ -262,13 +269,16 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         linkages.append(Linkage(src, dst, jump=jump, name=f"{ev.name}: event map" +
                                 (" and periodicity (legs swapped)" if last else "")))
         if ev.touchdown:
+            landing_rows = [(c, a) for c, a in hold_axes(seq.holds_after(i, symmetry.contacts))
+                            if c in ev.touchdown]
+
             def touchdown(ends: Mapping[str, Any], p: Any, src: str = src,
-                        ev: EventSpec = ev) -> Any:
+                          landing_rows: list[tuple[str, int]] = landing_rows) -> Any:
                 q, _ = split(ends[src].xf)
                 rows: list[Any] = []
-                for c in ev.touchdown:
+                for c, a in landing_rows:
                     pos = as_scalars(contact_position(model, q, c), 2, "p")
-                    rows += [pos[0] - seq.anchor(c) * p[_L], pos[1]]
+                    rows.append(pos[a] - seq.ground_x(c, p[_L]) if a == 0 else pos[a])
                 return vector(rows)
 
             events.append(BoundaryConstraint(f"{ev.name}: {TOUCHDOWN}", touchdown, 0.0, 0.0,
@@ -282,12 +292,13 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
 
             events.append(BoundaryConstraint(f"{ev.name}: {IMPULSES}", normal, lower=floor,
                                              upper=ca.inf, scale=1.0))
-            if mu is not None:
+            pinned = tuple(c for c in seq.holds_after(i, symmetry.contacts) if ":" not in c)
+            if mu is not None and pinned:
                 def friction(ends: Mapping[str, Any], p: Any, i: int = i, src: str = src,
-                             after: tuple[str, ...] = after) -> Any:
+                             pinned: tuple[str, ...] = pinned) -> Any:
                     imp = event_impulses(model, seq, i, ends[src].xf, p[_P])
                     rows: list[Any] = []
-                    for c in after:
+                    for c in pinned:
                         t_i, n_i = as_scalars(imp[c], 2, "i")
                         rows += [mu * n_i - t_i, mu * n_i + t_i]
                     return vector(rows)
@@ -402,7 +413,7 @@ def _periodic_controls(model: RobotModel, symmetry: Symmetry, seq: ContactSequen
         if other in last_acts:
             targets.append(a)
             sources.append(last_acts.index(other))
-    n_last = len(last_acts) + 4 * len(seq.phases[-1].held)
+    n_last = len(last_acts) + 2 * len(hold_axes(seq.phases[-1].held))
 
     def fn(u_from: Any, p: Any) -> Any:
         us = as_scalars(u_from, n_last, "u")

@@ -18,6 +18,7 @@ from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.dynamics.impact import impact, liftoff_impulse
 from gaitopt.dynamics.kinematics import contact_jacobian
+from gaitopt.dynamics.tree import HOLD_AXES, hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import swap_maps, swap_permutations
@@ -47,10 +48,32 @@ def state_names(model: RobotModel) -> tuple[str, ...]:
     return names + tuple(f"{n}_rate" for n in names)
 
 
+def hold_axes(held: Sequence[str]) -> list[tuple[str, int]]:
+    """``(contact, axis)`` of each constraint row of the hold specs ``held`` (axis 0 = x,
+    1 = y; :func:`gaitopt.dynamics.tree.holds`), in the Contact Algorithm's row order."""
+    out = []
+    for spec in held:
+        name, _, axes = spec.partition(":")
+        out += [(name, a) for a in HOLD_AXES[axes or "xy"]]
+    return out
+
+
 def projection_names(held: Sequence[str]) -> tuple[str, ...]:
-    """Names of the projection controls of the held points."""
-    return tuple(f"{kind}_{c}_{axis}" for kind in ("gamma", "nu") for c in held
-                 for axis in ("x", "y"))
+    """Names of the projection controls of the held points (one ``gamma`` and one ``nu``
+    per constraint row)."""
+    rows = hold_axes(held)
+    return tuple(f"{kind}_{c}_{'xy'[a]}" for kind in ("gamma", "nu") for c, a in rows)
+
+
+def per_point(held: Sequence[str], flat: Any) -> dict[str, Any]:
+    """Row-stacked forces or impulses of the held points -> ``(2,)`` per point by name (world
+    x, y; zero along an axis the point is not held on)."""
+    rows = hold_axes(held)
+    values = as_scalars(flat, len(rows), "forces") if rows else []
+    out: dict[str, list[Any]] = {}
+    for (c, a), value in zip(rows, values, strict=True):
+        out.setdefault(c, [0.0, 0.0])[a] = value
+    return {c: vector(v) for c, v in out.items()}
 
 
 def actuator_names(model: RobotModel, held: Sequence[str], *, ankle: bool) -> tuple[str, ...]:
@@ -81,25 +104,28 @@ class PointValues:
 def phase_point(model: RobotModel, held: Sequence[str], actuators: Sequence[str], x: Any,
                 u: Any) -> PointValues:
     """``xdot = [qd + J^T gamma, qdd + J^T nu]`` with ``qdd, f`` from the Contact Algorithm
-    (``u`` = actuator torques then projection controls)."""
+    (``u`` = actuator torques then projection controls). ``forces`` ``(2 n_held,)``: per held
+    point ``[fx, fy]`` (0 along an axis it is not held on)."""
     nq, na = model.nq, len(actuators)
+    m = len(hold_axes(held))
     xs = as_scalars(x, 2 * nq, "x")
     q, qd = xs[:nq], xs[nq:]
-    us = as_scalars(u, na + 4 * len(held), "u")
+    us = as_scalars(u, na + 2 * m, "u")
     tau = generalized_forces(model, vector(q), vector(full_controls(model, actuators,
                                                                     us[:na])), held)
     sol = contact_dynamics(model, vector(q), vector(qd), tau, held)
     qdd = as_scalars(sol.qdd, nq, "qdd")
     dq, dqd = list(qd), list(qdd)
     if held:
-        m = 2 * len(held)
         gamma, nu = us[na:na + m], us[na + m:na + 2 * m]
         jac = contact_jacobian(model, vector(q), held)
         for r in range(m):
             for j in range(nq):
                 dq[j] = dq[j] + jac[r, j] * gamma[r]
                 dqd[j] = dqd[j] + jac[r, j] * nu[r]
-    return PointValues(xdot=vector(dq + dqd), qdd=sol.qdd, forces=sol.forces)
+    forces = per_point(held, sol.forces)
+    stacked = [f for spec in held for f in as_scalars(forces[hold_name(spec)], 2, "f")]
+    return PointValues(xdot=vector(dq + dqd), qdd=sol.qdd, forces=vector(stacked))
 
 
 @dataclass(frozen=True)
@@ -112,20 +138,19 @@ class EventValues:
 
 def event_map(model: RobotModel, seq: ContactSequence, i: int, q: Any, qd: Any,
               impulse: Any) -> EventValues:
-    """Event ``i``: impact of the points held afterwards if any touch down; else the
-    liftoff impulse of magnitude ``impulse`` (N s) on the released point; else nothing."""
+    """Event ``i``: impact of the points held afterwards (as the next phase holds them) if
+    any touch down; else the liftoff impulse of magnitude ``impulse`` (N s) on the released
+    point; else nothing. Impulses ``(2,)`` per point as in :func:`per_point`."""
     ev: EventSpec = seq.events[i]
-    after = seq.held_after(i)
+    after = seq.holds_after(i, model_symmetry(model).contacts)
     if ev.touchdown:
         sol = impact(model, q, qd, after)
-        flat = as_scalars(sol.impulses, 2 * len(after), "impulses")
-        return EventValues(sol.qd_plus, {c: vector(flat[2 * k:2 * k + 2])
-                                         for k, c in enumerate(after)})
+        return EventValues(sol.qd_plus, per_point(after, sol.impulses))
     if ev.impulse:
         lift = liftoff_impulse(model, q, qd, ev.release[0], impulse, after)
-        flat = as_scalars(lift.impulses_held, 2 * len(after), "impulses") if after else []
         out = {ev.release[0]: lift.impulse_lifting}
-        out |= {c: vector(flat[2 * k:2 * k + 2]) for k, c in enumerate(after)}
+        if after:
+            out |= per_point(after, lift.impulses_held)
         return EventValues(lift.qd_plus, out)
     return EventValues(qd, {})
 

@@ -53,7 +53,7 @@ VERSION = 2
 READABLE_VERSIONS: tuple[int, ...] = (1, 2)
 
 #: World points every gait's samples carry (leg numbers as in the step: leg 1 stands).
-POINT_NAMES: tuple[str, ...] = ("hip", "knee_1", "knee_2", "tip_1", "tip_2", "torso_top")
+POINT_NAMES: tuple[str, ...] = ("hip", "torso_top")
 PARAMETER_KEYS: tuple[str, ...] = ("step_length", "speed", "step_time", "single_support_time",
                                    "liftoff_impulse")
 SOLVER_KEYS: tuple[str, ...] = ("status", "success", "iterations", "wall_time_s", "variables",
@@ -229,8 +229,9 @@ class GaitEvent:
     qd_after: Array
 
     def __post_init__(self) -> None:
-        if self.name not in EVENT_NAMES:
-            raise _fail("name", f"expected one of {', '.join(EVENT_NAMES)}, got {self.name!r}")
+        if not (isinstance(self.name, str) and self.name.isidentifier()):
+            raise _fail("name", f"expected an event name (letters, digits, '_'; the built-in "
+                        f"sequences use {', '.join(EVENT_NAMES)}), got {self.name!r}")
         set_ = object.__setattr__
         set_(self, "t", _number("t", self.t))
         imp = _mapping("impulses", self.impulses)
@@ -244,7 +245,9 @@ class GaitEvent:
 @dataclass(frozen=True, kw_only=True, eq=False)
 class GaitSamples:
     """Dense samples: ``t`` (N,) s, ``q``/``qd`` (N, nq), ``u`` (N, nu), ``points`` name ->
-    (N, 2) world positions (m) of at least :data:`POINT_NAMES`."""
+    (N, 2) world positions (m) of at least :data:`POINT_NAMES` (the recorded points are
+    those of :func:`gaitopt.gait.record.sample_points`: for the five-link biped also
+    ``knee_1, knee_2, tip_1, tip_2``)."""
 
     t: Array
     q: Array

@@ -80,8 +80,7 @@ def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple
     force_scale = 100.0  # forces are cheap in the least-squares norm
     a = b_full[:, cols]
     if held:
-        j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(2 * len(held),
-                                                                               -1)
+        j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(-1, model.nq)
         a = np.hstack([a, force_scale * j.T])
     sol, *_ = np.linalg.lstsq(a, m_q @ qdd + h, rcond=None)
     return np.asarray(sol[: len(cols)], dtype=float)

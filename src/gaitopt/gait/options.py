@@ -21,7 +21,9 @@ Transcription = Literal["hermite-simpson", "hermite-simpson-separated", "trapezo
 TRANSCRIPTIONS: tuple[str, ...] = ("hermite-simpson", "hermite-simpson-separated",
                                    "trapezoidal")
 Formulation = Literal["reduced", "full"]
-GaitKind = Literal["walk", "run"]
+GaitKind = Literal["walk", "run", "heel-toe"]
+#: The built-in gaits (``GaitOptions.gait``).
+GAITS = ("walk", "run", "heel-toe")
 CostName = Literal["paper", "work", "metabolic"]
 FORMULATIONS: tuple[str, ...] = ("reduced", "full")
 ControlModel = Literal["paper", "jumps"]
@@ -86,7 +88,13 @@ class GaitOptions:
         gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no
-            liftoff impulse).
+            liftoff impulse) or ``"heel-toe"`` (feet with heel and toe points: foot flat,
+            heel off, double support, heel rocker; full formulation; see
+            :func:`gaitopt.gait.contact_sequence.heel_toe_sequence`).
+        contact_sequence: a contact sequence as plain data (the gait file's
+            ``contact_sequence``; :func:`gaitopt.gait.contact_sequence.sequence_from_dict`),
+            which replaces ``gait``; full formulation only. Its phase fractions are used as
+            given.
         cost: ``"paper"`` (torque squared per metre), ``"work"`` (mechanical cost of
             transport) or ``"metabolic"`` (with efficiencies and a resting power); formulas in
             :mod:`gaitopt.gait.cost` and docs/costs.md.
@@ -136,6 +144,7 @@ class GaitOptions:
     multistart: bool = False
     formulation: Formulation = "reduced"
     gait: GaitKind = "walk"
+    contact_sequence: dict[str, Any] | None = None
     single_support_fraction_bounds: tuple[float, float] | None = None
     cost: CostName = "paper"
     efficiency_positive: float = 0.25
@@ -201,9 +210,10 @@ def _bounds(name: str, value: Any, *, positive: bool = False) -> tuple[float, fl
     return lo, hi
 
 
-def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
+def validate_options(options: GaitOptions, biped: BipedStructure | None) -> None:
     """Check every option before any solve; raise :class:`GaitOptionsError` naming the field,
-    the bad value and the allowed range."""
+    the bad value and the allowed range. ``biped``: the legs, for the reach checks (None for a
+    model without thigh-shank legs in the full formulation: no reach check)."""
     o = options
     v_lo, v_hi = _bounds("speed_bounds", o.speed_bounds, positive=True)
     if o.speed is not None:
@@ -239,8 +249,18 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
             raise GaitOptionsError(f"single_support_fraction = {o.single_support_fraction:g}: "
                                    f"must lie in single_support_fraction_bounds "
                                    f"[{f_lo:g}, {f_hi:g}] (it is the first guess)")
-    if o.gait not in ("walk", "run"):
-        raise GaitOptionsError(f"gait = {o.gait!r}: must be 'walk' or 'run'")
+    if o.gait not in GAITS:
+        raise GaitOptionsError(f"gait = {o.gait!r}: must be one of {', '.join(GAITS)}")
+    if (o.gait == "heel-toe" or o.contact_sequence is not None) and o.formulation != "full":
+        raise GaitOptionsError("gait = 'heel-toe' and contact_sequence need formulation "
+                               "'full'")
+    if o.contact_sequence is not None:
+        from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
+
+        try:
+            sequence_from_dict(o.contact_sequence)
+        except ContactSequenceError as exc:
+            raise GaitOptionsError(str(exc)) from None
     if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0
                             or o.impulse):
         raise GaitOptionsError(
@@ -254,7 +274,7 @@ def validate_options(options: GaitOptions, biped: BipedStructure) -> None:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5) "
                                "in the reduced formulation (its leg inverse kinematics is "
                                "singular at a straight knee; formulation 'full' allows 0)")
-    reach = min(leg.reach(-flex) for leg in biped.legs)
+    reach = min(leg.reach(-flex) for leg in biped.legs) if biped is not None else math.inf
     longest = 2.0 * reach * 0.97
     if o.step_length is not None:
         step = _finite("step_length", o.step_length)

@@ -27,7 +27,6 @@ from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp import Result, warm_start_of
-from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -63,23 +62,37 @@ def _phase_functions(model: RobotModel, phase: str, controls: tuple[str, ...]) -
                        ["x", "u", "L"], ["q", "qd", "qdd", "forces", "u_full", "xdot"])
 
 
+def sample_points(model: RobotModel) -> tuple[tuple[str, str, tuple[float, float]], ...]:
+    """The named points of the gait samples: ``(name, link, point in the link frame)``.
+
+    ``hip`` (the base origin), the origin of every link not attached to the base at its
+    origin, named after its joint (``knee_1``, ``ankle_1``, ...), every contact point
+    (``tip_1``, ``heel_1``, ...) and ``torso_top`` (the base link's far end), in that order.
+    For the five-link biped: hip, knee_1, knee_2, tip_1, tip_2, torso_top."""
+    base = model.base
+    out = [("hip", base.name, (0.0, 0.0))]
+    for link in model.links[1:]:
+        if link.joint is None or (link.parent == base.name and
+                                  tuple(link.joint.at) == (0.0, 0.0)):
+            continue
+        out.append((link.joint.name, link.name, (0.0, 0.0)))
+    for c in model.contacts:
+        out.append((c.name, c.link, tuple(model.link(c.link).local_point(*c.at))))
+    out.append(("torso_top", base.name, tuple(base.local_point(base.length))))
+    return tuple(out)
+
+
+def point_names(model: RobotModel) -> tuple[str, ...]:
+    """The names of :func:`sample_points`."""
+    return tuple(name for name, _, _ in sample_points(model))
+
+
 @functools.lru_cache(maxsize=8)
 def _points_function(model: RobotModel) -> ca.Function:
-    """``q -> (hip, knee_1, knee_2, tip_1, tip_2, torso_top)`` world positions (2, 6)."""
-    legs = biped_structure(model).legs
+    """``q -> (2, P)`` world positions of :func:`sample_points`."""
     q = ca.SX.sym("q", model.nq)
-    cols = [q[0:2]]
-    for leg in legs:
-        cols.append(point_position(model, q, leg.shank, (0.0, 0.0)))
-    for leg in legs:
-        c = model.contact(leg.contact)
-        cols.append(point_position(model, q, c.link, model.link(c.link).local_point(*c.at)))
-    torso = model.base
-    cols.append(point_position(model, q, torso.name, torso.local_point(torso.length)))
+    cols = [point_position(model, q, link, p) for _, link, p in sample_points(model)]
     return ca.Function("record_points", [q], [ca.horzcat(*cols)])
-
-
-POINTS = ("hip", "knee_1", "knee_2", "tip_1", "tip_2", "torso_top")
 
 
 def _evaluate(fn: ca.Function, x: Array, u: Array, step: float) -> list[Array]:
@@ -105,7 +118,8 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
         count = max(101, int(np.ceil(total * SAMPLE_RATE)) + 1)
         phase_records, events = full_phases_and_events(
             model, contact_sequence(model, options), res, step, impulse)
-        samples = full_samples(model, res, count, _points_function(model), POINTS)
+        samples = full_samples(model, res, count, _points_function(model),
+                               point_names(model))
         return _gait(solution, phase_records, events, samples)
     legs = checked_biped(model).legs
     phases: list[GaitPhase] = []
@@ -230,7 +244,8 @@ def _samples(model: RobotModel, options: GaitOptions, res: Any, step: float) -> 
                 f"{times[-1]:.4f} s): the reach is enforced at knots and midpoints only; "
                 f"solve on a finer grid (more knots)")
         q[mask], qd[mask], u[mask] = q_s, qd_s, u_s
-    pts = np.asarray(_points_function(model).map(count)(q.T), dtype=float)  # (2, 6 * count)
-    pts = pts.T.reshape(count, len(POINTS), 2)  # sample k, point j at row 6 k + j
-    points = {name: pts[:, j, :] for j, name in enumerate(POINTS)}
+    names = point_names(model)
+    pts = np.asarray(_points_function(model).map(count)(q.T), dtype=float)  # (2, P * count)
+    pts = pts.T.reshape(count, len(names), 2)  # sample k, point j at row P k + j
+    points = {name: pts[:, j, :] for j, name in enumerate(names)}
     return GaitSamples(t=t, q=q, qd=qd, u=u, points=points)

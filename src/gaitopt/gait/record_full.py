@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.dynamics.backend import as_scalars
+from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait import full_physics as full
 from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.gait_file import GaitEvent, GaitPhase, GaitSamples
@@ -32,7 +33,7 @@ def _phase_function(model: RobotModel, held: tuple[str, ...], actuators: tuple[s
     """``(x, u) -> (qdd, forces, u_full)`` of a phase as one SX function."""
     nq = model.nq
     x = ca.SX.sym("x", 2 * nq)
-    u = ca.SX.sym("u", len(actuators) + 4 * len(held))
+    u = ca.SX.sym("u", len(actuators) + 2 * len(full.hold_axes(held)))
     point = full.phase_point(model, held, actuators, x, u)
     u_full = ca.vertcat(*full.full_controls(model, actuators, u[:len(actuators)]))
     forces = point.forces if held else ca.SX(0, 1)
@@ -54,9 +55,11 @@ def full_phases_and_events(model: RobotModel, seq: ContactSequence, res: Any, st
         qdd, forces, u_full = (np.asarray(o, dtype=float).T
                                for o in fn.map(ph.x.shape[0])(ph.x.T, ph.u.T))
         phases.append(GaitPhase(
-            name=spec.name, contacts=spec.held, t=ph.t, q=ph.x[:, :nq], qd=ph.x[:, nq:],
+            name=spec.name, contacts=tuple(hold_name(c) for c in spec.held), t=ph.t,
+            q=ph.x[:, :nq], qd=ph.x[:, nq:],
             qdd=qdd, u=u_full,
-            contact_forces={c: forces[:, 2 * k:2 * k + 2] for k, c in enumerate(spec.held)},
+            contact_forces={hold_name(c): forces[:, 2 * k:2 * k + 2]
+                            for k, c in enumerate(spec.held)},
             state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot))
         ev = seq.events[i]
         q_end, qd_end = ph.x[-1, :nq], ph.x[-1, nq:]

@@ -54,7 +54,14 @@ import numpy as np
 
 from gaitopt import codegen
 from gaitopt.fileio import write_bytes_atomic
-from gaitopt.gait.formulation import biped_of, problem_for, stage_bounds
+from gaitopt.gait.formulation import (
+    biped_of,
+    checked_sequence,
+    contact_sequence,
+    problem_for,
+    stage_bounds,
+)
+from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.guess import (
     WalkingGuess,
     default_running_step,
@@ -64,6 +71,7 @@ from gaitopt.gait.guess import (
 )
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.problem import FRACTION, Relaxation, parameter_bounds, with_step_time
+from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.ocp import (
     Bounds,
     Guess,
@@ -296,7 +304,8 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
         counts = grid_knots(knots, options)
         problem = problem_for(model, options.replace(knots=counts))
         intervals: dict[str, Any] = {
-            ph.name: (np.asarray(knots[i], dtype=float) if is_mesh(knots) else counts[i] - 1)
+            ph.name: (np.asarray(knots[i], dtype=float) if is_mesh(knots)
+                      else counts[min(i, len(counts) - 1)] - 1)
             for i, ph in enumerate(problem.phases)}
         _CACHE[key] = transcribe(
             problem, method=options.transcription, intervals=intervals, compiled=compiled,
@@ -386,8 +395,10 @@ class _Run:
         (the requested step length, or a speed-based guess and two others): the first that
         converges, or with ``every_start`` the best of all that converge."""
         o, coarse = self.options, coarse_knots(self.options)
-        legs = biped_of(self.model, o).legs
-        r_max = min(leg.reach(-o.min_stance_knee_flexion) for leg in legs)
+        biped = biped_of(self.model, o)
+        generic = biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
+        r_max = (0.0 if biped is None else
+                 min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
         bounds = held_fraction(dict(parameter_bounds(o)), o)
         bounds["speed"] = (speed, speed)
         bounds["impulse"] = (0.0, 0.0)
@@ -400,7 +411,12 @@ class _Run:
             steps = [default(speed) * f for f in (1.0, 0.7, 1.4)]
         found: list[Result] = []
         for step0 in steps:
-            if o.gait == "run":
+            if generic:
+                guess = sequence_guess(self.model, contact_sequence(self.model, o),
+                                       model_symmetry(self.model).contacts, speed=speed,
+                                       step_length=step0, knots=coarse, ankle=o.ankle,
+                                       ankle_torques=False)
+            elif o.gait == "run":
                 guess = naive_running_guess(
                     self.model, speed=speed, step_length=step0,
                     stance_fraction=o.single_support_fraction, knots=coarse, ankle=o.ankle,
@@ -617,6 +633,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed."""
     validate_options(options, biped_of(model, options))
+    checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)

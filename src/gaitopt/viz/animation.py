@@ -107,7 +107,8 @@ def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
     pose0 = pose_at(stride, 0.0)
     lines = draw_pose(ax, pose0, linewidth=3.0)
     arrows: dict[str, FancyArrow] = {}
-    for leg, color in (("tip_1", LEG_COLORS[0]), ("tip_2", LEG_COLORS[1])):
+    for leg, color in ((c.name, LEG_COLORS[0 if c.name.endswith("_1") else 1])
+                       for c in gait.model.contacts):
         arrows[leg] = FancyArrow(0, 0, 0, 0, width=0.008, head_width=0.03, head_length=0.03,
                                  length_includes_head=True, color=color, alpha=0.8, zorder=5)
         ax.add_patch(arrows[leg])

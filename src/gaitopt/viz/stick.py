@@ -1,7 +1,8 @@
 """Stick figures of the biped: one pose, and a strip of poses over a step.
 
 A pose is drawn from the world points of the gait samples (m): torso from ``hip`` to
-``torso_top``, leg i from ``hip`` through ``knee_i`` to ``tip_i``; leg 1 dark blue, leg 2
+``torso_top``, leg i from ``hip`` through its points (``knee_i`` to ``tip_i``, or to the ankle
+and the heel and toe of a foot); leg 1 dark blue, leg 2
 orange (:data:`gaitopt.viz.style.LEG_COLORS`).
 """
 
@@ -21,14 +22,24 @@ from gaitopt.viz.style import LEG_COLORS, new_figure
 Points = Mapping[str, NDArray[np.float64]]
 
 
+def leg_points(points: Points, leg: str) -> list[str]:
+    """The points of leg ``leg`` (``"1"`` or ``"2"``) in recorded order, from the hip out:
+    every name ending in ``_<leg>`` (joints, then contact points)."""
+    return [n for n in points if n.endswith(f"_{leg}")]
+
+
 def pose_segments(points: Points, offset: float = 0.0) -> dict[str, NDArray[np.float64]]:
-    """Polylines (k, 2) of the torso and both legs from one pose's points (each (2,))."""
+    """Polylines (k, 2) of the torso and both legs from one pose's points (each (2,)): leg
+    i from the hip through its points (:func:`leg_points`); a leg ending in two contact
+    points (a foot: heel and toe) is closed back to the joint before them (the ankle)."""
     shift = np.array([offset, 0.0])
-    return {
-        "torso": np.array([points["hip"], points["torso_top"]]) + shift,
-        "leg_1": np.array([points["hip"], points["knee_1"], points["tip_1"]]) + shift,
-        "leg_2": np.array([points["hip"], points["knee_2"], points["tip_2"]]) + shift,
-    }
+    out = {"torso": np.array([points["hip"], points["torso_top"]]) + shift}
+    for leg in ("1", "2"):
+        names = leg_points(points, leg)
+        if len(names) >= 4:
+            names = names + [names[-3]]
+        out[f"leg_{leg}"] = np.array([points["hip"]] + [points[n] for n in names]) + shift
+    return out
 
 
 def draw_pose(ax: Axes, points: Points, *, offset: float = 0.0, alpha: float = 1.0,
@@ -76,8 +87,9 @@ def stick_strip_figure(gait: Gait, *, frames: int = 9, title: str | None = None)
         raise ValueError(f"frames: expected >= 2, got {frames}")
     s = gait.samples
     times = np.linspace(s.t[0], s.t[-1], frames)
+    legs = leg_points(s.points, "1") + leg_points(s.points, "2")
     reach = max(float(np.ptp(np.concatenate([s.points[n][:, 0] - s.points["hip"][:, 0]
-                                             for n in ("tip_1", "tip_2")]))), 0.3)
+                                             for n in legs]))), 0.3)
     spacing = max(reach + 0.25, 0.55)
     height = float(np.max(s.points["torso_top"][:, 1])) + 0.1
     fig = new_figure(min(1.1 * frames * spacing + 0.6, 16.0), 3.2)

@@ -24,6 +24,9 @@ from numpy.typing import NDArray
 
 from gaitopt.analysis.checks.check import Check, Worst
 from gaitopt.dynamics.functions import impact_function, liftoff_function
+from gaitopt.dynamics.tree import hold_name
+from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, sequence_from_dict
+from gaitopt.gait.full_physics import model_symmetry, per_point
 from gaitopt.gait.gait_file import Gait, GaitEvent, leg_swap_permutations, swap_leg_label
 
 Array = NDArray[np.float64]
@@ -47,24 +50,48 @@ def _held_after_strike(gait: Gait, i: int, leg: str) -> tuple[str, ...]:
     return relabelled if leg in relabelled else (leg,)
 
 
-def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...]
+def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...], i: int
            ) -> tuple[Array, dict[str, Array], tuple[str, ...]]:
-    """``(qd_after, impulses, contacts held after)`` of ``event`` from ``(q, qd_before)``."""
+    """``(qd_after, impulses, contacts held after)`` of ``event`` (at the end of phase ``i``)
+    from ``(q, qd_before)``. With the gait's contact sequence, the event's kind and the hold
+    specs after it come from there (:meth:`ContactSequence.holds_after`); impulses are
+    ``(2,)`` per point (:func:`gaitopt.gait.full_physics.per_point`)."""
     model = gait.model
-    if event.name in TOUCHDOWNS:
-        qd, imp = impact_function(model, held)(q, event.qd_before)
-        flat = np.asarray(imp, dtype=float).ravel()
-        impulses = {c: flat[2 * j:2 * j + 2] for j, c in enumerate(held)}
-        return np.asarray(qd, dtype=float).ravel(), impulses, held
-    stay = tuple(c for c in held if c != event.leg)
-    if event.name not in IMPULSE_RELEASES:  # a release without impulse: velocities continue
-        return np.array(event.qd_before, dtype=float), {}, stay
+    spec = _sequence_event(gait, i, event)
+    if spec is not None:
+        seq, ev = spec
+        after = seq.holds_after(i, model_symmetry(model).contacts)
+        touchdown, impulse = bool(ev.touchdown), ev.impulse
+    else:
+        touchdown, impulse = event.name in TOUCHDOWNS, event.name in IMPULSE_RELEASES
+        after = held if touchdown else tuple(c for c in held if c != event.leg)
+    names = tuple(hold_name(c) for c in after)
+    if touchdown:
+        qd, imp = impact_function(model, after)(q, event.qd_before)
+        impulses = {c: np.asarray(v, dtype=float).ravel()
+                    for c, v in per_point(after, np.asarray(imp, dtype=float).ravel()).items()}
+        return np.asarray(qd, dtype=float).ravel(), impulses, names
+    if not impulse:  # a release without impulse: velocities continue
+        return np.array(event.qd_before, dtype=float), {}, names
     p = gait.parameters["liftoff_impulse"]
-    qd, lifting, on_held = liftoff_function(model, event.leg, list(stay))(q, event.qd_before, p)
-    flat = np.asarray(on_held, dtype=float).ravel()
-    impulses = {event.leg: np.asarray(lifting, dtype=float).ravel(),
-                **{c: flat[2 * j:2 * j + 2] for j, c in enumerate(stay)}}
-    return np.asarray(qd, dtype=float).ravel(), impulses, stay
+    qd, lifting, on_held = liftoff_function(model, event.leg, list(after))(q, event.qd_before, p)
+    impulses = {event.leg: np.asarray(lifting, dtype=float).ravel()}
+    if after:
+        impulses |= {c: np.asarray(v, dtype=float).ravel() for c, v in
+                     per_point(after, np.asarray(on_held, dtype=float).ravel()).items()}
+    return np.asarray(qd, dtype=float).ravel(), impulses, names
+
+
+def _sequence_event(gait: Gait, i: int, event: GaitEvent) -> tuple[ContactSequence,
+                                                                    EventSpec] | None:
+    """The gait's contact sequence and its event ``i``, when the file has a sequence whose
+    event ``i`` is ``event`` (same name)."""
+    if gait.contact_sequence is None:
+        return None
+    seq = sequence_from_dict(dict(gait.contact_sequence))
+    if i < len(seq.events) and seq.events[i].name == event.name:
+        return seq, seq.events[i]
+    return None
 
 
 def _events_of_phase(gait: Gait, i: int) -> list[GaitEvent]:
@@ -92,7 +119,7 @@ def event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
                 float(np.max(np.abs(e.qd_before - qd))), where)
             if e.name in TOUCHDOWNS:
                 held = _held_after_strike(gait, i, e.leg)
-            qd_after, impulses, held = _apply(gait, e, q, held)
+            qd_after, impulses, held = _apply(gait, e, q, held, i)
             worst["events.maps"] = worst["events.maps"].update(
                 float(np.max(np.abs(qd_after - e.qd_after))), where)
             zero = np.zeros(2)

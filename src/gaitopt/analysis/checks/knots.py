@@ -36,6 +36,7 @@ from gaitopt.dynamics.kinematics import (
 from gaitopt.dynamics.reduced import N_DOUBLE, double_support_state
 from gaitopt.dynamics.rnea import rnea
 from gaitopt.gait import walking
+from gaitopt.gait.contact_sequence import sequence_from_dict
 from gaitopt.gait.gait_file import Gait, GaitPhase
 from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
@@ -141,10 +142,26 @@ def knot_function(model: RobotModel, contacts: tuple[str, ...]) -> ca.Function:
 
 
 def ground_points(gait: Gait) -> dict[str, Array]:
-    """Where each tip is held (world, m): leg 1 at x = 0, leg 2 at x = step length, y = 0."""
+    """Where each held point stands (world, m): from the gait's contact sequence (``anchor L
+    + offset``, ``y = 0``; ``x`` NaN for a point without an anchor, held along y only), or for
+    a gait file without one, leg 1 at ``x = 0`` and leg 2 at ``x = L``."""
+    step = gait.parameters["step_length"]
+    if gait.contact_sequence is not None:
+        seq = sequence_from_dict(dict(gait.contact_sequence))
+        anchored = dict(seq.anchors)
+        return {c.name: np.array([seq.ground_x(c.name, step) if c.name in anchored else np.nan,
+                                  0.0]) for c in gait.model.contacts}
     legs = biped_structure(gait.model).legs
-    return {legs[0].contact: np.array([0.0, 0.0]),
-            legs[1].contact: np.array([gait.parameters["step_length"], 0.0])}
+    return {legs[0].contact: np.array([0.0, 0.0]), legs[1].contact: np.array([step, 0.0])}
+
+
+def body_size(model: RobotModel) -> float:
+    """The base's height above the lowest contact point in the pose with every coordinate 0
+    (m): the length scale of the equations-of-motion residual."""
+    zero = np.zeros(model.nq)
+    low = min(float(np.asarray(contact_position(model, zero, c.name), dtype=float).ravel()[1])
+              for c in model.contacts) if model.contacts else -1.0
+    return max(-low, 0.1)
 
 
 def _columns(fn: ca.Function, *args: Array) -> list[Array]:
@@ -158,9 +175,8 @@ def _columns(fn: ca.Function, *args: Array) -> list[Array]:
 def knot_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
     """``eom.residual``, ``contacts.*``, ``states.*`` at every knot (see the module)."""
     model = gait.model
-    legs = biped_structure(model).legs
     weight = model.total_mass * float(np.hypot(*model.gravity))
-    scale = weight * (legs[0].thigh_length + legs[0].shank_length)
+    scale = weight * body_size(model)
     at_ground = ground_points(gait)
     worst = {k: Worst() for k in ("eom.residual", "contacts.position", "contacts.velocity",
                                   "contacts.acceleration", "contacts.normal_force",
@@ -175,7 +191,8 @@ def knot_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
         x, xdot = _columns(state_map(model, tuple(ph.state_names)), ph.q, ph.qd, ph.qdd)
         per_knot = {
             "eom.residual": np.max(np.abs(eom), axis=1) / scale,
-            "contacts.position": _row_max(np.abs(pos - ground)),
+            # NaN ground x: a point held along y only, without an anchor (its x is free).
+            "contacts.position": _row_max(np.nan_to_num(np.abs(pos - ground), nan=0.0)),
             "contacts.velocity": _row_max(np.abs(vel)),
             "contacts.acceleration": _row_max(np.abs(acc)),
             "contacts.normal_force": _row_max(-forces[:, 1::2]) / weight,

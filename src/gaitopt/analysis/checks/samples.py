@@ -11,12 +11,14 @@ there; one a rounding error after it belongs to the next phase).
   the same);
 * ``samples.controls``: the sample's ``u`` equals the phase's piecewise-linear controls at t;
 * ``samples.points``: each named point equals the forward kinematics of the sample's ``q``
-  (``hip``: the base origin; ``knee_i``: the origin of leg i's shank; ``tip_i``: leg i's
-  contact point; ``torso_top``: the base link's far end; leg 1 stands in the step);
+  (:func:`gaitopt.gait.record.sample_points`: ``hip``, the base origin; a joint's name, the
+  origin of the link it moves; a contact's name, that point; ``torso_top``, the base link's
+  far end);
 * ``samples.normal_force``: normal forces recomputed from the sample's ``q, qd, u`` with the
   phase's contacts held, negative part (between knots a coarse grid may dip a little);
 * ``bounds.*``: torques (samples) and joint limits (knots; samples, where the interpolant may
-  overshoot a little); ``swing.clearance``: the swing tip's lowest point in single support.
+  overshoot a little); ``swing.clearance``: the lowest point of every contact point while it
+  is not held (the swing tip in single support), its depth below the ground.
 """
 
 from __future__ import annotations
@@ -30,9 +32,11 @@ from numpy.typing import NDArray
 from gaitopt.analysis.checks.check import Check, Worst
 from gaitopt.analysis.checks.knots import full_state_function
 from gaitopt.dynamics.functions import contact_dynamics_function
-from gaitopt.dynamics.kinematics import contact_position, point_position
+from gaitopt.dynamics.kinematics import point_position
+from gaitopt.gait.contact_sequence import phase_holds
+from gaitopt.gait.full_physics import hold_axes
 from gaitopt.gait.gait_file import Gait, phase_controls_at, phase_states_at
-from gaitopt.robot.biped import biped_structure
+from gaitopt.gait.record import point_names, sample_points
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -51,28 +55,18 @@ def phase_of_samples(gait: Gait) -> list[NDArray[np.bool_]]:
 
 @functools.lru_cache(maxsize=16)
 def points_function(model: RobotModel, names: tuple[str, ...]) -> ca.Function:
-    """``q -> (2, len(names))`` world positions of the named sample points (see the module)."""
-    legs = dict(zip(("_1", "_2"), biped_structure(model).legs, strict=True))  # leg 1, leg 2
+    """``q -> (2, len(names))`` world positions of the named sample points
+    (:func:`gaitopt.gait.record.sample_points`)."""
+    where = {name: (link, p) for name, link, p in sample_points(model)}
     q = ca.SX.sym("q", model.nq)
-    cols = []
-    for name in names:
-        if name == "hip":
-            cols.append(point_position(model, q, model.base.name, (0.0, 0.0)))
-        elif name == "torso_top":
-            base = model.base
-            cols.append(point_position(model, q, base.name, base.local_point(base.length)))
-        elif name.startswith("knee") and name[-2:] in legs:
-            cols.append(point_position(model, q, legs[name[-2:]].shank, (0.0, 0.0)))
-        else:
-            cols.append(contact_position(model, q, legs[name[-2:]].contact))
+    cols = [point_position(model, q, *where[name]) for name in names]
     return ca.Function("verify_points", [q], [ca.horzcat(*cols)])
 
 
 def _known_points(gait: Gait) -> tuple[str, ...]:
     """The sample points this check knows (others are allowed and not checked)."""
-    return tuple(n for n in gait.samples.points
-                 if n in ("hip", "torso_top") or (n[-2:] in ("_1", "_2") and
-                                                  n[:-2] in ("knee", "tip")))
+    known = set(point_names(gait.model))
+    return tuple(n for n in gait.samples.points if n in known)
 
 
 def sample_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
@@ -99,10 +93,12 @@ def sample_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
         err = np.max(np.abs(s.u[mask] - phase_controls_at(ph, t)), axis=1)
         k = int(np.argmax(err))
         controls = controls.update(err[k], at(k))
-        dyn = contact_dynamics_function(model, ph.contacts, inputs="u")
+        holds = phase_holds(gait.contact_sequence, i, ph.contacts)
+        dyn = contact_dynamics_function(model, holds, inputs="u")
         forces = np.asarray(dyn.map(n)(s.q[mask].T, s.qd[mask].T, s.u[mask].T)[1], dtype=float)
         if forces.size:
-            normal = forces[1::2, :].min(axis=0)
+            normal_rows = [r for r, (_, axis) in enumerate(hold_axes(holds)) if axis == 1]
+            normal = forces[normal_rows, :].min(axis=0)
             k = int(np.argmin(normal))
             force = force.update(-normal[k], at(k))
     names = _known_points(gait)
@@ -140,13 +136,20 @@ def _bound_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
         excess = np.maximum(s.q[:, c] - hi, lo - s.q[:, c])
         k = int(np.argmax(excess))
         between = between.update(excess[k], f"{joint.name} sample {k}")
-    t1 = gait.parameters["single_support_time"]
-    swing = s.points["tip_2"][s.t <= s.t[0] + t1 + 1e-12, 1]  # leg 2 swings in phase 1
-    k = int(np.argmin(swing))
+    lowest = Worst(-np.inf)
+    contacts = [c.name for c in model.contacts]
+    for i, (ph, mask) in enumerate(zip(gait.phases, phase_of_samples(gait), strict=True)):
+        for c in contacts:
+            if c in ph.contacts or c not in s.points or not mask.any():
+                continue
+            heights = s.points[c][mask, 1]
+            k = int(np.argmin(heights))
+            lowest = lowest.update(-float(heights[k]),
+                                   f"{c} sample {int(np.flatnonzero(mask)[k])} (phases[{i}])")
     return [Check("bounds.torque", max(0.0, torque.value), lim["bounds.torque"], torque.where),
             Check("bounds.joints_knots", max(0.0, knots.value), lim["bounds.joints_knots"],
                   knots.where),
             Check("bounds.joints_samples", max(0.0, between.value),
                   lim["bounds.joints_samples"], between.where),
-            Check("swing.clearance", max(0.0, -float(swing[k])), lim["swing.clearance"],
-                  f"sample {k}")]
+            Check("swing.clearance", max(0.0, lowest.value), lim["swing.clearance"],
+                  lowest.where)]

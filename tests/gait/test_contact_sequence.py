@@ -1,0 +1,131 @@
+"""Contact sequences as data: parsing, checks against a model, the heel-toe walk, the guess."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gaitopt.dynamics.kinematics import contact_position
+from gaitopt.gait.contact_sequence import (
+    ContactSequenceError,
+    check_sequence,
+    heel_toe_sequence,
+    sequence_from_dict,
+    walking_sequence,
+)
+from gaitopt.gait.formulation import checked_sequence, default_formulation
+from gaitopt.gait.full_physics import model_symmetry, per_point, projection_names
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.sequence_guess import sequence_guess
+from gaitopt.robot.loader import load_model
+from gaitopt.robot.model import RobotModel
+
+PAPER = {
+    "name": "my-walk",
+    "phases": [{"name": "single_support", "held": ["tip_1"], "fraction": 0.75},
+               {"name": "double_support", "held": ["tip_1", "tip_2"], "fraction": 0.25}],
+    "events": [{"name": "heel_strike", "touchdown": ["tip_2"]},
+               {"name": "liftoff", "release": ["tip_1"], "impulse": True}],
+    "anchors": {"tip_1": 0.0, "tip_2": 1.0},
+}
+
+
+@pytest.fixture(scope="module")
+def seven() -> RobotModel:
+    return load_model("seven-link")
+
+
+@pytest.fixture(scope="module")
+def five() -> RobotModel:
+    return load_model("five-link")
+
+
+def swap(model: RobotModel) -> dict[str, str]:
+    return dict(model_symmetry(model).contacts)
+
+
+def test_data_round_trip_equals_the_built_in_walk(five: RobotModel) -> None:
+    seq = sequence_from_dict(PAPER)
+    assert seq.phases == walking_sequence(five, 0.75, impulse=True).phases
+    assert seq.events == walking_sequence(five, 0.75, impulse=True).events
+    assert sequence_from_dict(seq.to_dict()) == seq
+    check_sequence(five, seq, swap(five))
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda d: d["phases"][1].update(held=["tip_1", "toe_2"]), "holds 'toe_2', not a contact"),
+    (lambda d: d["phases"][0].update(fraction=0.5), "fractions sum to 0.75"),
+    (lambda d: d["events"][0].update(touchdown=["tip_1"]), "touches down 'tip_1', which is held"),
+    (lambda d: d["events"][1].update(release=[], impulse=False), "after event 'liftoff'"),
+    (lambda d: d["anchors"].pop("tip_2"), "contact 'tip_2' has no anchor"),
+    (lambda d: d["phases"][1].update(held=["tip_1", "tip_1:y"]), "holds a point twice"),
+])
+def test_bad_sequences_are_refused_by_name(five: RobotModel, change, message: str) -> None:
+    import copy
+
+    data = copy.deepcopy(PAPER)
+    change(data)
+    with pytest.raises(ContactSequenceError, match=message):
+        check_sequence(five, sequence_from_dict(data), swap(five))
+
+
+@pytest.mark.parametrize(("data", "message"), [
+    ({"phases": [], "events": [], "anchors": {}}, r"phases = \[\]: must be a non-empty list"),
+    ({**PAPER, "extra": 1}, r"unknown keys \['extra'\]"),
+    ({**PAPER, "anchors": {"tip_1": "zero"}}, r"anchors.tip_1 = 'zero': must be a number"),
+    ({**PAPER, "events": [{"name": "e", "impulse": "yes"}]}, "impulse = 'yes'"),
+])
+def test_malformed_data_names_the_field(data: dict, message: str) -> None:
+    with pytest.raises(ContactSequenceError, match=message):
+        sequence_from_dict(data)
+
+
+def test_options_and_formulation_defaults(five: RobotModel, seven: RobotModel) -> None:
+    assert default_formulation(five, "walk", False) == "reduced"
+    assert default_formulation(five, "walk", True) == "full"
+    assert default_formulation(seven, "walk", False) == "full"
+    with pytest.raises(GaitOptionsError, match="need formulation 'full'"):
+        from gaitopt.gait.options import validate_options
+
+        validate_options(GaitOptions(contact_sequence=PAPER), None)
+    with pytest.raises(GaitOptionsError, match="two contact points on the foot"):
+        checked_sequence(five, GaitOptions(formulation="full", gait="heel-toe"))
+
+
+def test_heel_toe_sequence_of_the_seven_link_model(seven: RobotModel) -> None:
+    seq = heel_toe_sequence(seven, swap(seven), 0.8, impulse=True)
+    check_sequence(seven, seq, swap(seven))
+    heel, toe = (np.asarray(contact_position(seven, np.zeros(seven.nq), c), dtype=float)
+                 .ravel() for c in ("heel_1", "toe_1"))
+    assert seq.ground_x("toe_1", 0.7) == pytest.approx(toe[0] - heel[0])
+    assert seq.ground_x("heel_2", 0.7) == pytest.approx(0.7)
+    assert [ph.held for ph in seq.phases] == [("heel_1", "toe_1:y"), ("toe_1",),
+                                              ("toe_1", "heel_2"), ("heel_2",)]
+    # The last event's impact holds what the next step's first phase holds, legs swapped.
+    assert seq.holds_after(3, swap(seven)) == ("heel_2", "toe_2:y")
+    assert projection_names(("heel_1", "toe_1:y")) == (
+        "gamma_heel_1_x", "gamma_heel_1_y", "gamma_toe_1_y", "nu_heel_1_x", "nu_heel_1_y",
+        "nu_toe_1_y")
+    forces = per_point(("heel_1", "toe_1:y"), [1.0, 2.0, 3.0])
+    assert {c: list(np.asarray(v, dtype=float).ravel()) for c, v in forces.items()} == {
+        "heel_1": [1.0, 2.0], "toe_1": [0.0, 3.0]}
+
+
+def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> None:
+    seq = heel_toe_sequence(seven, swap(seven), 0.85, impulse=False)
+    step = 0.5
+    guess = sequence_guess(seven, seq, swap(seven), speed=0.5, step_length=step, knots=(8, 5),
+                           ankle=True)
+    assert [ph.name for ph in guess.phases] == [ph.name for ph in seq.phases]
+    for ph, spec in zip(guess.phases, seq.phases, strict=True):
+        for x in ph.x:
+            q = x[:seven.nq]
+            for hold in spec.held:
+                name, _, axes = hold.partition(":")
+                p = np.asarray(contact_position(seven, q, name), dtype=float).ravel()
+                assert abs(p[1]) < 5e-3, (ph.name, name, p)
+                if not axes:
+                    assert abs(p[0] - seq.ground_x(name, step)) < 5e-3, (ph.name, name, p)
+            for c in ("heel_1", "toe_1", "heel_2", "toe_2"):
+                p = np.asarray(contact_position(seven, q, c), dtype=float).ravel()
+                assert p[1] > -2e-3, (ph.name, c, p)
