@@ -78,14 +78,19 @@ def compile_library(source: str, name: str, *, flags: Sequence[str] = DEFAULT_FL
 
 
 def compile_libraries(sources: dict[str, str], *, flags: Sequence[str] = DEFAULT_FLAGS,
-                      targets: dict[str, Path] | None = None) -> dict[str, Path]:
+                      targets: dict[str, Path] | None = None,
+                      flags_by_name: dict[str, Sequence[str]] | None = None
+                      ) -> dict[str, Path]:
     """Compile several C sources (by library name) to shared libraries in the cache, the
     compilers running in parallel, and return their paths by name. Libraries already in the
     cache (same source, compiler and flags) are reused as they are. ``targets`` gives the
-    paths instead (a caller that keys the cache by what generates the source)."""
+    paths instead (a caller that keys the cache by what generates the source);
+    ``flags_by_name`` other flags for some libraries."""
     cc = compiler()
+    flags_of = {name: tuple((flags_by_name or {}).get(name, flags)) for name in sources}
     if targets is None:
-        targets = {name: library_path(src, name, flags) for name, src in sources.items()}
+        targets = {name: library_path(src, name, flags_of[name])
+                   for name, src in sources.items()}
     todo = [name for name, path in targets.items() if not path.exists()]
     if not todo:
         return targets
@@ -95,7 +100,7 @@ def compile_libraries(sources: dict[str, str], *, flags: Sequence[str] = DEFAULT
             c_file = Path(tmp) / f"{name}.c"
             c_file.write_text(sources[name])
             so_tmp = Path(tmp) / f"{name}.so"
-            cmd = [cc, *flags, str(c_file), "-o", str(so_tmp), "-lm"]
+            cmd = [cc, *flags_of[name], str(c_file), "-o", str(so_tmp), "-lm"]
             running.append((name, cmd, so_tmp,
                             subprocess.Popen(cmd, stdout=subprocess.PIPE,
                                              stderr=subprocess.PIPE, text=True)))

@@ -44,8 +44,22 @@ from gaitopt.ocp.method import Method
 from gaitopt.ocp.nlp import Assembly
 
 #: C compiler flags of the point libraries: ``-O1`` compiles the five-link biped's point
-#: Hessians about twice as fast as ``-O2`` (3-6 s against 4-13 s per phase).
+#: Hessians about twice as fast as ``-O2`` (3-6 s against 4-13 s per phase on an idle
+#: machine).
 POINT_FLAGS: tuple[str, ...] = ("-O1", "-fPIC", "-shared")
+#: Flags for large point functions (more than :data:`LARGE_POINT` instructions, e.g. the
+#: seven-link model with feet): ``-O0`` compiles 5-6x faster than ``-O1`` and evaluates
+#: 3-4x slower, still about 5x faster than CasADi's VM (the five-link point Hessians on a
+#: busy machine: 3-5 s against 16-33 s to compile, 70-92 against 16-29 us per point, VM
+#: 330-480 us). The size of a point's Hessian grows with its instructions, and ``-O1`` time
+#: faster than linearly with the size of one C function.
+LARGE_POINT_FLAGS: tuple[str, ...] = ("-O0", "-fPIC", "-shared")
+LARGE_POINT = 1300
+
+
+def point_flags(point: ca.Function) -> tuple[str, ...]:
+    """The compiler flags of ``point``'s library (by its number of instructions)."""
+    return POINT_FLAGS if point.n_instructions() <= LARGE_POINT else LARGE_POINT_FLAGS
 #: Version of the generated point libraries (part of their cache key): change it when the
 #: functions a library holds change.
 FORMAT = "gaitopt-points-1"
@@ -128,14 +142,16 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
     if not (compile_c and codegen.has_compiler()):
         return [PointDerivatives.of(PointDerivatives.derive(p), compiled=False) for p in points]
     libs = {f"pt_{p.name()}": p for p in points}
-    paths = {lib: codegen.cache_dir() / f"{lib}-{library_key(p)}.so" for lib, p in libs.items()}
+    flags = {lib: point_flags(p) for lib, p in libs.items()}
+    paths = {lib: codegen.cache_dir() / f"{lib}-{library_key(p, flags[lib])}.so"
+             for lib, p in libs.items()}
     missing = [lib for lib, path in paths.items() if not path.exists()]
     if missing:
         sources = {lib: codegen.generate_source(PointDerivatives.derive(libs[lib]), lib)
                    for lib in missing}
         try:
-            codegen.compile_libraries(sources, flags=POINT_FLAGS,
-                                      targets={lib: paths[lib] for lib in missing})
+            codegen.compile_libraries(sources, targets={lib: paths[lib] for lib in missing},
+                                      flags_by_name={lib: flags[lib] for lib in missing})
         except codegen.CompileError as exc:
             warnings.warn(f"compiling the point functions failed, evaluating them in CasADi's "
                           f"VM instead: {str(exc)[:300]}", RuntimeWarning, stacklevel=2)
