@@ -172,3 +172,17 @@ def test_a_failing_compiler_falls_back_to_the_vm(tmp_path: Path,
     assert tr._pointwise is not None and not tr._pointwise.compiled
     assert tr.solve().objective == pytest.approx(4.0, rel=1e-6)
     assert not list(tmp_path.glob("pt_*.so"))
+
+
+def test_large_point_functions_compile_with_the_fast_flags() -> None:
+    from gaitopt.ocp.pointwise import LARGE_POINT, LARGE_POINT_FLAGS, POINT_FLAGS, point_flags
+
+    x = ca.SX.sym("x", 2)
+    small = ca.Function("small", [x], [ca.sin(x[0]) * x[1]])
+    big_expr = x[0]
+    for k in range(LARGE_POINT):
+        big_expr = ca.sin(big_expr + k * x[1])
+    big = ca.Function("big", [x], [big_expr])
+    assert small.n_instructions() <= LARGE_POINT < big.n_instructions()
+    assert point_flags(small) == POINT_FLAGS and "-O1" in POINT_FLAGS
+    assert point_flags(big) == LARGE_POINT_FLAGS and "-O0" in LARGE_POINT_FLAGS
