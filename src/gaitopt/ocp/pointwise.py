@@ -24,8 +24,8 @@ point). Only ``phi``, its Jacobian and the weighted Hessian
 ``Hess_z (mu^T phi)`` see the dynamics; they are functions of one point, so their size and
 the time to compile them do not depend on the mesh. They are generated as C once per point
 function and compiled into the disk cache of :mod:`gaitopt.codegen` (keyed by a hash of the
-C source: a changed model or problem compiles anew; an unchanged one loads in milliseconds)
-and mapped over the grid. Without a C compiler the same functions run in CasADi's virtual
+serialized point function, which determines the C, see :func:`library_key`: a changed model
+or problem compiles anew; an unchanged one loads in milliseconds) and mapped over the grid. Without a C compiler the same functions run in CasADi's virtual
 machine. The outer functions are small SX functions, always interpreted.
 """
 
@@ -51,8 +51,8 @@ POINT_FLAGS: tuple[str, ...] = ("-O1", "-fPIC", "-shared")
 #: seven-link model with feet): ``-O0`` compiles 5-6x faster than ``-O1`` and evaluates
 #: 3-4x slower, still about 5x faster than CasADi's VM (the five-link point Hessians on a
 #: busy machine: 3-5 s against 16-33 s to compile, 70-92 against 16-29 us per point, VM
-#: 330-480 us). The size of a point's Hessian grows with its instructions, and ``-O1`` time
-#: faster than linearly with the size of one C function.
+#: 330-480 us). The size of a point's Hessian grows with its instructions, and the time of
+#: ``-O1`` faster than linearly with the size of one C function.
 LARGE_POINT_FLAGS: tuple[str, ...] = ("-O0", "-fPIC", "-shared")
 LARGE_POINT = 1300
 
