@@ -25,8 +25,9 @@ point). Only ``phi``, its Jacobian and the weighted Hessian
 the time to compile them do not depend on the mesh. They are generated as C once per point
 function and compiled into the disk cache of :mod:`gaitopt.codegen` (keyed by a hash of the
 serialized point function, which determines the C, see :func:`library_key`: a changed model
-or problem compiles anew; an unchanged one loads in milliseconds) and mapped over the grid. Without a C compiler the same functions run in CasADi's virtual
-machine. The outer functions are small SX functions, always interpreted.
+or problem compiles anew; an unchanged one loads in milliseconds) and mapped over the grid.
+Without a C compiler the same functions run in CasADi's virtual machine. The outer functions
+are small SX functions, always interpreted.
 """
 
 from __future__ import annotations
