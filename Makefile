@@ -16,7 +16,7 @@ define run_pytest
 	exit $$status
 endef
 
-.PHONY: run test test-slow lint bench clean
+.PHONY: run costs test test-slow lint bench clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || { \
@@ -32,6 +32,10 @@ $(STAMP): pyproject.toml
 
 run: $(STAMP)
 	$(BIN)/gaitopt study -o out/study
+
+# The cost study (docs/costs.md): a few minutes, so not part of `make run`.
+costs: $(STAMP)
+	$(BIN)/gaitopt study --costs -o out/costs
 
 lint: $(STAMP)
 	$(BIN)/ruff check

@@ -60,12 +60,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gaitopt.gait import solve as gait_solve
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import gait_from_solution
 from gaitopt.gait.solve import WalkingSolution, solve_walking
+from gaitopt.gait.transcriptions import clear_cache
 from gaitopt.ocp import Result
 from gaitopt.ocp.result import METHODS
 from gaitopt.ocp.transcription import Transcription
@@ -159,9 +159,9 @@ def best_of(repeat: int, name: str, knots: tuple[int, int],
 def bench_grid(knots: tuple[int, int], repeat: int, formulation: str = "reduced",
                transcription: str = "hermite-simpson") -> list[Measure]:
     model = load_model("five-link")
-    options = GaitOptions(speed=SPEED, knots=knots, formulation=formulation,  # type: ignore
-                          transcription=transcription)  # type: ignore[arg-type]
-    gait_solve._CACHE.clear()  # the process-wide NLP cache: a fresh start
+    options = GaitOptions.paper(speed=SPEED, knots=knots, formulation=formulation,  # type: ignore
+                                transcription=transcription)  # type: ignore[arg-type]
+    clear_cache()  # the process-wide NLP cache: a fresh start
     fresh, _ = measure("cold (fresh)", knots, lambda: solve_walking(model, options))
     cached, solution = best_of(repeat, "cold (cache built)", knots,
                                lambda: solve_walking(model, options))
@@ -248,7 +248,8 @@ def run_cli(src: Path, transcription: str, knots: str, out: Path,
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "gaitopt", "solve", "--speed", "12m/min",
-                           "--knots", knots, "--transcription", transcription,
+                           "--knots", knots, "--control-model", "paper",
+                           "--transcription", transcription,
                            "--formulation", formulation, "-o", str(out)],
                           env=env, capture_output=True, text=True)
     wall = time.perf_counter() - start

@@ -18,6 +18,12 @@ SPEED = 0.2        # m/s, the paper's 12 m/min
 SPEED_STEP = 1.05  # the "small speed change" of the warm starts
 
 
+def paper_options(options_class: Any) -> Any:
+    """``GaitOptions.paper`` (the paper's control model with the given grid) where it exists,
+    else ``GaitOptions`` (whose defaults were the paper's)."""
+    return getattr(options_class, "paper", options_class)
+
+
 def share(solution: Any) -> tuple[int, float, float]:
     """IPOPT iterations, time in the NLP functions and IPOPT's total time over the stages."""
     results = [r for _, r in solution.stage_results]
@@ -49,8 +55,8 @@ def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str,
     from gaitopt.robot import load_model
 
     model = load_model("five-link")
-    options = GaitOptions(speed=SPEED, knots=knots, transcription=transcription,  # type: ignore
-                          formulation=formulation)  # type: ignore[arg-type]
+    options = paper_options(GaitOptions)(speed=SPEED, knots=knots,  # type: ignore[arg-type]
+                                         transcription=transcription, formulation=formulation)
     out: dict[str, Any] = {}
     wall, sol = timed(lambda: solve_gait_solution(model, options))
     out["cold_first_s"] = wall
@@ -87,9 +93,9 @@ def first_warm(knots: tuple[int, int], transcription: str, path: str,
 
     imports = time.perf_counter() - start
     model = load_model("five-link")
-    options = GaitOptions(speed=SPEED * SPEED_STEP, knots=knots,  # type: ignore[arg-type]
-                          transcription=transcription,  # type: ignore[arg-type]
-                          formulation=formulation)  # type: ignore[arg-type]
+    options = paper_options(GaitOptions)(speed=SPEED * SPEED_STEP,  # type: ignore[arg-type]
+                                         knots=knots, transcription=transcription,
+                                         formulation=formulation)
     wall, sol = timed(lambda: solve_gait_solution(model, options, warm_start=Gait.load(path)))
     it, ev, tot = share(sol)
     return dict(imports_s=imports, first_warm_s=wall, first_warm_cpu_s=CPU[id(sol)],

@@ -28,7 +28,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from gaitopt.cli_study import parse_speeds
+from gaitopt.cli.study import parse_speeds
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import transcription_for
 from gaitopt.robot import load_model
@@ -60,7 +60,7 @@ def pool_start_s(workers: int, method: str) -> float:
 def build_s() -> float:
     """One transcription build (the no-ankle structure) in this process."""
     start = time.perf_counter()
-    transcription_for(load_model("five-link"), GaitOptions(ankle=False), (8, 5))
+    transcription_for(load_model("five-link"), GaitOptions.paper(ankle=False), (8, 5))
     return time.perf_counter() - start
 
 
@@ -112,7 +112,7 @@ def main() -> None:
 
     spec = SweepSpec(model=load_model("five-link"), speeds=parse_speeds(args.speeds),
                      variants=VARIANTS, free_speed=args.free,
-                     base=GaitOptions(transcription=args.transcription))  # type: ignore
+                     base=GaitOptions.paper(transcription=args.transcription))  # type: ignore
     n = len(spec.points)
     load = os.getloadavg()[0]
     print(f"sweep benchmark: {len(spec.variants)} variants x {len(spec.speeds)} speeds"

@@ -47,16 +47,17 @@ SPEED_STEP = 1.05  # the neighbouring gait of the warm start
 def _options(form: str, knots: tuple[int, int], speed: float = SPEED) -> Any:
     from gaitopt.gait.options import GaitOptions
 
-    return GaitOptions(speed=speed, knots=knots, transcription=form)  # type: ignore[arg-type]
+    return GaitOptions.paper(speed=speed, knots=knots, transcription=form)  # type: ignore[arg-type]
 
 
 def worker_cold(form: str, knots: tuple[int, int], exact_fine: bool, out: str) -> dict[str, Any]:
     """A fresh process: the default cold solve; its Result is pickled to ``out``."""
     from gaitopt.gait import solve as gait_solve
+    from gaitopt.gait import stages
     from gaitopt.robot import load_model
 
     if exact_fine:
-        gait_solve.FINE_STAGE_OPTIONS = {}
+        stages.FINE_STAGE_OPTIONS = {}
     model = load_model("five-link")
     start = time.perf_counter()
     sol = gait_solve.solve_walking(model, _options(form, knots))

@@ -32,10 +32,11 @@ def main(argv: list[str] | None = None) -> Gait:
     print(f"model {model.name}: q = {list(model.coordinate_names)}, "
           f"u = {[a.name for a in model.actuators]}, mass {model.total_mass:g} kg")
 
-    # -- options: the variant, the speed (m/s; None = free), the grid -------------------------
-    options = GaitOptions(speed=args.speed / 60.0, ankle=args.ankle, impulse=True,
-                          knots=(8, 5))
-    print(f"options: {options.variant} at {args.speed:g} m/min, knots {options.knots}")
+    # -- options: the variant, the speed (m/s; None = free); the default grid is 16 + 6 knots
+    # with torques free to jump at the events (GaitOptions.paper(...): the paper's 8 + 5) -----
+    options = GaitOptions(speed=args.speed / 60.0, ankle=args.ankle, impulse=True)
+    print(f"options: {options.variant} at {args.speed:g} m/min, knots {options.knots}, "
+          f"control model {options.control_model}")
 
     # -- solve: from a naive guess through the continuation stages ----------------------------
     gait = solve_gait(model, options)

@@ -10,7 +10,8 @@ from click.testing import CliRunner
 from PIL import Image
 
 from gaitopt.cli import UserError, cli
-from gaitopt.cli_study import parse_speeds, parse_variants, sweep_dirs
+from gaitopt.cli.report import sweep_dirs
+from gaitopt.cli.study import parse_speeds, parse_variants
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.driver import prepare_directory
@@ -180,6 +181,13 @@ def test_study_writes_the_report_and_an_animation(runner: CliRunner, tmp_path: P
     rows = read_summary(folder / SUMMARY_FILE)
     assert len(rows) == 16 and all(r.success for r in rows)
     assert f"Open {folder / 'report' / 'report.html'}" in result.output
+    # The same points on the check grid, and the grid statements they give.
+    check = read_summary(folder / "check-grid" / SUMMARY_FILE)
+    assert len(check) == 16 and all(r.success for r in check)
+    page = (folder / "report" / "report.html").read_text(encoding="utf-8")
+    assert ("Grid: 16+6 knots, control model jumps. Error estimate (change to 24+8 knots at "
+            "12 fixed-speed points, 4 speed-free optima)") in page
+    assert "on the check grid speed" in " ".join(result.output.split())
 
 
 def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,

@@ -20,6 +20,7 @@ from gaitopt.analysis.return_map import (
     PhaseProfile,
     StepEvent,
     StepSpec,
+    event_jump,
     impact_jump,
     integrate_phase,
     phase_field,
@@ -52,7 +53,7 @@ GAINS = (300.0, 30.0)
 @pytest.fixture(scope="module")
 def gait() -> Gait:
     """The paper's problem at 12 m/min on the coarse grid (8 + 5 knots), a few seconds."""
-    return solve_gait("five-link", GaitOptions(speed=0.2))
+    return solve_gait("five-link", GaitOptions.paper(speed=0.2))
 
 
 @pytest.fixture(scope="module")
@@ -309,7 +310,7 @@ def test_cli_reports_a_replay_that_never_lands(gait: Gait, tmp_path: Path) -> No
 @pytest.fixture(scope="module")
 def single_support_gait() -> Gait:
     """A walk without double support (``single_support_fraction = 1``), 8 knots."""
-    return solve_gait("five-link", GaitOptions(speed=0.2, single_support_fraction=1.0))
+    return solve_gait("five-link", GaitOptions.paper(speed=0.2, single_support_fraction=1.0))
 
 
 def test_single_support_walk_strikes_and_lifts_off_at_once(single_support_gait: Gait) -> None:
@@ -333,3 +334,70 @@ def test_single_support_walk_monodromies_agree(single_support_gait: Gait) -> Non
     assert rep.fd_agreement is not None and rep.fd_agreement < 1e-4, rep.fd_agreement
     assert rep.residual < 0.05
     assert rep.multipliers.size == 2 * single_support_gait.model.nq - 4
+
+
+# -- a run: stance, toe-off, flight, touchdown ----------------------------------------------------
+
+@pytest.fixture(scope="module")
+def run_gait() -> Gait:
+    """A run (stance on tip 1, then flight), full coordinates, 60 m/min, 8 + 5 knots: about
+    2 s."""
+    return solve_gait("five-link", GaitOptions(speed=1.0, formulation="full", gait="run",
+                                               impulse=False))
+
+
+def test_run_step_follows_its_contact_sequence(run_gait: Gait) -> None:
+    """The run's return map: stance for its recorded duration, the toe-off (a liftoff without
+    impulse, nothing held after it), flight until the swing tip strikes (the guard), the
+    touchdown impact of the swing tip alone. With PD tracking the simulated step lands within
+    a millisecond of the gait's own touchdown and comes back near its start."""
+    assert [ph.contacts for ph in run_gait.phases] == [("tip_1",), ()]
+    spec = step_from_gait(run_gait, pd=GAINS)
+    stance, flight = spec.phases
+    assert stance.duration == pytest.approx(run_gait.phases[0].duration)
+    assert flight.duration is None and flight.contacts == ()
+    (toe_off,), (touchdown,) = spec.events
+    assert (toe_off.kind, toe_off.contact, toe_off.contacts, toe_off.magnitude) == (
+        "liftoff", "tip_1", (), 0.0)
+    assert (touchdown.kind, touchdown.contact, touchdown.contacts) == (
+        "strike", "tip_2", ("tip_2",))
+    y0 = gait_start(run_gait)
+    step = simulate_step(spec, y0)
+    assert step.strike_time == pytest.approx(run_gait.phases[1].duration, abs=1e-3)
+    assert step.step_time == pytest.approx(run_gait.step_time, abs=1e-3)
+    # In flight nothing is held: the toe-off without impulse leaves the velocities as they are.
+    y_toe_off = integrate_phase(spec, stance, y0)[1]
+    assert np.max(np.abs(event_jump(spec, toe_off, y_toe_off)[0] - y_toe_off)) < 1e-12
+    assert np.max(np.abs(step.y_next - y0)) < 0.05
+
+
+def test_run_linearized_about_its_knots_is_periodic_and_unstable(run_gait: Gait) -> None:
+    """About its own knots the open-loop run is periodic to the transcription's accuracy and,
+    like the walks, open-loop unstable."""
+    rep = gait_stability(run_gait, about="gait")
+    assert rep.start_residual < 1e-6
+    assert rep.multipliers.size == 2 * run_gait.model.nq - 4
+    assert rep.verdict == "unstable"
+
+
+@pytest.mark.slow
+def test_run_monodromies_agree(run_gait: Gait) -> None:
+    """With PD (300, 30) the variational monodromy of the run (through the toe-off, the flight
+    and the touchdown's saltation) agrees with central differences of the simulated map, at
+    the gait's start and at the Newton fixed point (about 25 s)."""
+    rep = gait_stability(run_gait, pd=GAINS)
+    assert rep.fd_agreement is not None and rep.fd_agreement < 1e-4, rep.fd_agreement
+    fixed = gait_stability(run_gait, pd=GAINS, fixed_point="newton")
+    assert fixed.residual < 1e-8
+    assert fixed.fd_agreement is not None and fixed.fd_agreement < 1e-4, fixed.fd_agreement
+
+
+def test_cli_analyses_a_run(run_gait: Gait, tmp_path: Path) -> None:
+    path = run_gait.save(tmp_path / "run.gait.json")
+    out = tmp_path / "run.json"
+    result = CliRunner().invoke(cli, ["stability", str(path), "--about", "gait", "--json",
+                                      str(out)])
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    assert data["verdict"] == "unstable"
+    assert len(data["multipliers"]) == 2 * run_gait.model.nq - 4

@@ -13,6 +13,7 @@ from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.dynamics.reduced import (
     ReachError,
+    checked_biped,
     double_support_coordinates,
     double_support_dynamics,
     double_support_state,
@@ -173,3 +174,35 @@ def test_a_model_without_two_legs_is_rejected_by_name() -> None:
     data["actuators"] = [a for a in data["actuators"] if a.get("contact") != "tip_2"]
     with pytest.raises(BipedStructureError, match="exactly two contact points"):
         biped_structure(model_from_dict(data))
+
+
+def test_the_biped_structure_is_built_once_per_model() -> None:
+    """Equal (immutable) models share one structure; a model that is no biped is refused at
+    every request, not cached as a success."""
+    five = load_model("five-link")
+    assert biped_structure(five) is biped_structure(load_model("five-link"))
+    assert checked_biped(five) is checked_biped(model_from_dict(five.to_dict()))
+    data = five.to_dict()
+    data["contacts"] = data["contacts"][:1]
+    data["actuators"] = [a for a in data["actuators"] if a.get("contact") != "tip_2"]
+    one_leg = model_from_dict(data)
+    for _ in range(2):
+        with pytest.raises(BipedStructureError, match="exactly two contact points"):
+            biped_structure(one_leg)
+
+
+def test_the_base_coordinates_are_named_and_indexed_once() -> None:
+    """``q = [x, y, base angle, joints...]``: the index constants match the names."""
+    from gaitopt.robot.model import (
+        BASE_ANGLE,
+        BASE_COORDINATES,
+        BASE_POSITION,
+        BASE_X,
+        BASE_Y,
+    )
+
+    model = load_model("five-link")
+    names = model.coordinate_names
+    assert (names[BASE_X], names[BASE_Y]) == BASE_COORDINATES[:2]
+    assert names[BASE_ANGLE] == model.base.name
+    assert tuple(names[BASE_POSITION]) == BASE_COORDINATES[:2]

@@ -54,13 +54,14 @@ SolveFn = Callable[..., Solved]
 
 @pytest.fixture(scope="session")
 def solved() -> Iterator[SolveFn]:
-    """``solved(options=GaitOptions(), model="five-link") -> Solved``, memoised per session."""
+    """``solved(options=GaitOptions.paper(), model="five-link") -> Solved``, memoised per
+    session."""
     cache: dict[tuple[str, str], Solved] = {}
 
     def solve(options: GaitOptions | None = None,
               model: RobotModel | str = "five-link") -> Solved:
         robot = model if isinstance(model, RobotModel) else load_model(model)
-        opts = options or GaitOptions()
+        opts = options or GaitOptions.paper()
         key = (robot.content_hash(), repr(opts))
         if key not in cache:
             solution = solve_gait_solution(robot, opts)
@@ -72,9 +73,9 @@ def solved() -> Iterator[SolveFn]:
 
 @pytest.fixture(scope="session")
 def default_solved(solved: SolveFn) -> Solved:
-    """The paper's problem: ``GaitOptions()`` (12 m/min, ankle + impulse, step length free,
-    8 + 5 knots) on the built-in five-link biped."""
-    return solved(GaitOptions())
+    """The paper's problem: ``GaitOptions.paper()`` (12 m/min, ankle + impulse, step length
+    free, 8 + 5 knots, the paper's control model) on the built-in five-link biped."""
+    return solved(GaitOptions.paper())
 
 
 @pytest.fixture(scope="session")

@@ -17,6 +17,7 @@ from gaitopt.cli import cli
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError
+from tests.gait.conftest import SolveFn
 from tests.gait.test_walking_errors import one_legged_model_file
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -27,7 +28,8 @@ def solve(*args: str) -> Result:
 
 
 def test_solve_prints_a_summary_and_writes_a_gait_that_verifies(
-        tmp_path: Path, default_gait: Gait) -> None:
+        tmp_path: Path, solved: SolveFn) -> None:
+    default_gait = solved(GaitOptions()).gait  # the API's default problem
     out = tmp_path / "walk.gait.json"
     result = solve("-o", str(out))
     assert result.exit_code == 0, result.output
@@ -140,7 +142,7 @@ def test_failed_solve_exits_1_names_the_stage_and_writes_nothing(
         monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """Forced failure: 3 IPOPT iterations per stage, no continuation (the CLI has no option
     for that, so the options it builds are patched)."""
-    monkeypatch.setattr("gaitopt.cli_gait.GaitOptions",
+    monkeypatch.setattr("gaitopt.cli.gait.GaitOptions",
                         functools.partial(GaitOptions, max_iter=3, continuation=False))
     out = tmp_path / "g.gait.json"
     result = solve("-o", str(out))
@@ -181,8 +183,9 @@ def test_motion_out_of_reach_exits_1_with_the_reason_and_writes_nothing(
 def test_warm_start_from_a_gait_file_solves_a_nearby_speed_in_one_stage(
         tmp_path: Path, default_gait: Gait, default_gait_file: Path) -> None:
     out = tmp_path / "faster.gait.json"
-    result = solve("--speed", "12.6m/min", "--warm-start", str(default_gait_file), "-o",
-                   str(out))
+    # default_gait_file holds the paper's problem: warm-start the same problem.
+    result = solve("--paper-grid", "--speed", "12.6m/min", "--warm-start",
+                   str(default_gait_file), "-o", str(out))
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert "stage warm start" in text and "stage relaxed contact" not in text
@@ -191,7 +194,7 @@ def test_warm_start_from_a_gait_file_solves_a_nearby_speed_in_one_stage(
     # Energy per metre grows with speed near the optimum (paper Fig. 3).
     assert gait.cost_value > default_gait.cost_value
     # A gait of another variant is not used: the solve starts cold and says so.
-    other = solve("--no-ankle", "--warm-start", str(default_gait_file), "-o",
+    other = solve("--paper-grid", "--no-ankle", "--warm-start", str(default_gait_file), "-o",
                   str(tmp_path / "plain.gait.json"))
     assert other.exit_code == 0, other.output
     other_text = " ".join(other.output.split())  # rich wraps lines at the terminal width

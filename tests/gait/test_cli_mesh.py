@@ -36,10 +36,10 @@ def test_an_unknown_control_model_is_refused() -> None:
     result = CliRunner().invoke(cli, ["solve", "--control-model", "smooth"])
     assert result.exit_code == 2 and "smooth" in result.output
     with pytest.raises(GaitOptionsError, match=r"control_model = 'smooth': must be one of"):
-        validate_options(GaitOptions(control_model="smooth"),  # type: ignore[arg-type]
+        validate_options(GaitOptions.paper(control_model="smooth"),  # type: ignore[arg-type]
                          biped_structure(load_model("five-link")))
     with pytest.raises(GaitOptionsError, match=r"clearance_profile = 'sine'"):
-        validate_options(GaitOptions(swing_clearance=0.01,
+        validate_options(GaitOptions.paper(swing_clearance=0.01,
                                      clearance_profile="sine"),  # type: ignore[arg-type]
                          biped_structure(load_model("five-link")))
 
@@ -47,7 +47,7 @@ def test_an_unknown_control_model_is_refused() -> None:
 def test_the_options_reach_the_gait_file_and_the_summary(tmp_path: Path) -> None:
     out = tmp_path / "jumps.gait.json"
     result = CliRunner(env={"COLUMNS": "200"}).invoke(cli, ["solve", "--control-model", "jumps",
-                                                            "--clearance",
+                                                            "--knots", "8,5", "--clearance",
                                       "0.01", "-o", str(out)])
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())

@@ -18,7 +18,7 @@ PERIODICITY = "controls periodic (legs relabelled)"
 
 @pytest.fixture(scope="module")
 def jumps(solved: SolveFn) -> Solved:
-    return solved(GaitOptions(control_model="jumps"))
+    return solved(GaitOptions(knots=(8, 5), control_model="jumps"))
 
 
 def block_names(options: GaitOptions) -> set[str]:
@@ -27,11 +27,11 @@ def block_names(options: GaitOptions) -> set[str]:
 
 
 def test_only_the_paper_model_links_the_controls() -> None:
-    paper = block_names(GaitOptions())
+    paper = block_names(GaitOptions.paper())
     assert CONTINUITY in paper and PERIODICITY in paper
-    assert CONTINUITY in block_names(GaitOptions(periodic_controls=False))
-    assert PERIODICITY not in block_names(GaitOptions(periodic_controls=False))
-    free = block_names(GaitOptions(control_model="jumps"))
+    assert CONTINUITY in block_names(GaitOptions.paper(periodic_controls=False))
+    assert PERIODICITY not in block_names(GaitOptions.paper(periodic_controls=False))
+    free = block_names(GaitOptions(knots=(8, 5), control_model="jumps"))
     assert CONTINUITY not in free and PERIODICITY not in free
 
 

@@ -37,7 +37,7 @@ def _positive_work_on_samples(gait: Gait) -> float:
 
 @pytest.mark.parametrize("name", ["work", "metabolic"])
 def test_each_cost_converges_and_recomputes(solved: SolveFn, name: str) -> None:
-    gait = solved(GaitOptions(cost=name)).gait  # type: ignore[arg-type]
+    gait = solved(GaitOptions.paper(cost=name)).gait  # type: ignore[arg-type]
     assert gait.success
     assert gait.cost["name"] == name and name in gait.cost["formula"]
     assert cost.recompute_cost(gait) == pytest.approx(gait.cost_value, rel=1e-6)
@@ -50,7 +50,7 @@ def test_work_cost_is_the_positive_actuator_work(solved: SolveFn) -> None:
     torques on the dense samples, over weight x step length, within the smoothing's bound
     (n_a eps T / (2 W L)) and the grid's quadrature error of the kinked integrand (a few per
     cent at 16 + 6 knots)."""
-    gait = solved(GaitOptions(cost="work", impulse=False, knots=(16, 6))).gait
+    gait = solved(GaitOptions.paper(cost="work", impulse=False, knots=(16, 6))).gait
     assert gait.success
     model = gait.model
     denominator = cost.weight(model) * gait.step_length
@@ -61,16 +61,16 @@ def test_work_cost_is_the_positive_actuator_work(solved: SolveFn) -> None:
 
 def test_resting_term_scales_exactly_with_step_time() -> None:
     model = load_model("five-link")
-    options = GaitOptions(cost="metabolic", resting_power=1.5)
+    options = GaitOptions.paper(cost="metabolic", resting_power=1.5)
     rest = [cost.parameter_cost(model, options, [step, 0.5, 0.0]) for step in (0.2, 0.4, 0.8)]
     np.testing.assert_allclose(rest, [1.5 * model.total_mass * t for t in (0.4, 0.8, 1.6)])
-    assert cost.parameter_cost(model, GaitOptions(cost="work"), [0.2, 0.5, 0.0]) == 0.0
+    assert cost.parameter_cost(model, GaitOptions.paper(cost="work"), [0.2, 0.5, 0.0]) == 0.0
 
 
 def test_metabolic_cost_changes_by_the_resting_energy(solved: SolveFn) -> None:
     """The same gait costs exactly (delta P_rest) m T / (W L) more with a larger resting
     power: recomputed from the file with the option changed."""
-    gait = solved(GaitOptions(cost="metabolic")).gait
+    gait = solved(GaitOptions.paper(cost="metabolic")).gait
     data = gait.to_dict()
     data["options"]["resting_power"] = gait.options["resting_power"] + 0.5
     changed = Gait.from_dict(data)
@@ -90,4 +90,4 @@ def test_metabolic_cost_changes_by_the_resting_energy(solved: SolveFn) -> None:
 def test_bad_cost_options_name_the_field(changes: dict[str, object], message: str) -> None:
     legs = biped_structure(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match=message):
-        validate_options(GaitOptions().replace(**changes), legs)
+        validate_options(GaitOptions.paper().replace(**changes), legs)

@@ -36,7 +36,7 @@ from tests.gait.conftest import (
 RefFn = Callable[[RobotModel], Reference]
 SolveFn = Callable[..., Solved]
 
-FULL = GaitOptions(formulation="full")
+FULL = GaitOptions.paper(formulation="full")
 
 
 def test_paper_problem_in_full_coordinates_is_physical(solved: SolveFn,
@@ -59,7 +59,7 @@ def test_paper_problem_in_full_coordinates_is_physical(solved: SolveFn,
 def test_both_formulations_agree_on_the_paper_grid(solved: SolveFn) -> None:
     """They discretise different coordinates, so on the coarse 8+5 grid they differ by the
     discretization error only (a few per cent; the fine-grid table is in docs/walking.md)."""
-    full, reduced = solved(FULL).gait, solved(GaitOptions()).gait
+    full, reduced = solved(FULL).gait, solved(GaitOptions.paper()).gait
     assert full.cost_value == pytest.approx(reduced.cost_value, rel=0.03)
     assert full.step_length == pytest.approx(reduced.step_length, rel=0.03)
 
@@ -69,7 +69,7 @@ def test_both_formulations_agree_on_the_paper_grid(solved: SolveFn) -> None:
 @pytest.mark.parametrize("impulse", [True, False])
 def test_formulations_agree_on_a_fine_grid(ankle: bool, impulse: bool) -> None:
     """On 40+10 knots the two formulations' optima agree to 1 % (cost) and 2 % (step)."""
-    base = GaitOptions(ankle=ankle, impulse=impulse, knots=(40, 10))
+    base = GaitOptions.paper(ankle=ankle, impulse=impulse, knots=(40, 10))
     reduced = solve_gait("five-link", base)
     full = solve_gait("five-link", base.replace(formulation="full"))
     assert reduced.success and full.success
@@ -116,7 +116,7 @@ def test_single_support_gait_with_a_straight_knee(model: RobotModel, reference: 
     """The single-support gait (no double support) with fixed step length and time, states
     periodic only, no ankle torques, knee margin 0: converges from a naive start and is
     physical."""
-    options = GaitOptions(formulation="full", single_support_fraction=1.0, ankle=False,
+    options = GaitOptions.paper(formulation="full", single_support_fraction=1.0, ankle=False,
                           impulse=False, periodic_controls=False, min_stance_knee_flexion=0.0,
                           speed=0.3, step_length=0.2)
     gait = solve_gait(model, options)
@@ -188,9 +188,9 @@ def test_contact_sequences_are_one_mechanism() -> None:
 def test_option_errors_name_the_formulation() -> None:
     legs = biped_structure(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match="formulation 'full' allows 0"):
-        validate_options(GaitOptions(min_stance_knee_flexion=0.0), legs)
+        validate_options(GaitOptions.paper(min_stance_knee_flexion=0.0), legs)
     with pytest.raises(GaitOptionsError, match="formulation = 'polar': must be one of"):
-        validate_options(GaitOptions(formulation="polar"), legs)  # type: ignore[arg-type]
+        validate_options(GaitOptions.paper(formulation="polar"), legs)  # type: ignore[arg-type]
     with pytest.raises(GaitOptionsError, match=r"must lie in \[0, 1.5\)"):
         validate_options(FULL.replace(min_stance_knee_flexion=-0.1), legs)
 
@@ -201,7 +201,7 @@ def test_a_run_converges_and_is_physical(reference: RefFn, tmp_path) -> None:  #
     and read back; checked with Pinocchio at the knots (equations of motion, the stance tip
     at the origin, tip 2 landing one step ahead) and by verify; the feet are off the ground
     during the flight."""
-    options = GaitOptions(formulation="full", gait="run", impulse=False, speed=1.0,
+    options = GaitOptions.paper(formulation="full", gait="run", impulse=False, speed=1.0,
                           single_support_fraction=0.5, min_stance_knee_flexion=0.0)
     gait = Gait.load(solve_gait("five-link", options).save(tmp_path / "run.gait.json"))
     assert gait.success and gait.version == 2
@@ -247,4 +247,4 @@ def test_a_free_single_support_fraction(solved: SolveFn) -> None:
 def test_free_fraction_errors(changes: dict[str, object], message: str) -> None:
     legs = biped_structure(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match=message):
-        validate_options(GaitOptions().replace(**changes), legs)
+        validate_options(GaitOptions.paper().replace(**changes), legs)

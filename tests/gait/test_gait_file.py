@@ -104,7 +104,7 @@ def _corrupt(gait: Gait, tmp_path: Path, edit: object) -> Path:
     (lambda d: d["phases"][0].update(contacts=["tip_1", "tip_2"]),
      "phases[0].contact_forces", "contacts on the ground"),
     (lambda d: d["phases"][0].update(t=d["phases"][0]["t"][::-1]), "phases[0].t", "increasing"),
-    (lambda d: d["samples"]["points"].pop("knee_1"), "samples.points", "knee_1"),
+    (lambda d: d["samples"]["points"].pop("torso_top"), "samples.points", "torso_top"),
     (lambda d: d["events"][0].update(leg="foot_9"), "events[0].leg", "not a contact"),
     (lambda d: d["events"][1].update(name="a jump!"), "events[1].name", "heel_strike"),
     (lambda d: d["parameters"].update(step_time=9.0), "parameters.step_time", "span"),

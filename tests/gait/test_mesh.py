@@ -26,7 +26,7 @@ from tests.gait.conftest import Solved, SolveFn
 TOL = 1e-3
 #: The jumps control model: its cost converges on coarse grids (docs/walking.md), so a
 #: refinement is quick.
-REFINED = GaitOptions(control_model="jumps", mesh_tol=TOL)
+REFINED = GaitOptions(knots=(8, 5), control_model="jumps", mesh_tol=TOL)
 INTERVAL_CHECK = "integration.interval"
 
 
@@ -95,7 +95,7 @@ def test_a_gait_file_without_accuracy_still_loads(default_gait: Gait) -> None:
         del data["options"][key]
     old = Gait.from_dict(data)
     assert "accuracy" not in old.solver
-    assert GaitOptions.from_dict(dict(old.options)) == GaitOptions()
+    assert GaitOptions.from_dict(dict(old.options)) == GaitOptions.paper()
 
 
 def test_a_fixed_grid_has_no_cost_error_estimate(default_gait: Gait) -> None:
@@ -130,7 +130,7 @@ def test_a_warm_start_keeps_the_refined_mesh(refined: Solved) -> None:
 def test_the_cost_error_estimate_bounds_the_difference_to_a_fine_grid() -> None:
     """The refined cost (mesh_tol 1e-4) differs from the cost on a uniform 160 + 40 grid by
     less than its reported estimate."""
-    options = GaitOptions(control_model="jumps", mesh_tol=1e-4)
+    options = GaitOptions(knots=(8, 5), control_model="jumps", mesh_tol=1e-4)
     refined = solve_gait_solution("five-link", options)
     fine = solve_gait_solution("five-link", options.replace(mesh_tol=None, knots=(160, 40)))
     assert refined.success and fine.success

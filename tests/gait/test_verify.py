@@ -242,9 +242,7 @@ def test_cli_verify_rejects_a_bad_tolerance(default_gait_file: Path) -> None:
 
 # -- a gait whose dense samples include the heel-strike instant ---------------------------------
 
-# 30 m/min: step time < 0.5 s, 101 samples, one at 0.85 T (on the compressed form's optimum,
-# where the sample falls on the strike exactly).
-FAST = GaitOptions(speed=0.5, transcription="hermite-simpson")
+FAST = GaitOptions.paper(speed=0.5)  # 30 m/min: step time < 0.5 s, 101 samples, one at 0.85 T
 
 
 def test_fast_gait_forces_between_knots_are_non_negative(solved: SolveFn,
@@ -273,9 +271,8 @@ def test_fast_gait_forces_between_knots_are_non_negative(solved: SolveFn,
 def test_a_sample_a_rounding_error_after_the_heel_strike_is_in_double_support(
         solved: SolveFn) -> None:
     """At 54 m/min (ankle + impulse) a dense sample lies 6e-17 s after the heel strike: the
-    record evaluated it in double support (post-impact velocity), and verify must too (the
-    compressed form's optimum, where this rounding happens)."""
-    gait = solved(GaitOptions(speed=0.9, transcription="hermite-simpson")).gait
+    record evaluated it in double support (post-impact velocity), and verify must too."""
+    gait = solved(GaitOptions.paper(speed=0.9)).gait
     s, strike = gait.samples, gait.phases[0].t[-1]
     k = int(np.argmin(np.abs(s.t - strike)))
     assert 0.0 < s.t[k] - strike < 1e-12

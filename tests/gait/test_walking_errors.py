@@ -21,7 +21,7 @@ from gaitopt.robot.loader import builtin_text
 from tests.gait.conftest import Solved
 
 #: A solve forced to fail: 3 IPOPT iterations per stage and no speed continuation.
-FAILING = GaitOptions(max_iter=3, continuation=False)
+FAILING = GaitOptions.paper(max_iter=3, continuation=False)
 
 
 @pytest.fixture
@@ -75,7 +75,7 @@ BAD_OPTIONS: dict[str, tuple[dict[str, Any], tuple[str, ...]]] = {
 def test_bad_options_raise_before_any_solve(no_solve: None, case: str) -> None:
     changes, words = BAD_OPTIONS[case]
     with pytest.raises(GaitOptionsError) as info:
-        solve_gait("five-link", GaitOptions(**changes))
+        solve_gait("five-link", GaitOptions.paper(**changes))
     message = str(info.value)
     assert "\n" not in message
     for word in words:
@@ -85,7 +85,7 @@ def test_bad_options_raise_before_any_solve(no_solve: None, case: str) -> None:
 def test_model_without_two_legs_raises_before_any_solve(no_solve: None, tmp_path: Path) -> None:
     model = load_model(one_legged_model_file(tmp_path))  # a valid model, not a biped
     with pytest.raises(BipedStructureError, match="two contact points"):
-        solve_gait(model, GaitOptions())
+        solve_gait(model, GaitOptions.paper())
 
 
 def test_a_forced_failure_is_reported_as_failed(tmp_path: Path) -> None:
@@ -110,7 +110,7 @@ def test_a_forced_failure_is_reported_as_failed(tmp_path: Path) -> None:
 
 def test_missing_model_file_raises_model_error(no_solve: None, tmp_path: Path) -> None:
     with pytest.raises(ModelError, match="no-such.yaml"):
-        solve_gait(tmp_path / "no-such.yaml", GaitOptions())
+        solve_gait(tmp_path / "no-such.yaml", GaitOptions.paper())
 
 
 def test_motion_out_of_reach_between_knots_is_a_clear_error(default_solved: Solved) -> None:

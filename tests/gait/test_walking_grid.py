@@ -58,7 +58,7 @@ def test_grid_point_converges_from_scratch(variant: str, speed_m_min: int,
 def test_fine_grid_stays_near_the_coarse_optimum(default_gait: Gait) -> None:
     """A finer grid changes the optimum a little (a more accurate discretisation of the same
     problem), not by a factor: 16+8 and 24+8 give 458 and 450 against 487.9 at 8+5."""
-    fine = solve_gait("five-link", GaitOptions(knots=(40, 10)))
+    fine = solve_gait("five-link", GaitOptions.paper(knots=(40, 10)))
     assert fine.success
     assert fine.cost_value <= 1.05 * default_gait.cost_value
     assert fine.step_length == pytest.approx(default_gait.step_length, rel=0.3)

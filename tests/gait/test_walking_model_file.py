@@ -63,7 +63,7 @@ def model(tmp_path_factory: pytest.TempPathFactory) -> RobotModel:
 
 @pytest.fixture(scope="module")
 def gait(model: RobotModel, solved: SolveFn) -> Gait:
-    return solved(GaitOptions(), model).gait
+    return solved(GaitOptions.paper(), model).gait
 
 
 def test_the_model_file_is_what_was_written(model: RobotModel) -> None:

@@ -13,13 +13,11 @@ import numpy as np
 import pytest
 
 from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE, control_names
 from tests.gait.conftest import (
     EOM_RTOL,
     Reference,
     Solved,
-    SolveFn,
     assert_physics,
     contact_forces,
     eom_residuals,
@@ -49,20 +47,15 @@ def test_default_problem_converges_through_every_stage(default_solved: Solved) -
     assert np.isfinite(gait.cost_value) and gait.cost_value > 0.0
 
 
-def test_nlp_size_is_the_knot_values_and_three_parameters(default_gait: Gait,
-                                                          solved: SolveFn) -> None:
-    """Compressed Hermite-Simpson (the paper's form): states and controls at the knots, plus
-    L, v, P (the paper's DIRCOL NLP has 197 variables; see the docs for the difference). The
-    separated form (the default) adds the states at the interval midpoints."""
-    paper = solved(GaitOptions(transcription="hermite-simpson")).gait
-    model = paper.model
+def test_nlp_size_is_the_knot_values_and_three_parameters(default_gait: Gait) -> None:
+    """Compressed Hermite-Simpson: states and controls at the knots, plus L, v, P (the paper's
+    DIRCOL NLP has 197 variables; see the docs for the difference)."""
+    model = default_gait.model
     expected = 3
-    for ph in paper.phases:
+    for ph in default_gait.phases:
         controls = control_names(model, ph.name, ankle=True)
         expected += ph.t.size * (len(ph.state_names) + len(controls))
-    assert paper.solver["variables"] == expected == 8 * (10 + 5) + 5 * (6 + 6) + 3
-    midpoints = sum((ph.t.size - 1) * len(ph.state_names) for ph in default_gait.phases)
-    assert default_gait.solver["variables"] == expected + midpoints == 183 + 7 * 10 + 4 * 6
+    assert default_gait.solver["variables"] == expected == 8 * (10 + 5) + 5 * (6 + 6) + 3
 
 
 def test_every_knot_satisfies_pinocchio_equations_of_motion(

@@ -37,7 +37,7 @@ def _verified(gait: Gait) -> None:
 
 
 def test_ankle_off(solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
-    gait = solved(GaitOptions(ankle=False)).gait
+    gait = solved(GaitOptions.paper(ankle=False)).gait
     assert gait.success
     model = gait.model
     for ph in gait.phases:
@@ -50,7 +50,7 @@ def test_ankle_off(solved: SolveFn, default_gait: Gait, reference: RefFn) -> Non
 
 
 def test_impulse_off(solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
-    gait = solved(GaitOptions(impulse=False)).gait
+    gait = solved(GaitOptions.paper(impulse=False)).gait
     assert gait.success
     assert gait.parameters["liftoff_impulse"] == 0.0
     liftoff = next(e for e in gait.events if e.name == "liftoff")
@@ -64,15 +64,15 @@ def test_speed_free_finds_the_optimal_walk_near_the_papers(
         solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
     """The paper's globally optimal walk: about 12 m/min with a step of about 0.1 m. Its cost
     is below the cost at the given speeds 6, 12 and 30 m/min."""
-    free = solved(GaitOptions(speed=None)).gait
+    free = solved(GaitOptions.paper(speed=None)).gait
     assert free.success
     speed_m_min = free.speed * 60.0
     assert 9.0 <= speed_m_min <= 15.0, speed_m_min
     assert 0.07 <= free.step_length <= 0.14, free.step_length
-    lo, hi = GaitOptions().speed_bounds
+    lo, hi = GaitOptions.paper().speed_bounds
     assert lo * 1.01 < free.speed < hi * 0.99  # an interior optimum, not a bound
-    slow = solved(GaitOptions(speed=0.1)).gait
-    fast = solved(GaitOptions(speed=0.5)).gait
+    slow = solved(GaitOptions.paper(speed=0.1)).gait
+    fast = solved(GaitOptions.paper(speed=0.5)).gait
     assert slow.success and fast.success
     for other in (slow, default_gait, fast):
         assert free.cost_value <= other.cost_value * (1 + REL), (other.speed, other.cost_value)
@@ -82,7 +82,7 @@ def test_speed_free_finds_the_optimal_walk_near_the_papers(
 
 
 def test_step_length_fixed(solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
-    gait = solved(GaitOptions(step_length=0.15)).gait
+    gait = solved(GaitOptions.paper(step_length=0.15)).gait
     assert gait.success
     assert gait.step_length == pytest.approx(0.15, abs=1e-9)
     assert gait.parameters["step_time"] == pytest.approx(0.15 / 0.2)
@@ -96,19 +96,19 @@ def test_step_time_fixed_with_the_speed_given_and_free(
         solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
     """A step time fixes the step length at a given speed (the same optimum as that step
     length) and, with the speed free, gives the optimal walk of that step time."""
-    timed = solved(GaitOptions(step_time=0.75)).gait
-    by_length = solved(GaitOptions(step_length=0.15)).gait
+    timed = solved(GaitOptions.paper(step_time=0.75)).gait
+    by_length = solved(GaitOptions.paper(step_length=0.15)).gait
     assert timed.success and timed.step_length == pytest.approx(0.15, abs=1e-9)
     assert timed.cost_value == pytest.approx(by_length.cost_value, rel=1e-6)
-    walk = solved(GaitOptions(speed=None, step_time=0.8)).gait
+    walk = solved(GaitOptions.paper(speed=None, step_time=0.8)).gait
     assert walk.success
     assert walk.parameters["step_time"] == pytest.approx(0.8, abs=1e-7)
     assert walk.step_length == pytest.approx(0.8 * walk.speed, abs=1e-7)
     # Constrained, it costs no less than the free optimum (whose step time is about 0.57 s)
     # nor more than the 12 m/min gait of the same step time.
-    free = solved(GaitOptions(speed=None)).gait
+    free = solved(GaitOptions.paper(speed=None)).gait
     assert walk.cost_value >= free.cost_value * (1 - REL)
-    fixed_speed = solved(GaitOptions(step_time=0.8)).gait
+    fixed_speed = solved(GaitOptions.paper(step_time=0.8)).gait
     assert walk.cost_value <= fixed_speed.cost_value * (1 + REL)
     assert_physics(reference(walk.model), walk)
     _verified(walk)
@@ -119,7 +119,7 @@ def test_multistart_finds_the_lower_branch_at_high_speed(solved: SolveFn,
     """Without ankle torques at 45 m/min the cold solve ends on a long-step local optimum;
     the continuation in speed from 12 m/min that ``multistart`` adds reaches the short-step
     one, about 13 % cheaper (docs/benchmarks-gait.md), and ``multistart`` keeps it."""
-    options = GaitOptions(speed=0.75, ankle=False, impulse=False)
+    options = GaitOptions.paper(speed=0.75, ankle=False, impulse=False)
     single = solved(options).gait
     multi = solved(options.replace(multistart=True)).gait
     assert single.success and multi.success
@@ -136,7 +136,7 @@ def test_single_support_fraction_one_has_no_double_support(
         solved: SolveFn, reference: RefFn) -> None:
     """The single-support gait: tip 2 strikes, tip 1 leaves at that instant with no impulse,
     and the next step starts at once."""
-    gait = solved(GaitOptions(single_support_fraction=1.0)).gait
+    gait = solved(GaitOptions.paper(single_support_fraction=1.0)).gait
     assert gait.success
     assert [ph.name for ph in gait.phases] == [SINGLE]
     assert gait.parameters["single_support_time"] == pytest.approx(gait.step_time)
@@ -164,7 +164,7 @@ def test_single_support_fraction_one_has_no_double_support(
 
 
 def test_periodic_states_only(solved: SolveFn, default_gait: Gait, reference: RefFn) -> None:
-    gait = solved(GaitOptions(periodic_controls=False)).gait
+    gait = solved(GaitOptions.paper(periodic_controls=False)).gait
     assert gait.success
     acting = control_names(gait.model, SINGLE, ankle=True)
     state, control = periodicity_errors(gait, controls=acting)
@@ -187,7 +187,7 @@ def _tangential_excess(gait: Gait, mu: float) -> float:
 
 def test_friction_cone_holds_at_every_knot(solved: SolveFn, default_gait: Gait,
                                            reference: RefFn) -> None:
-    gait = solved(GaitOptions(friction=MU)).gait
+    gait = solved(GaitOptions.paper(friction=MU)).gait
     assert gait.success
     assert _tangential_excess(default_gait, MU) > 1.0  # the default gait is outside the cone
     assert _tangential_excess(gait, MU) <= 1e-6
@@ -197,12 +197,12 @@ def test_friction_cone_holds_at_every_knot(solved: SolveFn, default_gait: Gait,
 
 
 def test_friction_cone_gait_needs_no_more_friction_than_mu(solved: SolveFn) -> None:
-    gait = solved(GaitOptions(friction=MU)).gait
+    gait = solved(GaitOptions.paper(friction=MU)).gait
     assert gait_metrics(gait).friction_required <= MU * (1 + 1e-3)
 
 
 def test_ankle_optimum_is_no_worse_than_without_ankles_at_6_m_min(solved: SolveFn) -> None:
-    ankle = solved(GaitOptions(speed=0.1)).gait
-    plain = solved(GaitOptions(speed=0.1, ankle=False)).gait
+    ankle = solved(GaitOptions.paper(speed=0.1)).gait
+    plain = solved(GaitOptions.paper(speed=0.1, ankle=False)).gait
     assert ankle.success and plain.success
     assert ankle.cost_value <= plain.cost_value * (1 + REL)

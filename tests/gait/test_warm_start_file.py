@@ -21,7 +21,7 @@ def test_warm_start_from_a_file_restarts_with_its_multipliers(
         solved: SolveFn, default_gait_file: Path) -> None:
     gait = Gait.load(default_gait_file)
     assert set(gait.solver["warm_start"]) == {"w", "lam_x", "lam_g", "layout", "method"}
-    faster = GaitOptions(speed=0.21)
+    faster = GaitOptions.paper(speed=0.21)
     warm = solve_gait("five-link", faster, warm_start=gait)
     cold = solved(faster).gait
     first = warm.solver["stages"][0]
@@ -33,8 +33,8 @@ def test_warm_start_from_a_file_restarts_with_its_multipliers(
 def test_the_restart_point_is_used_only_where_it_fits(default_gait_file: Path) -> None:
     gait = Gait.load(default_gait_file)
     model = load_model("five-link")
-    assert restart_point(model, GaitOptions(speed=0.21), gait) is not None
-    assert restart_point(model, GaitOptions(knots=(10, 5)), gait) is None  # another grid
+    assert restart_point(model, GaitOptions.paper(speed=0.21), gait) is not None
+    assert restart_point(model, GaitOptions.paper(knots=(10, 5)), gait) is None  # another grid
     data = gait.to_dict()
     del data["solver"]["warm_start"]  # a file written before it existed
-    assert restart_point(model, GaitOptions(), Gait.from_dict(data)) is None
+    assert restart_point(model, GaitOptions.paper(), Gait.from_dict(data)) is None

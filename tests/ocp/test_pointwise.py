@@ -140,11 +140,12 @@ def test_walking_optimum_of_the_points_mode_is_optimal_for_the_expanded_nlp() ->
     from gaitopt.gait.formulation import problem_for, stage_bounds
     from gaitopt.gait.options import GaitOptions
     from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
-    from gaitopt.gait.solve import solve_walking, transcription_for
+    from gaitopt.gait.solve import solve_walking
+    from gaitopt.gait.transcriptions import transcription_for
     from gaitopt.robot import load_model
 
     model = load_model("five-link")
-    options = GaitOptions(speed=0.2, transcription=SEPARATED)
+    options = GaitOptions.paper(speed=0.2, transcription=SEPARATED)
     solution = solve_walking(model, options)
     assert solution.success
     tr = transcription_for(model, options, options.knots)

@@ -40,17 +40,17 @@ FINE_GAP = 1e-3
 
 
 def walk(knots: tuple[int, int], form: str, **changes: object) -> WalkingSolution:
-    options = GaitOptions(speed=0.2, knots=knots, transcription=form,  # type: ignore[arg-type]
+    options = GaitOptions.paper(speed=0.2, knots=knots, transcription=form,  # type: ignore[arg-type]
                           **changes)  # type: ignore[arg-type]
     return solve_walking(MODEL, options)
 
 
 def test_options_and_cli_accept_the_separated_form_and_name_the_choices() -> None:
     biped = biped_structure(MODEL)
-    validate_options(GaitOptions(transcription=SEPARATED), biped)
+    validate_options(GaitOptions.paper(transcription=SEPARATED), biped)
     with pytest.raises(GaitOptionsError, match="transcription = 'simpson'.*"
                                                "'hermite-simpson-separated'"):
-        validate_options(GaitOptions(transcription="simpson"),  # type: ignore[arg-type]
+        validate_options(GaitOptions.paper(transcription="simpson"),  # type: ignore[arg-type]
                          biped)
     result = CliRunner().invoke(cli, ["solve", "--transcription", "simpson"])
     assert result.exit_code == 2 and "hermite-simpson-separated" in result.output
@@ -119,7 +119,7 @@ def test_both_forms_converge_to_the_same_fine_grid_cost() -> None:
                                                 (False, False)])
 def test_separated_form_converges_from_a_cold_start(speed_m_min: int, ankle: bool,
                                                     impulse: bool) -> None:
-    options = GaitOptions(speed=speed_m_min / 60.0, ankle=ankle, impulse=impulse,
+    options = GaitOptions.paper(speed=speed_m_min / 60.0, ankle=ankle, impulse=impulse,
                           transcription=SEPARATED)
     sol = solve_walking(MODEL, options)
     assert sol.success, [s.line() for s in sol.stages]

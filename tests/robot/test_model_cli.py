@@ -150,7 +150,7 @@ def test_main_returns_exit_status(tmp_path: Path, capsys: pytest.CaptureFixture[
 
 def test_real_process_prints_no_traceback(tmp_path: Path) -> None:
     bad = write_bad_model(tmp_path)
-    proc = subprocess.run([sys.executable, "-m", "gaitopt.cli", "model", "show", str(bad)],
+    proc = subprocess.run([sys.executable, "-m", "gaitopt", "model", "show", str(bad)],
                           capture_output=True, text=True, timeout=120,
                           env={"PYTHONPATH": str(Path(__file__).parents[2] / "src"),
                                "PATH": "/usr/bin:/bin"})

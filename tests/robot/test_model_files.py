@@ -20,7 +20,7 @@ from gaitopt.robot import (
     model_to_dict,
     model_to_yaml,
 )
-from gaitopt.robot.schema import ellipsoid_inertia, rod_inertia
+from gaitopt.robot.inertia import ellipsoid_inertia, rod_inertia
 
 
 def five_link_data() -> dict[str, Any]:

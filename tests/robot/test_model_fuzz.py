@@ -18,7 +18,7 @@ from gaitopt.robot import (
     model_to_dict,
     model_to_yaml,
 )
-from gaitopt.robot.schema import ellipsoid_inertia
+from gaitopt.robot.inertia import ellipsoid_inertia
 
 FUZZ = settings(deadline=None, max_examples=150,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])

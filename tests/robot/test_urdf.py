@@ -246,8 +246,8 @@ def test_rewritten_urdf_gives_the_same_optimal_gait() -> None:
 
     original, imported = five_link(), model_from_urdf(rewritten_five_link())
     assert imported.content_hash() != original.content_hash()  # not a cached copy
-    a = solve_gait(original, GaitOptions(speed=0.2))
-    b = solve_gait(imported, GaitOptions(speed=0.2))
+    a = solve_gait(original, GaitOptions.paper(speed=0.2))
+    b = solve_gait(imported, GaitOptions.paper(speed=0.2))
     assert a.success and b.success
     assert b.cost_value == pytest.approx(a.cost_value, rel=1e-6)
     assert b.step_length == pytest.approx(a.step_length, rel=1e-6)

@@ -7,10 +7,11 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
    each phase replaying its torque profile ``u(tau)`` on its own clock ``tau`` (0 at the phase
    start; piecewise linear between knots, the last value held if a perturbed phase runs
    longer), until the guard ``g(q) = y_swing tip = 0`` is crossed moving down with the swing
-   tip more than ``arm_distance`` ahead of the stance tip (earlier crossings are ignored: the
-   scuffing of a rigid swing leg at mid-stance, and the grazing of the ground by optimal gaits
-   whose swing clearance constraint is active; a tip still below the ground there must come
-   up first); the crossing is found by the integrator's root finder on its dense output
+   tip more than ``arm_distance`` ahead of the origin (where the stance tip stands at the
+   step's start; earlier crossings are ignored: the scuffing of a rigid swing leg at
+   mid-stance, and the grazing of the ground by optimal gaits whose swing clearance
+   constraint is active; a tip still below the ground there must come up first); the
+   crossing is found by the integrator's root finder on its dense output
    (state-triggered);
 2. the **heel-strike impact** ``qd+ = Delta(q, qd-)`` (:func:`gaitopt.dynamics.impact`) with the
    contacts held in double support (or the striking tip alone when the gait has none);
@@ -23,6 +24,9 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
 That is the paper's walk; in general (:class:`StepSpec`) the phases run in order, the one that
 ends at the guard is state-triggered and the others last their durations, and after each
 phase its :class:`StepEvent` jumps (impacts, liftoffs) are applied in order, then the swap.
+A run is stance (time-triggered), the toe-off (a liftoff without impulse, no contact held
+after it), flight (no contact held) until the swing tip strikes (the guard), the touchdown
+impact, the swap.
 
 Optional joint-space PD tracking adds ``u = kp B^T (q_ref(tau) - q) + kd B^T (qd_ref(tau) -
 qd)`` to the replayed torques (``B`` the actuation matrix of the phase, so a joint actuator
@@ -125,8 +129,9 @@ class StepSpec:
     """Everything the return map needs: the model, the stance and swing contacts, the phases
     in order (exactly one ends at the guard: ``duration`` None; the others last their
     ``duration``), the events after each phase (``events[i]``, applied in order), the
-    distance (m) the swing tip must be ahead of the stance tip before the guard is armed,
-    optional PD gains ``(kp, kd)`` (N m/rad, N m s/rad) and the integrator tolerances."""
+    distance (m) the swing tip must be ahead of the origin (the stance tip at the start of
+    the step) before the guard is armed, optional PD gains ``(kp, kd)`` (N m/rad,
+    N m s/rad) and the integrator tolerances."""
 
     model: RobotModel
     stance: str
@@ -293,7 +298,6 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     (``duration`` None, or ``guard=True``). Returns ``(tau_end, y, Phi)``."""
     n = 2 * spec.nq
     swing = _tip(spec, spec.swing)
-    stance = _tip(spec, spec.stance)
 
     def rhs(tau: float, z: Array) -> Array:
         if not variational:
@@ -302,8 +306,9 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
         return np.concatenate([ydot, (a @ z[n:].reshape(n, n)).ravel()])
 
     def ahead(tau: float, z: Array) -> float:
-        return float(_eval(swing, z[:n])[0][0, 0] - _eval(stance, z[:n])[0][0, 0]
-                     - spec.arm_distance)
+        # From the origin, where the stance tip stands at the start of the step (and, held,
+        # all through a walk's single support; a run's flight holds no tip).
+        return float(_eval(swing, z[:n])[0][0, 0] - spec.arm_distance)
 
     def height(tau: float, z: Array) -> float:
         return float(_eval(swing, z[:n])[0][1, 0])

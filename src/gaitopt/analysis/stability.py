@@ -61,6 +61,11 @@ About = Literal["simulation", "gait"]
 #: constraint is active in mid-swing).
 ARM_FRACTION = 0.5
 
+#: Gait-file events that land a contact (an inelastic impact: the walk's heel strike, the
+#: run's touchdown after the flight) and that release one (with or without an impulse).
+STRIKE_EVENTS: tuple[str, ...] = ("heel_strike", "touchdown")
+RELEASE_EVENTS: tuple[str, ...] = ("liftoff", "toe_off")
+
 #: Step of the central differences along the section's tangent basis (rad, m, rad/s, m/s).
 #: The five-link gaits' maps are strongly nonlinear (their swing tip lands almost tangentially,
 #: so the heel-strike time is very sensitive): 1.3e-6 relative agreement at 1e-6, 1.3e-4 at
@@ -147,19 +152,26 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
         raise StabilityError(f"phases[0].contacts: the step must start in single support on "
                              f"one contact, got {list(phases[0].contacts)}")
     stance = phases[0].contacts[0]
-    strikes = [e for e in gait.events if e.name == "heel_strike"]
+    strikes = [e for e in gait.events if e.name in STRIKE_EVENTS]
     if len(strikes) != 1:
-        raise StabilityError(f"events: expected one heel_strike event, got {len(strikes)}")
+        raise StabilityError(f"events: expected one touchdown event ({' or '.join(STRIKE_EVENTS)}"
+                             f") per step, got {len(strikes)}")
     swing = strikes[0].leg
+    unknown = [e.name for e in gait.events if e.name not in STRIKE_EVENTS + RELEASE_EVENTS]
+    if unknown:
+        raise StabilityError(f"events: {unknown[0]!r} is neither a touchdown "
+                             f"({', '.join(STRIKE_EVENTS)}) nor a release "
+                             f"({', '.join(RELEASE_EVENTS)})")
     ends = [float(ph.t[-1]) for ph in phases]
     events: list[list[StepEvent]] = [[] for _ in phases]
     guard = -1
-    for e in sorted(gait.events, key=lambda e: e.name != "heel_strike"):
+    # At one instant the strike comes first (the single-support walk: strike, then release).
+    for e in sorted(gait.events, key=lambda e: e.name not in STRIKE_EVENTS):
         i = int(np.argmin([abs(e.t - t) for t in ends]))
         if abs(e.t - ends[i]) > 1e-9:
             raise StabilityError(f"events: {e.name} at {e.t:g} s is not at the end of a phase")
         after = phases[i + 1].contacts if i + 1 < len(phases) else (swing,)
-        if e.name == "heel_strike":
+        if e.name in STRIKE_EVENTS:
             guard = i
             events[i].append(StepEvent("strike", e.leg, tuple(dict.fromkeys((*after, e.leg)))))
         else:

@@ -27,8 +27,6 @@ from gaitopt.dynamics.spatial import (
     unit3,
 )
 from gaitopt.dynamics.tree import (
-    X_COORDINATE,
-    Y_COORDINATE,
     Body,
     bodies,
     contact_point,
@@ -36,7 +34,7 @@ from gaitopt.dynamics.tree import (
     joint_transforms,
     link_index,
 )
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_X, BASE_Y, RobotModel
 
 Point2 = tuple[Scalar, Scalar]
 
@@ -76,7 +74,7 @@ def link_poses(model: RobotModel, q: Scalars, x: Sequence[Transform]) -> list[Po
     of :func:`gaitopt.dynamics.tree.joint_transforms` (their cos/sin are reused)."""
     base_x = x[model.coordinate_of_link(0)]
     poses = [Pose(q[model.coordinate_of_link(0)], base_x.c, base_x.s,
-                  (q[X_COORDINATE], q[Y_COORDINATE]))]
+                  (q[BASE_X], q[BASE_Y]))]
     for i in range(1, len(model.links)):
         parent = poses[model.parent_index(i)]
         k = model.coordinate_of_link(i)
@@ -148,7 +146,7 @@ def point_jacobian_rows(model: RobotModel, poses: Sequence[Pose], link: int,
     """
     row_x: Scalars = [0.0] * model.nq
     row_y: Scalars = [0.0] * model.nq
-    row_x[X_COORDINATE], row_y[Y_COORDINATE] = 1.0, 1.0
+    row_x[BASE_X], row_y[BASE_Y] = 1.0, 1.0
     for j in model.chain(link):
         k = model.coordinate_of_link(j)
         o = poses[j].origin

@@ -34,6 +34,7 @@ a leg's reach raises :class:`ReachError` instead of returning NaN.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -51,7 +52,7 @@ from gaitopt.dynamics.backend import (
 )
 from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.robot.biped import BipedStructure, BipedStructureError, Leg, biped_structure
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_ANGLE, BASE_POSITION, BASE_X, BASE_Y, RobotModel
 
 #: Names of the independent coordinates, with ``{w}`` the swing leg's number.
 SINGLE_SUPPORT_COORDINATES = ("r", "alpha", "torso", "hip_{w}", "knee_{w}")
@@ -59,8 +60,6 @@ DOUBLE_SUPPORT_COORDINATES = ("r", "alpha", "torso")
 N_SINGLE = len(SINGLE_SUPPORT_COORDINATES)
 N_DOUBLE = len(DOUBLE_SUPPORT_COORDINATES)
 
-# Indices of q for the floating base (model convention: q = [x, y, base angle, joints...]).
-_X, _Y, _TORSO = 0, 1, 2
 
 
 class ReachError(ValueError):
@@ -95,8 +94,10 @@ class ReducedSolution:
     forces: Any
 
 
+@functools.lru_cache(maxsize=64)
 def checked_biped(model: RobotModel) -> BipedStructure:
-    """The biped structure of ``model``; also requires no links beyond torso and legs."""
+    """The biped structure of ``model``; also requires no links beyond torso and legs.
+    Built once per model (:func:`~gaitopt.robot.biped.biped_structure`)."""
     structure = biped_structure(model)
     if model.nq != 7:
         raise BipedStructureError(
@@ -167,8 +168,8 @@ def _full_state(model: RobotModel, p_hip: Scalars, v_hip: Scalars, torso: Scalar
                 torso_rate: Scalar, joints: dict[int, tuple[Scalar, Scalar]]) -> tuple[Any, Any]:
     q: Scalars = [0.0] * model.nq
     qd: Scalars = [0.0] * model.nq
-    q[_X], q[_Y], q[_TORSO] = p_hip[0], p_hip[1], torso
-    qd[_X], qd[_Y], qd[_TORSO] = v_hip[0], v_hip[1], torso_rate
+    q[BASE_X], q[BASE_Y], q[BASE_ANGLE] = p_hip[0], p_hip[1], torso
+    qd[BASE_X], qd[BASE_Y], qd[BASE_ANGLE] = v_hip[0], v_hip[1], torso_rate
     for index, (angle, rate) in joints.items():
         q[index], qd[index] = angle, rate
     return vector(q), vector(qd)
@@ -212,10 +213,10 @@ def single_support_coordinates(model: RobotModel, stance: int, q: Any, qd: Any,
     legs = checked_biped(model).legs
     qs = as_scalars(q, model.nq, "q")
     qds = as_scalars(qd, model.nq, "qd")
-    r, alpha, rd, alphad = polar_from_hip(p_stance, qs[_X:_Y + 1], qds[_X:_Y + 1])
+    r, alpha, rd, alphad = polar_from_hip(p_stance, qs[BASE_POSITION], qds[BASE_POSITION])
     w = legs[1 - stance]
-    z = [r, alpha, qs[_TORSO], qs[w.hip_index], qs[w.knee_index]]
-    zd = [rd, alphad, qds[_TORSO], qds[w.hip_index], qds[w.knee_index]]
+    z = [r, alpha, qs[BASE_ANGLE], qs[w.hip_index], qs[w.knee_index]]
+    zd = [rd, alphad, qds[BASE_ANGLE], qds[w.hip_index], qds[w.knee_index]]
     return vector(z), vector(zd)
 
 
@@ -225,8 +226,8 @@ def double_support_coordinates(model: RobotModel, stance: int, q: Any, qd: Any,
     checked_biped(model)
     qs = as_scalars(q, model.nq, "q")
     qds = as_scalars(qd, model.nq, "qd")
-    r, alpha, rd, alphad = polar_from_hip(p_stance, qs[_X:_Y + 1], qds[_X:_Y + 1])
-    return vector([r, alpha, qs[_TORSO]]), vector([rd, alphad, qds[_TORSO]])
+    r, alpha, rd, alphad = polar_from_hip(p_stance, qs[BASE_POSITION], qds[BASE_POSITION])
+    return vector([r, alpha, qs[BASE_ANGLE]]), vector([rd, alphad, qds[BASE_ANGLE]])
 
 
 def polar_accelerations(r: Scalar, alpha: Scalar, rd: Scalar, alphad: Scalar,
@@ -251,9 +252,9 @@ def single_support_dynamics(model: RobotModel, stance: int, z: Any, zd: Any, tau
     sol = contact_dynamics(model, q, qd, tau, [legs[stance].contact])
     zs, zds = as_scalars(z, N_SINGLE, "z"), as_scalars(zd, N_SINGLE, "zd")
     qdd = as_scalars(sol.qdd, model.nq, "qdd")
-    rdd, alphadd = polar_accelerations(zs[0], zs[1], zds[0], zds[1], qdd[_X:_Y + 1])
+    rdd, alphadd = polar_accelerations(zs[0], zs[1], zds[0], zds[1], qdd[BASE_POSITION])
     w = legs[1 - stance]
-    zdd = vector([rdd, alphadd, qdd[_TORSO], qdd[w.hip_index], qdd[w.knee_index]])
+    zdd = vector([rdd, alphadd, qdd[BASE_ANGLE], qdd[w.hip_index], qdd[w.knee_index]])
     return ReducedSolution(zdd=zdd, q=q, qd=qd, qdd=sol.qdd, forces=sol.forces)
 
 
@@ -267,6 +268,6 @@ def double_support_dynamics(model: RobotModel, stance: int, z: Any, zd: Any, tau
     sol = contact_dynamics(model, q, qd, tau, [legs[stance].contact, legs[1 - stance].contact])
     zs, zds = as_scalars(z, N_DOUBLE, "z"), as_scalars(zd, N_DOUBLE, "zd")
     qdd = as_scalars(sol.qdd, model.nq, "qdd")
-    rdd, alphadd = polar_accelerations(zs[0], zs[1], zds[0], zds[1], qdd[_X:_Y + 1])
-    zdd = vector([rdd, alphadd, qdd[_TORSO]])
+    rdd, alphadd = polar_accelerations(zs[0], zs[1], zds[0], zds[1], qdd[BASE_POSITION])
+    zdd = vector([rdd, alphadd, qdd[BASE_ANGLE]])
     return ReducedSolution(zdd=zdd, q=q, qd=qd, qdd=sol.qdd, forces=sol.forces)

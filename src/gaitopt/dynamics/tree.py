@@ -35,8 +35,6 @@ from gaitopt.robot.model import RobotModel
 
 #: ``Body.axis`` values: the motion subspace is the unit motion vector along this axis.
 ROTATION, TRANSLATION_X, TRANSLATION_Y = 0, 1, 2
-#: Indices in ``q`` of the base position (world frame) and the base angle.
-X_COORDINATE, Y_COORDINATE, BASE_ANGLE_COORDINATE = 0, 1, 2
 
 
 @dataclass(frozen=True)

@@ -111,7 +111,7 @@ class ContactSequence:
             return nxt
         return tuple(swap_spec(c, contact_swap) for c in nxt)
 
-    def to_dict(self) -> dict[str, object]:
+    def to_dict(self) -> dict[str, Any]:
         """Plain data for the gait file."""
         return {
             "name": self.name,

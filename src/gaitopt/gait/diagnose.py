@@ -8,9 +8,16 @@ user asked for (not a relaxed stage's):
   event and periodicity rows, with their sizes in the constraint's own units;
 * binding bounds: actuator torques at their bounds (by actuator, how many knots), joints at
   their limits;
-* advice that follows from them: looser torque bounds or a lower speed when torques
-  saturate, a shorter step when the landing or the legs' reach fails, a finer grid or
-  another start when the dynamics do not close, multistart.
+* binding bounds of the problem statement (with the solve's transcription): the stance
+  leg's hip-to-tip distance ``r`` at its longest (the legs at full reach), the torso and
+  the joint rates at their bounds;
+* the most likely cause, named first: the torque bounds when they pin most knots of an
+  actuator while constraints stay violated, else the family of the constraint with the
+  largest violation (relative to its scale: the legs' reach, contact forces, the dynamics,
+  ...), which is named with its size;
+* advice that follows from them, the cause's first: looser torque bounds or a lower speed
+  when torques saturate, a shorter step when the landing or the legs' reach fails, a finer
+  grid or another start when the dynamics do not close, multistart.
 
 Only the walking solve's public pieces are used: the :class:`WalkingSolution`, its options
 and the cached transcription of the grid the result lives on.
@@ -19,6 +26,7 @@ and the cached transcription of the grid the result lives on.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -26,14 +34,18 @@ from gaitopt.gait.formulation import stage_bounds
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.problem import Relaxation
 from gaitopt.gait.solve import Grid, WalkingSolution, transcription_for
-from gaitopt.ocp import Result, Transcription
+from gaitopt.ocp import Problem, Result, Transcription
 from gaitopt.ocp.functions import broadcast_bound
+from gaitopt.ocp.validate import as_bound
 from gaitopt.robot.model import RobotModel
 
 #: A constraint counts as violated above this share of its scale.
 VIOLATION_SHARE = 1e-4
 #: A variable counts as at its bound within this share of the bound's size.
 BOUND_SHARE = 1e-4
+#: The torque bounds are the likely cause when they pin at least this share of some
+#: actuator's knots.
+CAUSE_SHARE = 0.5
 
 
 class SolveFailedError(RuntimeError):
@@ -41,18 +53,42 @@ class SolveFailedError(RuntimeError):
 
 
 @dataclass(frozen=True)
+class Finding:
+    """One observation at the best point: ``kind`` (a key of :data:`ADVICE`, or ``other``),
+    ``text``, and ``share``: a violation's size over its scale, or the share of a variable's
+    knots at a bound (``binding``)."""
+
+    kind: str
+    text: str
+    share: float
+    binding: bool = False
+    #: For a binding bound: the variable and how many knots, e.g. ``hip_1 at 13 of 13 knots``.
+    subject: str = ""
+
+
+@dataclass(frozen=True)
 class Diagnosis:
-    """What failed (``stage``, ``status``), the ``findings`` at the best point found, and
-    ``advice`` (lines of text)."""
+    """What failed (``stage``, ``status``), the ``findings`` at the best point found, the
+    most likely ``cause`` and the ``largest`` violation (texts, empty if none), the point's
+    ``violation`` (largest constraint violation in the constraints' units) and ``advice``."""
 
     stage: str
     status: str
     findings: tuple[str, ...]
     advice: tuple[str, ...]
+    cause: str = ""
+    largest: str = ""
+    violation: float = float("nan")
+    where: str = ""
 
     def text(self) -> str:
         """The diagnosis as lines for a terminal."""
-        lines = [f"the solve failed at stage '{self.stage}' ({self.status})."]
+        at = f" at {self.where}" if self.where else ""
+        lines = [f"the solve failed at stage '{self.stage}' ({self.status}){at}."]
+        if self.cause:
+            lines.append(f"Most likely cause: {self.cause}.")
+        if self.largest:
+            lines.append(f"Largest violation: {self.largest}.")
         if self.findings:
             lines.append("At the best point found:")
             lines += [f"  - {f}" for f in self.findings]
@@ -66,8 +102,7 @@ def diagnose(solution: WalkingSolution) -> Diagnosis:
     """The :class:`Diagnosis` of a failed walking solve (see the module docstring)."""
     options, model = solution.options, solution.model
     res, stage = best_failed_point(solution)
-    findings: list[str] = []
-    hints: set[str] = set()
+    found: list[Finding] = []
     meshes = [np.asarray(m, dtype=float) for m in res.mesh]
     uniform = all(np.allclose(m, np.linspace(0.0, 1.0, m.size)) for m in meshes)
     grid: Grid = tuple(meshes)
@@ -77,12 +112,46 @@ def diagnose(solution: WalkingSolution) -> Diagnosis:
         tr = transcription_for(model, options, grid)
     except Exception:  # noqa: BLE001 - a diagnosis must never hide the failure itself
         tr = None
-    if tr is not None and tr.layout.signature() == res.layout_signature:
-        findings += _path_findings(tr, res, hints)
-        findings += _row_findings(tr, res, options, hints)
-    findings += _binding_findings(model, res, hints)
-    return Diagnosis(stage=stage, status=res.status, findings=tuple(findings),
-                     advice=tuple(_advice(hints, options)))
+    matches = tr is not None and tr.layout.signature() == res.layout_signature
+    if matches:
+        assert tr is not None
+        found += _path_findings(tr, res)
+        found += _row_findings(tr, res, options)
+    found += _binding_findings(model, res, tr.problem if matches and tr is not None else None)
+    violated = [f for f in found if not f.binding]
+    largest = max(violated, key=lambda f: f.share) if violated else None
+    cause = _cause(found, largest)
+    p = res.parameters
+    where = ", ".join(part for part in (
+        f"{p['speed'] * 60:.2f} m/min" if "speed" in p else "",
+        f"step {p['step_length']:.3f} m" if "step_length" in p else "") if part)
+    kinds = [cause[0]] if cause else []
+    kinds += [f.kind for f in found  # bounds that bind at an optimum too advise nothing
+              if (not f.binding or f.kind == "torque") and f.kind in ADVICE
+              and f.kind not in kinds]
+    return Diagnosis(stage=stage, status=res.status, findings=tuple(f.text for f in found),
+                     advice=tuple(_advice(kinds, options)), cause=cause[1] if cause else "",
+                     largest=largest.text if largest is not None else "",
+                     violation=res.constraint_violation, where=where)
+
+
+def _cause(found: list[Finding], largest: Finding | None) -> tuple[str, str] | None:
+    """The kind and words of the most likely cause: the torque bounds when they pin at least
+    :data:`CAUSE_SHARE` of some actuator's knots (saturated torques with constraints still
+    violated), else the family of the largest violation. (Other bounds that bind, such as
+    the stance leg at full reach, are listed but are no cause by themselves: the optimal
+    walk has them too.)"""
+    torques = [f for f in found if f.binding and f.kind == "torque" and f.share >= CAUSE_SHARE]
+    if torques:
+        return "torque", f"{CAUSES['torque']}: {', '.join(f.subject for f in torques)}"
+    if largest is None:
+        return None
+    words = CAUSES.get(largest.kind, "a constraint that no point found could meet")
+    if largest.kind == "reach":
+        reach = [f.subject for f in found if f.binding and f.kind == "reach"]
+        if reach:
+            words += f" (the stance leg's hip-to-tip distance {reach[0]})"
+    return largest.kind, words
 
 
 def best_failed_point(solution: WalkingSolution) -> tuple[Result, str]:
@@ -99,7 +168,7 @@ def best_failed_point(solution: WalkingSolution) -> tuple[Result, str]:
     return min(pairs, key=lambda pair: pair[0].constraint_violation)
 
 
-def _path_findings(tr: Transcription, res: Result, hints: set[str]) -> list[str]:
+def _path_findings(tr: Transcription, res: Result) -> list[Finding]:
     out = []
     for spec, traj in zip(tr.problem.phases, res.phases, strict=True):
         for pc in spec.path_constraints:
@@ -117,14 +186,13 @@ def _path_findings(tr: Transcription, res: Result, hints: set[str]) -> list[str]
             if not np.any(share > VIOLATION_SHARE):
                 continue
             k, j = np.unravel_index(int(np.argmax(share)), share.shape)
-            out.append(f"{spec.name}: '{pc.name}' violated by {excess[k, j]:.3g} at "
-                       f"t = {traj.t[k]:.3f} s (knot {k})")
-            hints.add(_kind(pc.name))
+            out.append(Finding(_kind(pc.name),
+                               f"{spec.name}: '{pc.name}' violated by {excess[k, j]:.3g} at "
+                               f"t = {traj.t[k]:.3f} s (knot {k})", float(share[k, j])))
     return out
 
 
-def _row_findings(tr: Transcription, res: Result, options: GaitOptions,
-                  hints: set[str]) -> list[str]:
+def _row_findings(tr: Transcription, res: Result, options: GaitOptions) -> list[Finding]:
     bounds = stage_bounds(tr, Relaxation(), options)
     g = np.asarray(tr.nlp.evaluate(res.w)[0], dtype=np.float64).ravel()
     out = []
@@ -137,41 +205,61 @@ def _row_findings(tr: Transcription, res: Result, options: GaitOptions,
         share = np.where(np.isfinite(excess), excess, 0.0) / scale
         if rows.size == 0 or not np.any(share > VIOLATION_SHARE):
             continue
-        worst = float(excess[int(np.argmax(share))])
+        i = int(np.argmax(share))
         what = (f"{blk.phase}: the equations of motion between knots (collocation defects)"
                 if blk.kind == "defects" else f"'{blk.name}'")
-        out.append(f"{what} violated by {worst:.3g}")
-        hints.add("dynamics" if blk.kind == "defects" else _kind(blk.name))
+        out.append(Finding("dynamics" if blk.kind == "defects" else _kind(blk.name),
+                           f"{what} violated by {float(excess[i]):.3g}", float(share[i])))
     return out
 
 
-def _binding_findings(model: RobotModel, res: Result, hints: set[str]) -> list[str]:
-    """Torques at their bounds and joints at their limits, counted over all knots."""
-    torque = {a.name: a.limits for a in model.actuators}
+def _binding_findings(model: RobotModel, res: Result, problem: Problem | None) -> list[Finding]:
+    """Torques at their bounds, joints at their limits and (with the ``problem``) every other
+    state bound of the statement that binds, counted over all knots; ``share`` is the share
+    of the variable's knots at the bound."""
+    torques = {a.name: a.limits for a in model.actuators}
     joints = {j.name: j.limits for j in model.joints}
-    counts: dict[tuple[str, str], list[int]] = {}
+    counts: dict[tuple[str, str], list[Any]] = {}
     for traj in res.phases:
-        for kind, names, values, limits in (("torque", traj.controls, traj.u, torque),
-                                            ("joint", traj.states, traj.x, joints)):
-            for j, name in enumerate(names):
-                if name not in limits:
-                    continue
-                lo, hi = limits[name]
-                tol = BOUND_SHARE * max(abs(lo), abs(hi), 1.0)
-                at = (values[:, j] <= lo + tol) | (values[:, j] >= hi - tol)
-                c = counts.setdefault((kind, name), [0, 0])
-                c[0] += int(np.count_nonzero(at))
-                c[1] += values.shape[0]
+        stated = {} if problem is None else {
+            n: as_bound(b, n) for ph in problem.phases if ph.name == traj.name
+            for n, b in ph.state_bounds.items()}
+        columns = [("torque", name, traj.u[:, j], torques[name])
+                   for j, name in enumerate(traj.controls) if name in torques]
+        for j, name in enumerate(traj.states):
+            if name in joints:
+                columns.append(("joint", name, traj.x[:, j], joints[name]))
+            elif name in stated:
+                columns.append((_state_kind(name), name, traj.x[:, j], stated[name]))
+        for kind, name, values, (lo, hi) in columns:
+            size = max(abs(v) for v in (lo, hi, 1.0) if np.isfinite(v))
+            at = (values <= lo + BOUND_SHARE * size) | (values >= hi - BOUND_SHARE * size)
+            c = counts.setdefault((kind, name), [0, 0, (lo, hi)])
+            c[0] += int(np.count_nonzero(at))
+            c[1] += values.shape[0]
     out = []
-    for (kind, name), (n_at, n_all) in counts.items():
+    for (kind, name), (n_at, n_all, (lo, hi)) in counts.items():
         if n_at == 0:
             continue
-        lo, hi = (torque if kind == "torque" else joints)[name]
-        unit = "N m" if kind == "torque" else "rad"
-        what = "at its bound" if kind == "torque" else "at its limit"
-        out.append(f"{kind} {name} {what} ({lo:g}, {hi:g} {unit}) at {n_at} of {n_all} knots")
-        hints.add(kind)
+        knots = f"at {n_at} of {n_all} knots"
+        if kind == "reach":
+            text = (f"the stance leg's hip-to-tip distance {name} at its bound ({lo:.3g}, "
+                    f"{hi:.3g} m; the longest is the legs' reach with the least knee bend)")
+        elif kind in ("torque", "joint"):
+            what = "at its bound" if kind == "torque" else "at its limit"
+            unit = "N m" if kind == "torque" else "rad"
+            text = f"{kind} {name} {what} ({lo:g}, {hi:g} {unit})"
+        else:
+            unit = "rad/s" if name.endswith("_rate") else "rad"
+            text = f"state {name} at its bound ({lo:g}, {hi:g} {unit})"
+        out.append(Finding(kind, f"{text} {knots}", n_at / n_all, binding=True,
+                           subject=f"{name} at the bound {knots}"))
     return out
+
+
+def _state_kind(name: str) -> str:
+    """The family of a bounded state of the reduced statement (``r``: the legs' reach)."""
+    return "reach" if name == "r" else "other"
 
 
 def _kind(name: str) -> str:
@@ -208,9 +296,22 @@ ADVICE = {
 }
 
 
-def _advice(hints: set[str], options: GaitOptions) -> list[str]:
-    out = [ADVICE[h] for h in ("torque", "reach", "force", "impulse", "clearance",
-                               "friction", "joint", "dynamics", "periodic") if h in hints]
+#: The most likely causes in words, by kind.
+CAUSES = {
+    "torque": "the torque bounds",
+    "reach": "the legs' reach (the step asks for more than the legs can reach)",
+    "joint": "the joint limits",
+    "force": "the contact forces (the ground would have to pull)",
+    "impulse": "the contact impulses (the ground would have to pull at an event)",
+    "clearance": "the swing clearance",
+    "friction": "the friction cone",
+    "dynamics": "the equations of motion (no motion on this grid meets them)",
+    "periodic": "closing the step into a periodic gait",
+}
+
+
+def _advice(kinds: list[str], options: GaitOptions) -> list[str]:
+    out = [ADVICE[k] for k in kinds if k in ADVICE]
     if not options.multistart:
         out.append("--multistart tries every naive start and the continuation in speed")
     return out

@@ -29,8 +29,10 @@ from gaitopt.gait import walking
 from gaitopt.gait.full_physics import actuator_names
 from gaitopt.gait.full_physics import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.ocp import Guess as OcpGuess
+from gaitopt.ocp import PhaseGuess as OcpPhaseGuess
 from gaitopt.robot.biped import biped_structure
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_POSITION, RobotModel
 
 Array = NDArray[np.float64]
 
@@ -55,6 +57,17 @@ class PhaseGuess:
 class WalkingGuess:
     phases: tuple[PhaseGuess, ...]
     parameters: dict[str, float]
+
+    def to_ocp(self) -> OcpGuess:
+        """The engine's guess object (values at normalised knot times)."""
+        phases = {}
+        for ph in self.phases:
+            span = ph.t[-1] - ph.t[0]
+            phases[ph.name] = OcpPhaseGuess(
+                x={n: ph.x[:, j] for j, n in enumerate(ph.states)},
+                u={n: ph.u[:, j] for j, n in enumerate(ph.controls)},
+                tau=(ph.t - ph.t[0]) / span)
+        return OcpGuess(phases=phases, parameters=dict(self.parameters))
 
 
 def default_step_length(speed: float) -> float:
@@ -116,7 +129,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
     tip2 = np.stack([-step + 2.0 * step * _smoothstep(s), lift * np.sin(np.pi * s)], axis=1)
     p_hip = hip(t_fine)
     q_fine = np.zeros((_FINE, model.nq))
-    q_fine[:, 0:2] = p_hip
+    q_fine[:, BASE_POSITION] = p_hip
     for k in range(_FINE):
         for leg, tip in ((legs[0], (0.0, 0.0)), (legs[1], tuple(tip2[k]))):
             joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip), 0.0,
@@ -129,7 +142,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
         t_fine = np.linspace(t1, t1 + t2, _FINE)
         p_hip = hip(t_fine)
         q_fine = np.zeros((_FINE, model.nq))
-        q_fine[:, 0:2] = p_hip
+        q_fine[:, BASE_POSITION] = p_hip
         for k in range(_FINE):
             for leg, tip in ((legs[0], (0.0, 0.0)), (legs[1], (step, 0.0))):
                 joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),
@@ -182,7 +195,7 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
                              yb * sig1 + bump * np.sin(np.pi * (t - t1) / (total - t1))],
                             axis=1)
         q_fine = np.zeros((_FINE, model.nq))
-        q_fine[:, 0:2] = p_hip
+        q_fine[:, BASE_POSITION] = p_hip
         for k in range(_FINE):
             for leg, tip in ((legs[0], tip1[k]), (legs[1], tip2[k])):
                 joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),

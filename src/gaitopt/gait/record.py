@@ -77,8 +77,10 @@ def sample_points(model: RobotModel) -> tuple[tuple[str, str, tuple[float, float
             continue
         out.append((link.joint.name, link.name, (0.0, 0.0)))
     for c in model.contacts:
-        out.append((c.name, c.link, tuple(model.link(c.link).local_point(*c.at))))
-    out.append(("torso_top", base.name, tuple(base.local_point(base.length))))
+        x, y = model.link(c.link).local_point(*c.at)
+        out.append((c.name, c.link, (float(x), float(y))))
+    x, y = base.local_point(base.length)
+    out.append(("torso_top", base.name, (float(x), float(y))))
     return tuple(out)
 
 
@@ -184,7 +186,7 @@ def _solved_sequence(solution: WalkingSolution) -> dict[str, Any]:
     data = contact_sequence(solution.model, solution.options).to_dict()
     durations = [ph.duration for ph in solution.result.phases]
     total = sum(durations)
-    phases: list[dict[str, Any]] = list(data["phases"])  # type: ignore[call-overload]
+    phases: list[dict[str, Any]] = list(data["phases"])
     for phase, duration in zip(phases, durations, strict=True):
         phase["fraction"] = float(duration / total)
     return data

@@ -29,10 +29,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from gaitopt.dynamics.kinematics import contact_position
-from gaitopt.dynamics.tree import BASE_ANGLE_COORDINATE, X_COORDINATE, Y_COORDINATE, hold_name
+from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.guess import Array, PhaseGuess, WalkingGuess, _knots, _phase_guess, _smoothstep
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 
 #: Samples per phase of the inverse kinematics (rates are differentiated from them).
 SAMPLES = 60
@@ -112,7 +112,7 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     pose = np.array([0.0, 0.0, 0.0] + [FLEXED_KNEE if "knee" in j.name else 0.0
                                        for j in model.joints])
     q = np.clip(pose.copy(), lo, hi)
-    q[X_COORDINATE], q[Y_COORDINATE] = middle - v * total / 2.0, 0.95 * stand
+    q[BASE_X], q[BASE_Y] = middle - v * total / 2.0, 0.95 * stand
     ends = np.concatenate([[0.0], np.cumsum([ph.fraction for ph in seq.phases])]) * total
     phases: list[PhaseGuess] = []
     for i, ph in enumerate(seq.phases):
@@ -133,8 +133,8 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
                     if tgt[0] is not None:
                         r.append(tgt[2] * (p[0] - tgt[0]))
                     r.append(tgt[2] * (p[1] - tgt[1]))
-                r += [W_BASE * (qq[X_COORDINATE] - base[0]), W_BASE * (qq[Y_COORDINATE] - base[1]),
-                      W_TORSO * qq[BASE_ANGLE_COORDINATE]]
+                r += [W_BASE * (qq[BASE_X] - base[0]), W_BASE * (qq[BASE_Y] - base[1]),
+                      W_TORSO * qq[BASE_ANGLE]]
                 r += list(W_JOINT * (qq[3:] - pose[3:]))
                 return np.array(r)
 

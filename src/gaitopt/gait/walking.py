@@ -42,7 +42,7 @@ from gaitopt.dynamics.reduced import (
     single_support_state,
 )
 from gaitopt.robot.biped import Leg
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_POSITION, RobotModel
 
 SINGLE = "single_support"
 DOUBLE = "double_support"
@@ -172,7 +172,7 @@ def heel_strike(model: RobotModel, x_end: Any, step_length: Scalar, *,
     sol = impact(model, q, qd_minus, contacts)
     if double_support:
         qs, qds = as_scalars(q, model.nq, "q"), as_scalars(sol.qd_plus, model.nq, "qd")
-        _, _, rd, alphad = polar_from_hip(ORIGIN, qs[0:2], qds[0:2])
+        _, _, rd, alphad = polar_from_hip(ORIGIN, qs[BASE_POSITION], qds[BASE_POSITION])
         x_next = vector([z[0], z[1], z[2], rd, alphad, qds[2]])
     else:
         x_next = relabelled_single_support_state(model, q, sol.qd_plus, (step_length, 0.0))

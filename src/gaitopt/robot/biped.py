@@ -8,6 +8,7 @@ otherwise.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -65,8 +66,12 @@ class BipedStructure:
         return 1 - i
 
 
+@functools.lru_cache(maxsize=64)
 def biped_structure(model: RobotModel) -> BipedStructure:
     """Identify the torso (the floating base) and the two legs of ``model``.
+
+    Built once per model: the model is immutable, so equal models share one structure (the
+    walking code asks for it in many places); a model that is no biped raises every time.
 
     Requirements, each reported by name when violated: exactly two contact points; each on a
     link (the shank) whose parent (the thigh) is attached to the base; the hip joints at the

@@ -14,16 +14,10 @@ from typing import Any
 
 import yaml
 
-from gaitopt.robot.model import RobotModel
-from gaitopt.robot.schema import (
-    FORMAT,
-    VERSION,
-    ModelError,
-    ellipsoid_inertia,
-    model_from_dict,
-    model_to_dict,
-    rod_inertia,
-)
+from gaitopt.robot.errors import ModelError
+from gaitopt.robot.inertia import ellipsoid_inertia, rod_inertia
+from gaitopt.robot.model import FORMAT, VERSION, RobotModel, model_to_dict
+from gaitopt.robot.schema import model_from_dict
 
 __all__ = [
     "FORMAT", "VERSION", "ModelError", "builtin_names", "builtin_text", "ellipsoid_inertia",

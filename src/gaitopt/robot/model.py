@@ -34,8 +34,17 @@ Direction = Literal["up", "down"]
 
 AXIS_OF_DIRECTION: dict[str, tuple[float, float]] = {"up": (0.0, 1.0), "down": (0.0, -1.0)}
 
+#: The model-file format and version that :func:`model_to_dict` writes (and
+#: :mod:`gaitopt.robot.schema` reads).
+FORMAT = "gaitopt.model"
+VERSION = 1
+
 #: Names of the three coordinates of the floating base, in order.
 BASE_COORDINATES: tuple[str, str, str] = ("x", "y", "angle")
+#: Indices in ``q`` of the base position (world frame, m) and the base angle (rad), in the
+#: order of :data:`BASE_COORDINATES`; ``BASE_POSITION`` slices ``(x, y)`` out of ``q``.
+BASE_X, BASE_Y, BASE_ANGLE = 0, 1, 2
+BASE_POSITION = slice(BASE_X, BASE_Y + 1)
 
 
 @dataclass(frozen=True)
@@ -242,9 +251,8 @@ class RobotModel:
 
     # -- identity ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """The model as plain data in the model-file schema (see ``gaitopt.robot.schema``)."""
-        from gaitopt.robot.schema import model_to_dict
-
+        """The model as plain data in the model-file schema (:func:`model_to_dict`; read back
+        by :func:`gaitopt.robot.schema.model_from_dict`)."""
         return model_to_dict(self)
 
     def content_hash(self) -> str:
@@ -252,3 +260,39 @@ class RobotModel:
         a cache key: equal models have equal hashes."""
         text = json.dumps(self.to_dict(), sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+# -- model -> plain data ---------------------------------------------------------------------
+
+def model_to_dict(model: RobotModel) -> dict[str, Any]:
+    """The model as plain data in the model-file schema (:data:`FORMAT`, :data:`VERSION`).
+
+    Every default is written out; a link keeps its ``shape`` (if any) next to the explicit
+    ``inertia``. ``gaitopt.robot.schema.model_from_dict(model_to_dict(m)) == m``.
+    """
+    links: list[dict[str, Any]] = []
+    for link in model.links:
+        entry: dict[str, Any] = {"name": link.name, "parent": link.parent}
+        if link.joint is not None:
+            entry["joint"] = {"name": link.joint.name, "at": list(link.joint.at),
+                              "limits": list(link.joint.limits)}
+        entry.update({"direction": link.direction, "length": link.length, "mass": link.mass,
+                      "com": list(link.com), "inertia": link.inertia})
+        if link.shape is not None:
+            entry["shape"] = ({"type": "ellipsoid", "radius": link.shape.radius}
+                              if link.shape.type == "ellipsoid" else {"type": "rod"})
+        links.append(entry)
+    actuators: list[dict[str, Any]] = []
+    for a in model.actuators:
+        target = {"joint": a.joint} if a.joint is not None else {"contact": a.contact}
+        actuators.append({"name": a.name, **target, "limits": list(a.limits)})
+    out = {
+        "format": FORMAT, "version": VERSION, "name": model.name,
+        "description": model.description, "gravity": list(model.gravity), "links": links,
+        "contacts": [{"name": c.name, "link": c.link, "at": list(c.at)} for c in model.contacts],
+        "actuators": actuators,
+    }
+    if model.symmetry is not None:  # only when declared: older models keep their hash
+        out["symmetry"] = {"links": [list(p) for p in model.symmetry.links],
+                           "contacts": [list(p) for p in model.symmetry.contacts]}
+    return out

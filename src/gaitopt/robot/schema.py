@@ -27,11 +27,15 @@ bad value and what is allowed. Validation never raises any other exception, what
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Mapping
 from typing import Any
 
+from gaitopt.robot.errors import MISSING, ModelError, show_value
+from gaitopt.robot.fields import FieldReader, names_text
+from gaitopt.robot.inertia import INERTIA_RTOL, shape_inertia
 from gaitopt.robot.model import (
+    FORMAT,
+    VERSION,
     Actuator,
     Contact,
     Direction,
@@ -42,8 +46,6 @@ from gaitopt.robot.model import (
     SymmetrySpec,
 )
 
-FORMAT = "gaitopt.model"
-VERSION = 1
 DEFAULT_GRAVITY: tuple[float, float] = (0.0, -9.81)
 
 TOP_KEYS = ("format", "version", "name", "description", "gravity", "links", "contacts",
@@ -55,109 +57,6 @@ CONTACT_KEYS = ("name", "link", "at")
 ACTUATOR_KEYS = ("name", "joint", "contact", "limits")
 SHAPE_TYPES = ("ellipsoid", "rod")
 DIRECTIONS = ("up", "down")
-
-#: Relative tolerance when a link gives both ``inertia`` and ``shape``.
-INERTIA_RTOL = 1e-9
-
-
-class _Missing:
-    def __repr__(self) -> str:
-        return "<missing>"
-
-
-#: Stands for the value of a required field that is absent.
-MISSING: Any = _Missing()
-
-
-def show_value(value: Any, limit: int = 60) -> str:
-    """A one-line, length-limited ``repr`` of a value for error messages."""
-    try:
-        text = repr(value)
-    except Exception:  # a repr that fails must not hide the real error
-        text = f"<{type(value).__name__}>"
-    text = " ".join(text.split())
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-class ModelError(ValueError):
-    """A model file or description is invalid.
-
-    The message is one line: ``SOURCE: PATH: got VALUE; allowed: ALLOWED`` (``missing`` instead
-    of ``got VALUE`` for an absent required field, or another ``problem`` text).
-
-    Attributes:
-        source: the file (or ``<builtin NAME>``, ``<dict>``, ``<string>``) the model came from.
-        path: the field path, e.g. ``links[2].mass``; ``""`` for the whole file.
-        value: the offending value (:data:`MISSING` for an absent field).
-        allowed: what would have been accepted.
-    """
-
-    def __init__(self, source: str, path: str, value: Any, allowed: str, *,
-                 problem: str | None = None) -> None:
-        self.source, self.path, self.value, self.allowed = source, path, value, allowed
-        if problem is None:
-            problem = "missing" if value is MISSING else f"got {show_value(value)}"
-        where = f"{path}: " if path else ""
-        super().__init__(f"{source}: {where}{problem}; allowed: {allowed}")
-
-
-# -- inertia of shapes -----------------------------------------------------------------------
-
-def ellipsoid_inertia(mass: float, length: float, radius: float) -> float:
-    """Inertia (kg m^2) about the axis through the centre normal to the plane of a uniform
-    ellipsoid with semi-axes ``a = length/2`` (along the link), ``b = c = radius``:
-    ``I = m (a^2 + b^2) / 5``."""
-    a = length / 2.0
-    return mass * (a * a + radius * radius) / 5.0  # products give inf, never OverflowError
-
-
-def rod_inertia(mass: float, length: float) -> float:
-    """Inertia (kg m^2) of a thin uniform rod about its centre: ``I = m length^2 / 12``."""
-    return mass * (length * length) / 12.0
-
-
-def shape_inertia(shape: Shape, mass: float, length: float) -> float:
-    """Inertia (kg m^2) about the centre of a link of ``mass`` kg and ``length`` m."""
-    if shape.type == "ellipsoid":
-        assert shape.radius is not None
-        return ellipsoid_inertia(mass, length, shape.radius)
-    return rod_inertia(mass, length)
-
-
-# -- model -> plain data ---------------------------------------------------------------------
-
-def model_to_dict(model: RobotModel) -> dict[str, Any]:
-    """The model as plain data in the model-file schema.
-
-    Every default is written out; a link keeps its ``shape`` (if any) next to the explicit
-    ``inertia``. ``model_from_dict(model_to_dict(m)) == m``.
-    """
-    links: list[dict[str, Any]] = []
-    for link in model.links:
-        entry: dict[str, Any] = {"name": link.name, "parent": link.parent}
-        if link.joint is not None:
-            entry["joint"] = {"name": link.joint.name, "at": list(link.joint.at),
-                              "limits": list(link.joint.limits)}
-        entry.update({"direction": link.direction, "length": link.length, "mass": link.mass,
-                      "com": list(link.com), "inertia": link.inertia})
-        if link.shape is not None:
-            entry["shape"] = ({"type": "ellipsoid", "radius": link.shape.radius}
-                              if link.shape.type == "ellipsoid" else {"type": "rod"})
-        links.append(entry)
-    actuators: list[dict[str, Any]] = []
-    for a in model.actuators:
-        target = {"joint": a.joint} if a.joint is not None else {"contact": a.contact}
-        actuators.append({"name": a.name, **target, "limits": list(a.limits)})
-    out = {
-        "format": FORMAT, "version": VERSION, "name": model.name,
-        "description": model.description, "gravity": list(model.gravity), "links": links,
-        "contacts": [{"name": c.name, "link": c.link, "at": list(c.at)} for c in model.contacts],
-        "actuators": actuators,
-    }
-    if model.symmetry is not None:  # only when declared: older models keep their hash
-        out["symmetry"] = {"links": [list(p) for p in model.symmetry.links],
-                           "contacts": [list(p) for p in model.symmetry.contacts]}
-    return out
 
 
 # -- plain data -> model ---------------------------------------------------------------------
@@ -172,98 +71,8 @@ def model_from_dict(data: Any, *, source: str = "<dict>") -> RobotModel:
     return _Validator(source).model(data)
 
 
-def _field(path: str, key: Any) -> str:
-    """The path of ``key`` under ``path``: ``links[1].mass``, or ``links[1]['odd key']``."""
-    if isinstance(key, str) and key.isidentifier():
-        return f"{path}.{key}" if path else key
-    return f"{path}[{show_value(key, 30)}]"
-
-
-def _names(names: list[str] | set[str] | tuple[str, ...]) -> str:
-    return ", ".join(sorted(names)) or "none defined"
-
-
-class _Validator:
+class _Validator(FieldReader):
     """Checks one model description; ``source`` goes into every error."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, path: str, value: Any, allowed: str, problem: str | None = None) -> ModelError:
-        return ModelError(self.source, path, value, allowed, problem=problem)
-
-    # -- generic fields ----------------------------------------------------------------------
-    def mapping(self, path: str, value: Any, keys: tuple[str, ...], required: tuple[str, ...],
-                what: str) -> Mapping[str, Any]:
-        if not isinstance(value, Mapping):
-            raise self.fail(path, value, f"a mapping (key: value) describing {what}")
-        for key in value:
-            if key not in keys:
-                raise self.fail(_field(path, key), value[key],
-                                f"the keys {', '.join(keys)}",
-                                problem=f"unknown key {show_value(key)}")
-        for key in required:
-            if key not in value:
-                raise self.fail(f"{path}.{key}" if path else key, MISSING,
-                                f"'{key}' is required in {what}")
-        return value
-
-    def number(self, path: str, value: Any, allowed: str, *, positive: bool = False) -> float:
-        """A finite real number (> 0 if ``positive``); ``allowed`` describes it with units."""
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            hint = ""
-            if isinstance(value, str):
-                try:
-                    float(value)
-                    hint = " (YAML reads numbers like 1e3 as text: write 1.0e+3)"
-                except ValueError:
-                    pass
-            raise self.fail(path, value, allowed + hint)
-        try:
-            x = float(value)
-        except (OverflowError, ValueError, TypeError):
-            raise self.fail(path, value, allowed) from None
-        if not math.isfinite(x) or (positive and x <= 0.0):
-            raise self.fail(path, value, allowed)
-        return x
-
-    def name(self, path: str, value: Any) -> str:
-        """A name: non-empty printable text without leading or trailing spaces."""
-        if (not isinstance(value, str) or not value.strip() or value != value.strip()
-                or not value.isprintable()):
-            hint = " (quote it in YAML: '1', 'yes')" if isinstance(value, bool | int | float) \
-                else ""
-            raise self.fail(path, value, "a non-empty printable text without leading or "
-                            f"trailing spaces{hint}")
-        return value
-
-    def pair(self, path: str, value: Any, allowed: str) -> tuple[float, float]:
-        """Two finite numbers ``[a, b]``; ``allowed`` describes them with units."""
-        if not isinstance(value, list | tuple) or len(value) != 2:
-            raise self.fail(path, value, f"a list of two numbers {allowed}")
-        return (self.number(f"{path}[0]", value[0], f"a finite number; {allowed}"),
-                self.number(f"{path}[1]", value[1], f"a finite number; {allowed}"))
-
-    def bounds(self, path: str, value: Any, unit: str) -> tuple[float, float]:
-        lo, hi = self.pair(path, value, f"[lower, upper] in {unit}")
-        if lo > hi:
-            raise self.fail(path, [lo, hi], f"[lower, upper] in {unit} with lower <= upper",
-                            problem=f"lower bound above upper bound {show_value([lo, hi])}")
-        return (lo, hi)
-
-    def unique(self, path: str, name: str, seen: set[str], what: str) -> None:
-        if name in seen:
-            article = "an" if what[0] in "aeiou" else "a"
-            raise self.fail(path, name, f"{article} {what} name not used by another {what}",
-                            problem=f"duplicate {what} name {show_value(name)}")
-        seen.add(name)
-
-    def optional_list(self, path: str, value: Any, what: str) -> list[Any]:
-        if value is None:
-            return []
-        if not isinstance(value, list):
-            raise self.fail(path, value, f"a list of {what} (or null for none)")
-        return value
 
     # -- the model ---------------------------------------------------------------------------
     def model(self, data: Any) -> RobotModel:
@@ -325,7 +134,7 @@ class _Validator:
                         or not all(isinstance(n, str) and n in known for n in item)
                         or item[0] == item[1]):
                     raise self.fail(path, item, f"a pair [left, right] of two different "
-                                                f"{key} of this model ({_names(known)})")
+                                                f"{key} of this model ({names_text(known)})")
                 for n in item:
                     if n in seen:
                         raise self.fail(path, item, "each name in one pair at most",
@@ -375,7 +184,7 @@ class _Validator:
         for i, parent in enumerate(parents):
             if parent is not None and parent not in names:
                 raise self.fail(f"links[{i}].parent", parent,
-                                f"the name of a link in this model ({_names(names)})")
+                                f"the name of a link in this model ({names_text(names)})")
         parent_of = dict(zip(order, parents, strict=True))
         for i, start in enumerate(order):
             seen = [start]
@@ -450,7 +259,7 @@ class _Validator:
         reserved = {"x", "y", base_name}
         if name in reserved:
             raise self.fail(f"{path}.name", name,
-                            f"a name other than {_names(reserved)} (they name the base "
+                            f"a name other than {names_text(reserved)} (they name the base "
                             "coordinates of q)")
         self.unique(f"{path}.name", name, joint_names, "joint")
         at = self.pair(f"{path}.at", j["at"], "[along, across] in m on the parent link")
@@ -483,7 +292,7 @@ class _Validator:
             link = c["link"]
             if not isinstance(link, str) or link not in by_name:
                 raise self.fail(f"{path}.link", link,
-                                f"the name of a link in this model ({_names(list(by_name))})")
+                                f"the name of a link in this model ({names_text(list(by_name))})")
             at = (self.pair(f"{path}.at", c["at"], "[along, across] in m on the link")
                   if "at" in c else (by_name[link].length, 0.0))
             out.append(Contact(name=name, link=link, at=at))
@@ -510,7 +319,7 @@ class _Validator:
             target = a[kind]
             if not isinstance(target, str) or target not in known:
                 raise self.fail(f"{path}.{kind}", target,
-                                f"the name of a {kind} in this model ({_names(known)})")
+                                f"the name of a {kind} in this model ({names_text(known)})")
             key = f"{kind} {target}"
             if key in driven:
                 raise self.fail(f"{path}.{kind}", target,
@@ -522,3 +331,6 @@ class _Validator:
             out.append(Actuator(name=name, limits=limits, joint=target if kind == "joint"
                                 else None, contact=target if kind == "contact" else None))
         return tuple(out)
+
+
+__all__ = ["DEFAULT_GRAVITY", "FORMAT", "VERSION", "ModelError", "model_from_dict"]

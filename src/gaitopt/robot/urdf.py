@@ -39,32 +39,31 @@ from __future__ import annotations
 import math
 import os
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gaitopt.robot.errors import ModelError
+from gaitopt.robot.inertia import INERTIA_RTOL, shape_inertia
 from gaitopt.robot.model import RobotModel, Shape
-from gaitopt.robot.schema import INERTIA_RTOL, ModelError, model_from_dict, shape_inertia
+from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf_export import urdf_from_model
+from gaitopt.robot.urdf_plane import (
+    AXIS_TOL,
+    IN_PLANE,
+    PLANE,
+    SNAP,
+    direction_and_length,
+    is_identity,
+    link_point,
+)
 from gaitopt.robot.urdf_xml import CONTACT_PREFIX, Extension, Reader, UJoint, ULink
 
 __all__ = ["CONTACT_PREFIX", "ContactSpec", "model_from_urdf", "parse_contact_option",
            "urdf_from_model"]
-
-#: Coordinates smaller than this (m) computed through a frame rotation are taken as exactly 0.
-SNAP = 1e-12
-#: Tolerance on a joint axis being the common axis (a unit vector).
-AXIS_TOL = 1e-9
-
-#: Rows: gaitopt x, y, z as URDF vectors, for each common axis.
-_PLANE = {"y": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
-          "x": np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])}
-#: Which URDF coordinates of a link frame a ``--contact`` point gives, for each common axis.
-_IN_PLANE = {"y": (0, 2), "x": (1, 2)}
-
 
 @dataclass(frozen=True)
 class ContactSpec:
@@ -134,7 +133,7 @@ def model_from_urdf(source: str | os.PathLike[str], *, contacts: Iterable[Contac
         ModelError: one line naming the file, the joint or link and what is allowed.
     """
     text, label = _read_source(source)
-    if axis not in _PLANE:
+    if axis not in PLANE:
         raise ModelError(label, "axis", axis, "y or x (the common joint axis)")
     try:
         root = ET.fromstring(text)
@@ -144,7 +143,7 @@ def model_from_urdf(source: str | os.PathLike[str], *, contacts: Iterable[Contac
     if root.tag != "robot":
         raise ModelError(label, "", f"<{root.tag}>", "a <robot> element",
                          problem=f"the root element is <{root.tag}>")
-    return _Importer(Reader(label), root, _PLANE[axis], axis).model(list(contacts), name)
+    return _Importer(Reader(label), root, PLANE[axis], axis).model(list(contacts), name)
 
 
 class _Importer:
@@ -262,7 +261,7 @@ class _Importer:
         bodies = [_Body(base, -1, None)]
         # URDF link -> (its gaitopt link, its axes and origin in that link's frame, whether
         # no rotation went into them: then points computed from them are exact)
-        frame = {base: (0, self.base_rot, np.zeros(3), _is_identity(self.base_rot))}
+        frame = {base: (0, self.base_rot, np.zeros(3), is_identity(self.base_rot))}
         contacts: list[tuple[str, int, np.ndarray]] = []
         done = {j.name for j in chain}
         pending = [j for j in self.joints if j.name not in done]
@@ -282,7 +281,7 @@ class _Importer:
                 if (j.name.startswith(CONTACT_PREFIX) and child.mass == 0.0
                         and not self.children[j.child]):
                     contacts.append((j.child, k, self.in_plane(pos, exact_p)))
-                frame[j.child] = (k, rot, pos, exact_p and _is_identity(rot))
+                frame[j.child] = (k, rot, pos, exact_p and is_identity(rot))
             elif j.type in ("revolute", "continuous"):
                 sign = self.about_normal(f"{where} axis", rot @ j.axis)
                 assert j.limits is not None
@@ -291,7 +290,7 @@ class _Importer:
                 bodies[k].points.append(at)
                 bodies.append(_Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
                                     effort=j.effort or 0.0))
-                frame[j.child] = (len(bodies) - 1, rot, np.zeros(3), _is_identity(rot))
+                frame[j.child] = (len(bodies) - 1, rot, np.zeros(3), is_identity(rot))
             else:
                 raise self.r.fail(where, j.type, "revolute, continuous or fixed joints below "
                                   "the base (prismatic, planar and floating joints only in the "
@@ -316,7 +315,7 @@ class _Importer:
                                   f"{spec.link!r}")
             k, rot, pos, exact = frame[spec.link]
             local = np.zeros(3)
-            i0, i1 = _IN_PLANE[self.axis]
+            i0, i1 = IN_PLANE[self.axis]
             local[i0], local[i1] = spec.point
             contacts.append((spec.name, k, self.in_plane(pos + rot @ local, exact)))
             taken.add(spec.name)
@@ -340,16 +339,16 @@ class _Importer:
             if not inertia > 0.0:
                 raise self.r.fail(f"link {b.name!r}", inertia, "an inertia > 0 about the "
                                   f"{self.axis} axis (kg m^2)")
-            direction, length = ext.links.get(b.name) or _direction_and_length(
+            direction, length = ext.links.get(b.name) or direction_and_length(
                 b.points, com, base=i == 0)
             entry: dict[str, Any] = {"name": b.name,
                                      "parent": None if b.parent < 0 else bodies[b.parent].name}
             if b.joint is not None:
                 # the joint's position is a point on the parent (listed before its children)
-                entry["joint"] = {**b.joint, "at": _point(b.joint["at"],
+                entry["joint"] = {**b.joint, "at": link_point(b.joint["at"],
                                                           links[b.parent]["direction"])}
             entry.update({"direction": direction, "length": length, "mass": mass,
-                          "com": _point(com, direction), "inertia": inertia})
+                          "com": link_point(com, direction), "inertia": inertia})
             shape = ext.shapes.get(b.name)
             if shape is not None:
                 s = Shape(type=shape["type"], radius=shape.get("radius"))
@@ -360,7 +359,7 @@ class _Importer:
         directions = {b.name: links[i]["direction"] for i, b in enumerate(bodies)}
         data: dict[str, Any] = {
             "name": name or self.robot_name, "links": links,
-            "contacts": [{"name": c, "link": bodies[k].name, "at": _point(p, directions[
+            "contacts": [{"name": c, "link": bodies[k].name, "at": link_point(p, directions[
                 bodies[k].name])} for c, k, p in contacts],
         }
         if ext.actuators is not None:
@@ -375,41 +374,3 @@ class _Importer:
         if ext.description is not None:
             data["description"] = ext.description
         return data
-
-
-def _is_identity(rot: np.ndarray) -> bool:
-    return bool(np.array_equal(rot, np.eye(3)))
-
-
-def _point(p: Sequence[float] | np.ndarray, direction: str) -> list[float]:
-    """gaitopt link-frame coordinates (x, y) as ``[along, across]`` for a link direction
-    (``+ 0.0`` turns ``-0.0`` into ``0.0``)."""
-    x, y = float(p[0]), float(p[1])
-    return [-y + 0.0, x + 0.0] if direction == "down" else [y + 0.0, -x + 0.0]
-
-
-def _direction_and_length(points: list[np.ndarray], com: np.ndarray,
-                          base: bool) -> tuple[str, float]:
-    """The documented rule (``docs/urdf.md``) for a link's axis and length.
-
-    ``points`` are the link's child joints and contact points and ``com`` its centre of mass,
-    as gaitopt (x, y) in the link frame at zero angle. A non-base link points ``down`` to its
-    lowest point below the origin (length: that depth), else ``up`` to its highest point above
-    it. The base, and a link whose points are all level with its origin, points towards its
-    centre of mass (``up`` if above the origin) with length twice the centre's height (the
-    centre in the middle), at least reaching its points on that side; a link with nothing
-    above or below its origin gets ``down`` and 1 m.
-    """
-    below = max([-float(p[1]) for p in points if p[1] < 0.0], default=0.0)
-    above = max([float(p[1]) for p in points if p[1] > 0.0], default=0.0)
-    height = float(com[1])
-    if not base or height == 0.0:
-        if below > 0.0:
-            return "down", below
-        if above > 0.0:
-            return "up", above
-    if height > 0.0:
-        return "up", max(2.0 * height, above)
-    if height < 0.0:
-        return "down", max(-2.0 * height, below)
-    return "down", 1.0

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from gaitopt.robot.errors import ModelError
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.schema import ModelError
 from gaitopt.robot.urdf_xml import CONTACT_PREFIX
 
 

@@ -2,7 +2,7 @@
 (type, parent, child, origin, axis, limits, effort) and the ``<gaitopt>`` element.
 
 Units as in URDF: m, kg, kg m^2, rad, N m. Every problem is a one-line
-:class:`~gaitopt.robot.schema.ModelError` naming the link or joint and what is allowed. The
+:class:`~gaitopt.robot.errors.ModelError` naming the link or joint and what is allowed. The
 frames and what the records become are in :mod:`gaitopt.robot.urdf` and ``docs/urdf.md``.
 """
 
@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.robot.schema import ModelError
+from gaitopt.robot.errors import ModelError
 
 #: Name prefix of the fixed joints that mark contact frames (``gaitopt_contact_tip_1``).
 CONTACT_PREFIX = "gaitopt_contact_"

@@ -41,8 +41,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.formulation import biped_of
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptionsError, validate_options
 from gaitopt.ocp import Result
@@ -270,10 +270,10 @@ def write_summaries(spec: SweepSpec, directory: Path, rows: dict[str, SummaryRow
 def check_points(spec: SweepSpec) -> None:
     """Validate every point's options before any solve (:class:`SweepSpecError` names the
     point and the option)."""
-    biped = checked_biped(spec.model)
     for point in spec.points:
+        options = spec.options(point)  # the legs as the point's formulation sees them
         try:
-            validate_options(spec.options(point), biped)
+            validate_options(options, biped_of(spec.model, options))
         except GaitOptionsError as exc:
             raise SweepSpecError(f"{point.label().strip()}: {exc}") from None
 

@@ -375,15 +375,18 @@ def findings_text(findings: Findings) -> str:
     return "\n".join(lines)
 
 
-def findings_html(findings: Findings) -> str:
+def findings_html(findings: Findings, *, heading: str = "paper finding",
+                  anchor_prefix: str = "finding-") -> str:
     """An HTML table (no external resources): claim and id, verdict, evidence; each row's
-    HTML id is ``finding-<id>`` (a link target: ``report.html#finding-optimum.speed``)."""
+    HTML id is ``finding-<id>`` (a link target: ``report.html#finding-optimum.speed``);
+    ``heading`` names the first column, ``anchor_prefix`` replaces ``finding-``."""
     colors = {True: "#1a7f37", False: "#b3261e", None: "#6b6b6b"}
     rows = []
     for item in findings.items:
-        rows.append(f'<tr id="finding-{html.escape(item.id)}"><td>{html.escape(item.claim)}'
+        rows.append(f'<tr id="{html.escape(anchor_prefix + item.id)}"><td>'
+                    f'{html.escape(item.claim)}'
                     f'<br><code>{html.escape(item.id)}</code></td><td style="color:'
                     f'{colors[item.holds]};font-weight:bold;white-space:nowrap">'
                     f"{VERDICT_WORDS[item.holds]}</td><td>{html.escape(item.evidence)}</td></tr>")
-    return ('<table class="findings"><thead><tr><th>paper finding</th><th>ours</th>'
+    return (f'<table class="findings"><thead><tr><th>{html.escape(heading)}</th><th>ours</th>'
             "<th>evidence</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>")

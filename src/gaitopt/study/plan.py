@@ -265,7 +265,8 @@ def with_option_defaults(settings: Mapping[str, Any]) -> dict[str, Any]:
     sweep written before an option existed was solved with that option's default."""
     out = dict(settings)
     if isinstance(out.get("options"), Mapping):
-        defaults = {k: v for k, v in GaitOptions().to_dict().items() if k not in POINT_FIELDS}
+        defaults = {k: v for k, v in GaitOptions.saved_defaults().items()
+                    if k not in POINT_FIELDS}
         out["options"] = {**defaults, **out["options"]}
     return out
 

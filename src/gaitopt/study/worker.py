@@ -210,8 +210,8 @@ def gait_file_matches(gait: Gait, model: RobotModel, options: GaitOptions) -> st
     if not gait.success:
         return f"its solve failed ({gait.status})"
     wanted = options.to_dict()
-    # An option the gait file lacks was added after it was written: it had the default.
-    saved = {**GaitOptions().to_dict(), **{k: _plain(v) for k, v in gait.options.items()}}
+    # An option the gait file lacks was added after it was written: it had the default then.
+    saved = {**GaitOptions.saved_defaults(), **{k: _plain(v) for k, v in gait.options.items()}}
     diff = sorted(k for k in set(wanted) | set(saved) if wanted.get(k) != saved.get(k))
     if diff:
         return f"it was solved with other options ({', '.join(diff)})"

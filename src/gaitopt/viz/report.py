@@ -13,6 +13,12 @@ files it names, layout in :mod:`gaitopt.study.summary`) and writes to ``out_dir`
 
 Figs. 5-8 show, per the paper, each variant's energy-optimal walk and its solved walk nearest
 50 m/min; a missing gait leaves its curve out and is listed under "problems".
+
+Every figure's caption and the headline table state the sweep's grid (knots and control model)
+and, when a check sweep on a finer grid exists (``<sweep>/check-grid``, written by ``gaitopt
+study``; :mod:`gaitopt.study.grid_error`), the error estimate of what it shows: the largest
+change of the cost (or step length) to the finer grid over the points shown, and for each
+speed-free optimum how far its speed and step length move.
 """
 
 from __future__ import annotations
@@ -39,6 +45,7 @@ from gaitopt.study.findings import (
     optimal_row,
     row_near_speed,
 )
+from gaitopt.study.grid_error import GridError, grid_error
 from gaitopt.study.summary import (
     SUMMARY_COLUMNS,
     SUMMARY_FILE,
@@ -89,9 +96,11 @@ class _Selected:
 
 
 def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
-                 svg: bool = True) -> ReportInfo:
+                 svg: bool = True,
+                 check_dir: str | os.PathLike[str] | None = None) -> ReportInfo:
     """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
-    ``svg=False`` skips the SVG copies of the figures.
+    ``svg=False`` skips the SVG copies of the figures; ``check_dir`` is the check sweep on a
+    finer grid (default ``<sweep_dir>/check-grid`` when it exists).
 
     Raises :class:`gaitopt.study.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
@@ -120,6 +129,13 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         load(fast[v])
     gaits = {f: g for f, g in cache.items() if g is not None}
     findings = assess_findings(rows, gaits)
+    errors = grid_error(sweep, rows, check_dir)
+
+    def grid_note(shown: Sequence[SummaryRow | None] | None = None, what: str = "cost") -> str:
+        """The grid and error-estimate sentence of a figure showing ``shown`` (all rows)."""
+        if errors is None:
+            return ""
+        return " " + errors.statement(None if shown is None else errors.of(shown), what=what)
 
     sections: list[str] = []
     figures: list[Path] = []
@@ -133,12 +149,15 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         sections.append(f"<figure><img alt='{html.escape(stem)}' src='{png_data_uri(data)}'>"
                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 
-    sections.append("<h2>Energy-optimal walk of each variant</h2>" + _headline(rows, optimal))
+    sections.append("<h2>Energy-optimal walk of each variant</h2>"
+                    + _headline(rows, optimal, errors))
     sections.append("<h2>Energy and step length against speed</h2>")
     add(energy_figure(rows), "fig3_energy", "Fig. 3: cost (energy per metre) against speed, "
-        "four variants; the human curve on the right axis for comparing shapes.")
+        "four variants; the human curve on the right axis for comparing shapes." + grid_note())
     add(step_length_figure(rows), "fig4_step_length", "Fig. 4: optimal step length against "
-        "speed.")
+        "speed." + grid_note(what="step length"))
+
+    shown: dict[tuple[str, str], list[SummaryRow]] = {}
 
     def pick(variants: tuple[str, str]) -> list[_Selected]:
         """Optimal walks with/without ankles, then near 50 m/min (paper's line styles)."""
@@ -152,6 +171,7 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
                 kind = "optimal" if table is optimal else "fixed speed"
                 chosen.append(_Selected(f"{variant}, {row.speed_m_min:.1f} m/min ({kind})",
                                         gait, gait_style(k)))
+                shown.setdefault(variants, []).append(row)
         return chosen
 
     def curves(selected: Sequence[_Selected]
@@ -165,23 +185,28 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     add(hip_motion_figure(c, styles=st) if c else None, "fig5_hip_motion",
         "Fig. 5: hip horizontal position and velocity over a double step, liftoff impulse on; "
         "optimal speed with/without ankle torques (solid/dashed), near 50 m/min (dash-dot/"
-        "dotted). Grey lines: heel strike, next liftoff, next heel strike.")
+        "dotted). Grey lines: heel strike, next liftoff, next heel strike."
+        + grid_note(shown.get(("ankle+impulse", "impulse"), [])))
     add(heights_figure(c, styles=st) if c else None, "fig6_heights",
-        "Fig. 6: hip and knee heights over a double step (same gaits as Fig. 5).")
+        "Fig. 6: hip and knee heights over a double step (same gaits as Fig. 5)."
+        + grid_note(shown.get(("ankle+impulse", "impulse"), [])))
     sections.append("<h2>Torques</h2>")
     c7, st7 = curves(without_impulse)
     add(torques_figure(c7, styles=st7, title="Fig. 7  torques without liftoff impulse")
         if c7 else None, "fig7_torques_no_impulse",
-        "Fig. 7: torques without the liftoff impulse, with their bounds (dashed).")
+        "Fig. 7: torques without the liftoff impulse, with their bounds (dashed)."
+        + grid_note(shown.get(("ankle", "plain"), [])))
     add(torques_figure(c, styles=st, title="Fig. 8  torques with liftoff impulse")
         if c else None, "fig8_torques_impulse",
-        "Fig. 8: torques with the liftoff impulse, with their bounds (dashed).")
+        "Fig. 8: torques with the liftoff impulse, with their bounds (dashed)."
+        + grid_note(shown.get(("ankle+impulse", "impulse"), [])))
     sections.append("<h2>Stick figures of the optimal step</h2>")
     for v in VARIANTS:
         gait = load(optimal[v])
         add(stick_strip_figure(gait, title=f"{VARIANT_LABELS[v]}: optimal step at "
                                f"{gait.speed * 60:.1f} m/min") if gait else None,
-            f"stick_{v.replace('+', '-')}", f"One step of the optimal walk, {v}.")
+            f"stick_{v.replace('+', '-')}", f"One step of the optimal walk, {v}."
+            + grid_note([optimal[v]]))
     sections.append("<h2>Solver statistics</h2>" + _solver_table(rows, optimal, load))
     sections.append("<h2>Findings of the paper, checked</h2>" + findings_html(findings))
     sections.append("<h2>All sweep points</h2>" + _summary_table(rows))
@@ -220,10 +245,11 @@ def _fmt(x: float, spec: str) -> str:
     return "–" if not math.isfinite(x) else format(x, spec)
 
 
-def _headline(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None]) -> str:
+def _headline(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None],
+              errors: GridError | None = None) -> str:
     head = ("<table><thead><tr><th>variant</th><th>speed [m/min]</th><th>speed [m/s]</th>"
             "<th>step length [m]</th><th>step time [s]</th><th>cost</th><th>from</th>"
-            "<th>solved</th></tr></thead><tbody>")
+            "<th>solved</th><th>error estimate</th></tr></thead><tbody>")
     body = []
     for v in VARIANTS:
         r = optimal[v]
@@ -231,18 +257,34 @@ def _headline(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | Non
         solved = len(rows_of(rows, v))
         if r is None:
             body.append(f"<tr><td>{v}</td><td colspan=6>no successful solve</td>"
-                        f"<td>{solved}/{total}</td></tr>")
+                        f"<td>{solved}/{total}</td><td>–</td></tr>")
             continue
         source = "speed-free solve" if r.speed_mode == "free" else "grid minimum"
         body.append(f"<tr><td>{v}</td><td>{_fmt(r.speed_m_min, '.1f')}</td>"
                     f"<td>{_fmt(r.speed_m_s, '.3f')}</td><td>{_fmt(r.step_length, '.3f')}</td>"
                     f"<td>{_fmt(r.step_time, '.3f')}</td><td>{_fmt(r.cost, '.4g')}</td>"
-                    f"<td>{source}</td><td>{solved}/{total}</td></tr>")
+                    f"<td>{source}</td><td>{solved}/{total}</td>"
+                    f"<td>{html.escape(_optimum_error(errors, r))}</td></tr>")
     body.append(f"<tr class='paper'><td>paper (all variants)</td><td>≈ "
                 f"{PAPER_OPTIMAL_SPEED_M_MIN:g}</td><td>≈ {PAPER_OPTIMAL_SPEED_M_MIN / 60:.2f}"
                 f"</td><td>≈ {PAPER_OPTIMAL_STEP_LENGTH:g}</td><td>–</td><td>–</td>"
-                "<td>Figs. 3, 4</td><td>–</td></tr>")
-    return head + "".join(body) + "</tbody></table>"
+                "<td>Figs. 3, 4</td><td>–</td><td>–</td></tr>")
+    grid = "" if errors is None else f"<p>{html.escape(errors.statement())}</p>"
+    return head + "".join(body) + "</tbody></table>" + grid
+
+
+def _optimum_error(errors: GridError | None, row: SummaryRow) -> str:
+    """How far an optimum moves to the check grid: cost (%), speed (m/min), step (m)."""
+    if errors is None or errors.check_knots is None:
+        return "–"
+    found = errors.of([row])
+    if not found:
+        return "not checked"
+    p = found[0]
+    grid = f"{errors.check_knots[0]}+{errors.check_knots[1]}"
+    moved = "" if row.speed_mode == "fixed" else f"speed {p.speed_m_min:+.2f} m/min, "
+    return (f"to {grid} knots: cost {100 * p.cost:.2f} %, {moved}"
+            f"step {p.step_length:+.4f} m")
 
 
 def _solver_table(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None],
@@ -317,3 +359,12 @@ def _page(title: str, sections: Sequence[str], rows: Sequence[SummaryRow]) -> st
     return ("<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
             f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
             f"<h1>{html.escape(title)}</h1>{intro}" + "\n".join(sections) + "</body></html>\n")
+
+
+def html_page(title: str, intro_html: str, sections: Sequence[str]) -> str:
+    """A self-contained HTML page in the report's style: the title, an introduction (HTML)
+    and the sections (HTML), no external resource."""
+    return ("<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
+            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
+            f"<h1>{html.escape(title)}</h1>{intro_html}" + "\n".join(sections)
+            + "</body></html>\n")

@@ -32,6 +32,7 @@ from scipy.integrate import solve_ivp
 from gaitopt.analysis.checks.check import LIMITS, Check, Worst
 from gaitopt.analysis.checks.knots import state_map
 from gaitopt.dynamics.functions import contact_dynamics_function
+from gaitopt.gait.contact_sequence import phase_holds
 from gaitopt.gait.gait_file import Gait, GaitPhase
 from gaitopt.robot.model import RobotModel
 
@@ -64,7 +65,8 @@ def _interval_ends(gait: Gait, ph: GaitPhase, starts: Array | None) -> Array:
     """The state (2 nq,) at the end of each interval k (K-1 rows), integrated from
     ``starts[k]`` or, if ``starts`` is None, from the previous interval's end (the whole
     phase from its first knot)."""
-    ode = _ode(gait.model, tuple(ph.contacts))
+    i = next(j for j, other in enumerate(gait.phases) if other is ph)
+    ode = _ode(gait.model, phase_holds(gait.contact_sequence, i, tuple(ph.contacts)))
     ends = []
     y = np.hstack([ph.q[0], ph.qd[0]])
     for k in range(ph.t.size - 1):

@@ -36,7 +36,7 @@ from gaitopt.dynamics.kinematics import (
 from gaitopt.dynamics.reduced import N_DOUBLE, double_support_state
 from gaitopt.dynamics.rnea import rnea
 from gaitopt.gait import walking
-from gaitopt.gait.contact_sequence import sequence_from_dict
+from gaitopt.gait.contact_sequence import phase_holds, sequence_from_dict
 from gaitopt.gait.gait_file import Gait, GaitPhase
 from gaitopt.robot.biped import biped_structure
 from gaitopt.robot.model import RobotModel
@@ -197,7 +197,8 @@ def knot_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
             "contacts.acceleration": _row_max(np.abs(acc)),
             "contacts.normal_force": _row_max(-forces[:, 1::2]) / weight,
             "states.values": _row_max(np.abs(x - ph.x)),
-            "states.rates": _row_max(_off_normal(model, ph, xdot - ph.xdot)),
+            "states.rates": _row_max(_off_normal(
+                model, ph, xdot - ph.xdot, phase_holds(gait.contact_sequence, i, contacts))),
         }
         for key, values in per_knot.items():
             k = int(np.argmax(values))
@@ -209,7 +210,8 @@ def knot_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
     return checks + ([friction] if friction is not None else []) + [_parameter_check(gait, lim)]
 
 
-def _off_normal(model: RobotModel, ph: GaitPhase, residual: Array) -> Array:
+def _off_normal(model: RobotModel, ph: GaitPhase, residual: Array,
+                holds: tuple[str, ...]) -> Array:
     """``residual`` (K, 2 nq) of the state rates, less any part along the held points'
     constraint normals in a full-coordinate phase.
 
@@ -217,13 +219,13 @@ def _off_normal(model: RobotModel, ph: GaitPhase, residual: Array) -> Array:
     controls correct the collocation's drift off the constraint manifold and act only along
     ``J^T`` (docs/formulations.md). What is left after removing ``J^T (J J^T)^-1 J r`` from
     each half must vanish, as must the whole residual in a reduced phase or with no point
-    held."""
+    held. ``holds``: the phase's hold specs (the rows of ``J``)."""
     if not ph.contacts or tuple(ph.state_names) != full_state_names(model):
         return residual
     nq = model.nq
     out = np.array(residual, dtype=float)
     for k in range(out.shape[0]):
-        jac = np.asarray(contact_jacobian(model, ph.q[k], ph.contacts), dtype=float)
+        jac = np.asarray(contact_jacobian(model, ph.q[k], holds), dtype=float).reshape(-1, nq)
         for half in (slice(0, nq), slice(nq, 2 * nq)):
             r = out[k, half]
             out[k, half] = r - jac.T @ np.linalg.solve(jac @ jac.T, jac @ r)

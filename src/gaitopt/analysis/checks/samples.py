@@ -137,15 +137,15 @@ def _bound_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
         k = int(np.argmax(excess))
         between = between.update(excess[k], f"{joint.name} sample {k}")
     lowest = Worst(-np.inf)
-    contacts = [c.name for c in model.contacts]
+    contacts = [point.name for point in model.contacts]
     for i, (ph, mask) in enumerate(zip(gait.phases, phase_of_samples(gait), strict=True)):
-        for c in contacts:
-            if c in ph.contacts or c not in s.points or not mask.any():
+        for name in contacts:
+            if name in ph.contacts or name not in s.points or not mask.any():
                 continue
-            heights = s.points[c][mask, 1]
+            heights = s.points[name][mask, 1]
             k = int(np.argmin(heights))
             lowest = lowest.update(-float(heights[k]),
-                                   f"{c} sample {int(np.flatnonzero(mask)[k])} (phases[{i}])")
+                                   f"{name} sample {int(np.flatnonzero(mask)[k])} (phases[{i}])")
     return [Check("bounds.torque", max(0.0, torque.value), lim["bounds.torque"], torque.where),
             Check("bounds.joints_knots", max(0.0, knots.value), lim["bounds.joints_knots"],
                   knots.where),

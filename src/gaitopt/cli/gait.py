@@ -11,14 +11,21 @@ from typing import Any
 import click
 from rich.table import Table
 
-from gaitopt.cli_base import (
+from gaitopt.cli.base import (
     USER_ERRORS,
     UserError,
     cli,
+    control_model_option,
+    cost_option,
+    formulation_option,
+    grid_choice,
+    knots_option,
     make_console,
+    model_option,
+    paper_grid_option,
     parse_free_or_value,
-    parse_knots,
     parse_pair,
+    resting_power_option,
 )
 from gaitopt.gait.formulation import biped_of, checked_sequence, default_formulation
 from gaitopt.gait.gait_file import Gait, GaitFileError
@@ -72,8 +79,7 @@ def _step_time(text: str) -> float | None:
 
 
 @cli.command("solve")
-@click.option("--model", "model_name", default="five-link", show_default=True,
-              help="Built-in model name or model file.")
+@model_option
 @click.option("--speed", default="12m/min", show_default=True,
               help="Average speed with a unit (12m/min, 0.2m/s) or 'free' (the optimal walk).")
 @click.option("--step-length", default="free", show_default=True,
@@ -89,8 +95,8 @@ def _step_time(text: str) -> float | None:
 @click.option("--single-support-bounds", default=None,
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
-@click.option("--knots", default="8,5", show_default=True,
-              help="Grid points per phase: single support, double support.")
+@knots_option
+@paper_grid_option
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
               default=GaitOptions().transcription, show_default=True,
               help="hermite-simpson-separated: the same scheme with the midpoint states as "
@@ -103,11 +109,11 @@ def _step_time(text: str) -> float | None:
 @click.option("--unilateral-impulses/--paper-impulse-maps", default=True, show_default=True,
               help="Normal impulses on held tips >= 0 at the heel strike and the liftoff, or "
                    "the paper's maps as they are (the ground may pull a held tip).")
-@click.option("--formulation", type=click.Choice(["reduced", "full"]), default=None,
+@formulation_option(
               help="reduced: the paper's coordinates (five-link biped); full: the whole "
                    "tree's q, qd with the held points as constraints (any model and contact "
                    "sequence, knees may straighten) [default: reduced for the five-link shape "
-                   "and the walk, else full].")
+                   "and the walk, else full].", default=None)
 @click.option("--min-knee-flexion", type=float, default=None,
               help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
                    "stance knee straighten, with --formulation full].")
@@ -119,17 +125,14 @@ def _step_time(text: str) -> float | None:
               type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="A YAML file with a contact sequence (phases, events, anchors; "
                    "docs/formulations.md); replaces --gait.")
-@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
-              show_default=True,
+@cost_option(
               help="paper: torque squared per metre; work: mechanical cost of transport; "
                    "metabolic: positive/negative work efficiencies and a resting power "
                    "(docs/costs.md).")
-@click.option("--resting-power", type=float, default=None,
-              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
+@resting_power_option
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="Weight of an added mean squared torque (u / u_max)^2 term.")
-@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
-              show_default=True,
+@control_model_option(
               help="Controls continuous at the heel strike and periodic (paper), or free to "
                    "jump at both events (jumps).")
 @click.option("--mesh-tol", type=float, default=None,
@@ -153,13 +156,14 @@ def _step_time(text: str) -> float | None:
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
                   impulse: bool,
-                  single_support: float, knots: str, transcription: str,
+                  single_support: float, knots: str | None, paper_grid: bool,
+                  transcription: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
                   gait_kind: str, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
-                  control_model: str, mesh_tol: float | None,
+                  control_model: str | None, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool,
                   warm_start: Path | None, output: Path) -> None:
@@ -183,14 +187,14 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         contact_sequence=sequence,
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
-        single_support_fraction=single_support, knots=parse_knots(knots),
+        single_support_fraction=single_support,
+        **grid_choice(knots, control_model, paper_grid),
         transcription=transcription,  # type: ignore[arg-type]
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses, multistart=multistart,
         formulation=formulation,  # type: ignore[arg-type]
         gait=gait_kind, cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
-        control_model=control_model,  # type: ignore[arg-type]
         mesh_tol=mesh_tol, swing_clearance=clearance,
         clearance_profile=clearance_profile)  # type: ignore[arg-type]
     if resting_power is not None:
@@ -210,8 +214,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots, {options.formulation} "
-                  "coordinates")
+                  + f", {options.knots[0]}+{options.knots[1]} knots, control model "
+                  f"{options.control_model}"
+                  + (" (the paper's grid)" if options.paper_grid else "")
+                  + f", {options.formulation} coordinates")
 
     if (start is None and not multistart and options.speed is not None
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
@@ -232,9 +238,10 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     if not solution.success:
         from gaitopt.gait.diagnose import diagnose
 
-        console.print("FAILED: " + diagnose(solution).text())
-        console.print(f"Largest constraint violation {solution.result.constraint_violation:.3g}."
-                      " No gait file written.")
+        diagnosis = diagnose(solution)
+        console.print("FAILED: " + diagnosis.text())
+        console.print(f"Largest constraint violation at that point {diagnosis.violation:.3g} "
+                      "(in the constraints' own units). No gait file written.")
         sys.exit(1)
     try:
         gait = gait_from_solution(solution)
@@ -292,8 +299,14 @@ def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
         rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
     else:
         prev = "+".join(str(k) for k in accuracy["previous_knots"].values())
-        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s (change "
-                     f"from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+        rel = accuracy.get("cost_error_relative")
+        share = "" if rel is None else f" = {100 * rel:.2g} % of J"
+        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} "
+                     f"(change from {prev} knots, J {accuracy['previous_cost']:.6g})"))
+        dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
+        if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
+            rows.append(("change from " + prev + " knots",
+                         f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"))
     return rows
 
 

@@ -1,9 +1,9 @@
-"""``gaitopt sweep``, ``report``, ``animate`` and ``study`` (the main job): many gaits.
+"""``gaitopt sweep`` and ``study`` (the main job): many gaits.
 
 ``sweep`` solves a grid (variants x speeds, optionally x step lengths x single-support
-fractions) in parallel with continuation and writes a resumable sweep directory; ``report``
-writes the paper's figures and an HTML report of a sweep; ``animate`` writes a GIF or mp4 of
-a gait; ``study`` does all three for the paper's study. See docs/studies.md.
+fractions) in parallel with continuation and writes a resumable sweep directory; ``study``
+does that for the paper's study, then ``report`` and ``animate`` (:mod:`gaitopt.cli.report`).
+See docs/studies.md.
 """
 
 from __future__ import annotations
@@ -26,9 +26,24 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from gaitopt.cli_base import UserError, cli, make_console, parse_free_or_value, parse_knots
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.cli.base import (
+    UserError,
+    cli,
+    control_model_option,
+    cost_option,
+    formulation_option,
+    grid_choice,
+    knots_option,
+    make_console,
+    model_option,
+    paper_grid_option,
+    parse_free_or_value,
+    parse_knots,
+    resting_power_option,
+)
+from gaitopt.cli.report import animate_file, write_reports
+from gaitopt.gait.formulation import default_formulation
+from gaitopt.gait.options import GAITS, GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import (
     Counts,
@@ -38,9 +53,9 @@ from gaitopt.study.driver import (
     default_workers,
     run_sweep,
 )
-from gaitopt.study.executors import BackendError
-from gaitopt.study.plan import SETTINGS_FILE, SweepPoint, SweepSpec, SweepSpecError
-from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, SummaryError
+from gaitopt.study.executors import Backend, BackendError
+from gaitopt.study.plan import SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 from gaitopt.study.worker import PointOutcome
 
 #: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
@@ -48,6 +63,9 @@ DEFAULT_SPEEDS = "3:60:3"
 #: Default speed grid of ``gaitopt study`` (m/min).
 STUDY_SPEEDS = "3:60:3"
 STUDY_DIR = Path("out/study")
+#: Default directory and resting powers (W/kg) of ``gaitopt study --costs``.
+COSTS_DIR = Path("out/costs")
+DEFAULT_RESTING_POWERS_TEXT = "0,0.6,1.2,2.4,4.8"
 MAX_SPEEDS = 2000
 
 
@@ -134,10 +152,11 @@ def parse_fractions(text: str) -> tuple[float, ...]:
 
 
 def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
-              single_support: str, knots: str, step_time: str = "free",
+              single_support: str, knots: str | None = None, step_time: str = "free",
               problem: dict[str, Any] | None = None) -> SweepSpec:
     """The sweep of the CLI's options; ``problem`` holds further :class:`GaitOptions` fields
-    shared by every point (formulation, cost, control model, ...)."""
+    shared by every point (formulation, cost, control model, ...); ``knots`` None keeps
+    the default grid (or ``problem``'s)."""
     from gaitopt.gait.api import as_model
 
     model = as_model(model_name)
@@ -148,7 +167,8 @@ def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_l
                          step_times=parse_step_lengths(step_time, option="--step-time",
                                                        unit="s", quantity="time"),
                          single_support=parse_fractions(single_support),
-                         base=GaitOptions(knots=parse_knots(knots), **(problem or {})))
+                         base=GaitOptions(**{**(problem or {}), **(
+                             {} if knots is None else {"knots": parse_knots(knots)})}))
     except SweepSpecError as exc:
         raise UserError(str(exc)) from None
 
@@ -180,9 +200,11 @@ def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
 
 def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
                       workers: int | None, scheduler: str | None,
-                      fail_points: Sequence[str] = ()) -> SweepReport:
+                      fail_points: Sequence[str] = (),
+                      backend: Backend | None = None) -> SweepReport:
     """:func:`run_sweep` with a progress bar (done/failed/remaining, ETA) and a line per
-    finished point; errors the user can fix become :class:`UserError`."""
+    finished point; errors the user can fix become :class:`UserError`. ``backend``: run on
+    it (and leave it open) instead of starting one."""
     progress = Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
         TextColumn("failed {task.fields[failed]}  remaining {task.fields[remaining]}"),
@@ -209,7 +231,8 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
 
     try:
         report = run_sweep(spec, directory, workers=workers, scheduler=scheduler,
-                           on_start=on_start, on_point=on_point, fail_points=fail_points)
+                           on_start=on_start, on_point=on_point, fail_points=fail_points,
+                           backend=backend)
     except (SweepSpecError, SweepSettingsError, BackendError, GaitOptionsError,
             BipedStructureError) as exc:
         raise UserError(str(exc)) from None
@@ -242,8 +265,7 @@ def _workers_option(f: Any) -> Any:
 @cli.command("sweep")
 @click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
               required=True, help="Sweep directory (created; rerun to resume).")
-@click.option("--model", "model_name", default="five-link", show_default=True,
-              help="Built-in model name or model file.")
+@model_option
 @click.option("--speeds", default=DEFAULT_SPEEDS, show_default=True,
               help="Speeds in m/min: start:stop:step (stop included) and/or a comma list.")
 @click.option("--variants", default="all", show_default=True,
@@ -256,22 +278,24 @@ def _workers_option(f: Any) -> Any:
               help="Step times in s (comma list), or 'free'; not with --step-length.")
 @click.option("--single-support", default="0.85", show_default=True,
               help="Single-support fractions of the step time (comma list).")
-@click.option("--knots", default="8,5", show_default=True,
-              help="Grid points per phase: single support, double support.")
-@click.option("--formulation", type=click.Choice(["reduced", "full"]), default="reduced",
-              show_default=True, help="The coordinates of every point (docs/formulations.md).")
-@click.option("--cost", type=click.Choice(["paper", "work", "metabolic"]), default="paper",
-              show_default=True, help="The cost of every point (docs/costs.md).")
-@click.option("--resting-power", type=float, default=None,
-              help="Resting power of the metabolic cost, W/kg [default: 1.2].")
-@click.option("--control-model", type=click.Choice(["paper", "jumps"]), default="paper",
-              show_default=True, help="Controls continuous and periodic (paper) or free to "
+@knots_option
+@paper_grid_option
+@formulation_option(help="The coordinates of every point (docs/formulations.md) [default: "
+                         "reduced for the five-link shape and the walk, else full].",
+                    default=None)
+@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default="walk",
+              show_default=True, help="The contact sequence of every point (heel-toe: feet, "
+                                      "e.g. --model seven-link).")
+@cost_option(help="The cost of every point (docs/costs.md).")
+@resting_power_option
+@control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
-                  step_length: str, step_time: str, single_support: str, knots: str,
-                  formulation: str, cost: str, resting_power: float | None,
-                  control_model: str, workers: int | None, scheduler: str | None) -> None:
+                  step_length: str, step_time: str, single_support: str, knots: str | None,
+                  paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
+                  resting_power: float | None, control_model: str | None,
+                  workers: int | None, scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -279,121 +303,115 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     failed.
     """
     console = make_console()
+    if formulation is None:
+        from gaitopt.gait.api import as_model
+
+        try:
+            formulation = default_formulation(as_model(model_name), gait_kind, False)
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "control_model": control_model}
+                               "gait": gait_kind, **grid_choice(knots, control_model, paper_grid)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
-                     step_length=step_length, single_support=single_support, knots=knots,
+                     step_length=step_length, single_support=single_support,
                      step_time=step_time, problem=problem)
     report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
     if report.counts.failed:
         sys.exit(1)
 
 
-# -- report and animate -------------------------------------------------------------------------
-
-def sweep_dirs(directory: Path) -> list[Path]:
-    """The (sub-)sweeps of a sweep directory: itself, or its sub-folders with a summary."""
-    if (directory / SUMMARY_FILE).exists():
-        return [directory]
-    subs = sorted(p.parent for p in directory.glob(f"*/{SUMMARY_FILE}"))
-    if not subs:
-        what = "no sweep" if not (directory / SETTINGS_FILE).exists() else "no finished point"
-        raise UserError(f"{directory}: {what} here (no {SUMMARY_FILE}); run `gaitopt sweep -o "
-                        f"{directory}` first")
-    return subs
-
-
-def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
-    """Write the report of each (sub-)sweep, print where and the findings."""
-    from gaitopt.study.findings import findings_text
-    from gaitopt.viz.report import write_report
-
-    pages = []
-    for sweep in sweep_dirs(directory):
-        target = out if sweep == directory else out / sweep.name
-        try:
-            info = write_report(sweep, target)
-        except SummaryError as exc:
-            raise UserError(str(exc)) from None
-        console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)",
-                      soft_wrap=True)
-        for problem in info.problems:
-            console.print(f"  problem: {problem}", soft_wrap=True)
-        console.print(findings_text(info.findings), soft_wrap=True)
-        pages.append(info.html)
-    return pages
-
-
-@cli.command("report")
-@click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="Folder of the report (default: DIRECTORY/report).")
-def report_command(directory: Path, output: Path | None) -> None:
-    """Write the figures and the HTML report of a sweep, and print the findings."""
-    if not directory.is_dir():
-        raise UserError(f"{directory}: no such directory")
-    write_reports(make_console(), directory, output or directory / "report")
-
-
-def animate_file(console: Console, file: Path, output: Path, *, steps: int, fps: int) -> None:
-    from gaitopt.viz.animation import animate_gait
-
-    try:
-        gait = Gait.load(file)
-    except GaitFileError as exc:
-        raise UserError(str(exc)) from None
-    start = time.perf_counter()
-    try:
-        info = animate_gait(gait, output, steps=steps, fps=fps)
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
-    console.print(f"animation: {info.path} ({info.frames} frames, {info.duration_s:.2f} s at "
-                  f"{info.fps:g} fps, {steps} steps of {gait.speed * 60:.1f} m/min; written "
-                  f"in {time.perf_counter() - start:.1f} s)", soft_wrap=True)
-
-
-@cli.command("animate")
-@click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
-              default=Path("walk.gif"), show_default=True, help="A .gif or .mp4 file.")
-@click.option("--steps", type=click.IntRange(min=1, max=100), default=4, show_default=True,
-              help="Steps to show.")
-@click.option("--fps", type=click.IntRange(min=1, max=120), default=30, show_default=True,
-              help="Frames per second (the movie plays in real time).")
-def animate_command(file: Path, output: Path, steps: int, fps: int) -> None:
-    """Write an animation of a gait file: the stick figure walking, with contact forces."""
-    animate_file(make_console(), file, output, steps=steps, fps=fps)
-
-
 # -- the main job -------------------------------------------------------------------------------
 
 @cli.command("study")
 @click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
-              default=STUDY_DIR, show_default=True,
-              help="Study directory (the sweep; the report goes to its report/ folder).")
-@click.option("--model", "model_name", default="five-link", show_default=True,
-              help="Built-in model name or model file.")
+              default=None, help=f"Study directory (the sweep; the report goes to its report/ "
+                                 f"folder) [default: {STUDY_DIR}; with --costs {COSTS_DIR}].")
+@click.option("--model", "model_names", multiple=True,
+              help="Built-in model name or model file [default: five-link]; with --costs "
+                   "repeat it to compare models.")
 @click.option("--speeds", default=STUDY_SPEEDS, show_default=True,
               help="Speeds in m/min: start:stop:step and/or a comma list.")
+@click.option("--costs", "cost_study", is_flag=True,
+              help="The cost study instead (docs/costs.md): each model's speed-free optimum "
+                   "of the paper's, the work and the metabolic cost at each resting power.")
+@click.option("--cost", "costs", multiple=True,
+              type=click.Choice(["paper", "work", "metabolic"]),
+              help="The cost study of these costs only (repeat it; implies --costs).")
+@click.option("--resting-powers", default=DEFAULT_RESTING_POWERS_TEXT, show_default=True,
+              help="With --costs: resting powers of the metabolic cost, W/kg (comma list).")
+@click.option("--regularization", type=float, default=0.0, show_default=True,
+              help="With --costs: weight of the torque regularisation added to the work and "
+                   "metabolic costs.")
+@click.option("--clearance", type=float, default=None,
+              help="With --costs: least mid-swing height of the swing tip in m, every case "
+                   "(the work cost's optimum drags the swing tip otherwise).")
+@click.option("--gait", "gait_kind", type=click.Choice(["auto", "walk", "heel-toe"]),
+              default="auto", show_default=True,
+              help="With --costs: the contact sequence (auto: heel-toe for a model with feet, "
+                   "else the paper's walk).")
+@click.option("--formulation", type=click.Choice(["auto", "reduced", "full"]), default="auto",
+              show_default=True, help="With --costs: the coordinates (auto: reduced for the "
+                                      "five-link biped, full for any other model).")
+@click.option("--paper-grid", is_flag=True,
+              help="The paper's setting: 8+5 knots and its control model (continuous, "
+                   "periodic controls); checked against 16+6 knots.")
 @_workers_option
-def study_command(directory: Path, model_name: str, speeds: str, workers: int | None,
-                  scheduler: str | None) -> None:
+def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
+                  paper_grid: bool, cost_study: bool, costs: tuple[str, ...],
+                  resting_powers: str,
+                  regularization: float, clearance: float | None, gait_kind: str,
+                  formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
-    optimum, then the report (Figs. 3-8, findings) and an animation of the optimal walk.
-    Rerunning resumes."""
+    optimum, the same on a finer grid (DIR/check-grid) for the error estimates, then the
+    report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
+    optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
+    from gaitopt.study.grid_error import CHECK_DIR, check_knots, grid_error
     from gaitopt.study.summary import read_summary
 
     console = make_console()
+    if cost_study or costs:
+        run_cost_study(console, directory or COSTS_DIR, model_names or ("five-link",),
+                       costs=costs or ("paper", "work", "metabolic"),
+                       resting_powers=resting_powers, regularization=regularization,
+                       clearance=clearance, gait=gait_kind, formulation=formulation,
+                       workers=workers, scheduler=scheduler)
+        return
+    if len(model_names) > 1:
+        raise UserError("--model: the paper's study takes one model (several only with "
+                        "--costs)")
+    directory = directory or STUDY_DIR
     start = time.perf_counter()
-    spec = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
-                     step_length="free", single_support="0.85", knots="8,5")
+    grid = grid_choice(None, None, paper_grid)
+    model_name = model_names[0] if model_names else "five-link"
+    spec = make_spec(model_name=model_name, speeds=speeds,
+                     variants="all", free=True, step_length="free", single_support="0.85",
+                     problem=grid)
     run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    finer = check_knots(spec.knots)
+    console.print(f"check grid {finer[0]}+{finer[1]} knots (the error estimates):",
+                  soft_wrap=True)
+    check = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
+                      step_length="free", single_support="0.85",
+                      problem={**grid, "knots": finer})
+    run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
+                      scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
     rows = read_summary(directory / SUMMARY_FILE)
+    errors = grid_error(directory, rows)
+    if errors is not None:
+        console.print(errors.statement(), soft_wrap=True)
+        for v in VARIANTS:
+            p = errors.free(v)
+            if p is not None:
+                console.print(f"  {v} optimum {p.row.speed_m_min:.2f} m/min, step "
+                              f"{p.row.step_length:.4f} m, cost {p.row.cost:.4g}; on the check "
+                              f"grid speed {p.speed_m_min:+.2f} m/min, step "
+                              f"{p.step_length:+.4f} m, cost {100 * p.cost:.2f} %",
+                              soft_wrap=True)
     best = next((r for v in VARIANTS if (r := optimal_row(rows, v)) is not None), None)
     if best is not None:
         animate_file(console, directory / best.file, out / "optimal-walk.gif", steps=4,
@@ -407,5 +425,92 @@ def study_command(directory: Path, model_name: str, speeds: str, workers: int | 
                   soft_wrap=True)
 
 
-__all__ = ["animate_command", "parse_speeds", "parse_variants", "report_command",
+def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
+                   costs: Sequence[str], resting_powers: str, regularization: float,
+                   formulation: str, clearance: float | None = None, gait: str = "auto",
+                   workers: int | None, scheduler: str | None) -> None:
+    """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
+    processes keep their built problems), then ``costs.csv``, the report and the findings."""
+    from gaitopt.gait.api import as_model
+    from gaitopt.study.cost_study import (
+        CostStudyError,
+        CostStudySpec,
+        CostSweep,
+        collect_rows,
+        run_direct_solves,
+        write_cost_table,
+        write_settings,
+    )
+    from gaitopt.study.driver import make_backend
+
+    start = time.perf_counter()
+    powers: list[float] = []
+    for item in (i.strip() for i in resting_powers.split(",") if i.strip()):
+        try:
+            powers.append(float(item))
+        except ValueError:
+            raise UserError(f"--resting-powers: {item!r} is not a number (W/kg, >= 0)") from None
+    try:
+        spec = CostStudySpec(models=tuple(as_model(m) for m in model_names),
+                             costs=tuple(dict.fromkeys(costs)),
+                             resting_powers=tuple(powers), regularization=regularization,
+                             swing_clearance=clearance, gait=gait,
+                             formulation=formulation)  # type: ignore[arg-type]
+        sweeps = spec.sweeps()
+    except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
+        raise UserError(str(exc)) from None
+    write_settings(spec, directory)
+    console.print(f"cost study {directory}: {len(sweeps)} cases "
+                  f"({', '.join(m.name for m in spec.models)} x "
+                  f"{', '.join(c.tag for c in spec.cases)})", soft_wrap=True)
+    backend = None
+    try:
+        for k, sweep in enumerate(sweeps, start=1):
+            console.print(f"[{k}/{len(sweeps)}] {sweep.model} ({sweep.formulation}): "
+                          f"{sweep.case.label}", soft_wrap=True)
+            if backend is None:
+                try:
+                    backend = make_backend(workers=workers, scheduler=scheduler)
+                except BackendError as exc:
+                    raise UserError(str(exc)) from None
+            run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
+                              scheduler=scheduler, backend=backend)
+        if backend is not None:
+            def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
+                what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
+                        f" m  cost {outcome.row.cost:.4g}" if path is not None and outcome
+                        else (outcome.row.status if outcome else "the worker died"))
+                console.print(f"{'ok  ' if path else 'FAIL'} direct {sweep.model} "
+                              f"{sweep.case.tag}: {what}", soft_wrap=True)
+
+            console.print("direct (staged) solves of each case's speed-free optimum, the "
+                          "lower of the two optima is kept:", soft_wrap=True)
+            try:
+                kept, solved, failed = run_direct_solves(spec, directory, backend, done)
+            except KeyboardInterrupt:
+                backend.close(wait=False)
+                backend = None
+                console.print("interrupted: every finished solve is saved; rerun the same "
+                              "command to resume", soft_wrap=True)
+                sys.exit(130)
+            console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
+                          soft_wrap=True)
+    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
+        if backend is not None:
+            backend.close(wait=False)
+            backend = None
+        raise
+    finally:
+        if backend is not None:
+            backend.close()
+    table = write_cost_table(directory, collect_rows(spec, directory))
+    console.print(f"table: {table}", soft_wrap=True)
+    from gaitopt.cli.report import write_cost_reports
+
+    page = write_cost_reports(console, directory, directory / "report")
+    console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",
+                  soft_wrap=True)
+
+
+__all__ = ["make_spec", "parse_speeds", "parse_variants", "run_cost_study", "run_with_progress",
            "study_command", "sweep_command"]

@@ -1,15 +1,7 @@
-"""The ``gaitopt`` command line: one subcommand per step.
-
-The group and the shared pieces (:class:`UserError`, :data:`USER_ERRORS`, the console) are in
-:mod:`gaitopt.cli_base`; the subcommands in this module (``model``) and in
-:mod:`gaitopt.cli_gait` (``solve``, ``verify``) and :mod:`gaitopt.cli_study` (``sweep``,
-``report``, ``animate``, ``study``), which register on the group when imported here.
-"""
+"""``gaitopt model show``, ``export`` and ``import``: robot models (built-in, files, URDF)."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Sequence
 from pathlib import Path
 
 import click
@@ -17,8 +9,7 @@ from rich import box
 from rich.table import Table
 from rich.text import Text
 
-from gaitopt import cli_gait, cli_stability, cli_study  # noqa: F401  (they register their subcommands)
-from gaitopt.cli_base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
+from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model, model_to_yaml
 from gaitopt.robot.symmetry import SymmetryError, model_symmetry
 
@@ -183,18 +174,4 @@ def model_import(urdf: Path, output: Path | None, contacts: tuple[str, ...], axi
                    f"{m.nu} actuators, total mass {_g(m.total_mass)} kg")
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``gaitopt`` console script; returns the exit status."""
-    try:
-        cli.main(args=list(argv) if argv is not None else None, prog_name="gaitopt",
-                 standalone_mode=True)
-    except SystemExit as exc:
-        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-    return 0
-
-
-
-__all__ = ["PIPE_WIDTH", "USER_ERRORS", "UserError", "cli", "main", "make_console", "model_tables"]
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+__all__ = ["model", "model_tables"]

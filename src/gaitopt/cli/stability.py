@@ -10,7 +10,7 @@ import click
 import numpy as np
 from rich.table import Table
 
-from gaitopt.cli_base import UserError, cli, make_console
+from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
 

@@ -1,0 +1,30 @@
+"""The ``gaitopt`` command line: the group with every command family registered, and ``main``.
+
+What every command shares (the group, :class:`UserError`, the console, the option types and
+the options used by several commands) is in :mod:`gaitopt.cli.base`. Each other module holds
+one command family and registers its subcommands on the group when imported here:
+:mod:`~gaitopt.cli.model` (``model show|export|import``), :mod:`~gaitopt.cli.gait`
+(``solve``, ``verify``), :mod:`~gaitopt.cli.stability` (``stability``),
+:mod:`~gaitopt.cli.study` (``sweep``, ``study``) and :mod:`~gaitopt.cli.report`
+(``report``, ``animate``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from gaitopt.cli import gait, model, report, stability, study  # noqa: F401  (they register)
+from gaitopt.cli.base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``gaitopt`` console script; returns the exit status."""
+    try:
+        cli.main(args=list(argv) if argv is not None else None, prog_name="gaitopt",
+                 standalone_mode=True)
+    except SystemExit as exc:
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    return 0
+
+
+__all__ = ["PIPE_WIDTH", "USER_ERRORS", "UserError", "cli", "main", "make_console"]

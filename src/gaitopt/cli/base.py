@@ -1,0 +1,177 @@
+"""The ``gaitopt`` command group and what every subcommand shares.
+
+Errors the user can fix (a bad model file, a bad option) are printed as one clear line
+(``Error: ...``) on stderr and exit with status 2; they never show a traceback. A subcommand
+signals one by raising :class:`UserError`, or any exception type listed in
+:data:`USER_ERRORS` (converted by the ``cli`` group), e.g. :class:`~gaitopt.robot.ModelError`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from typing import Any, TypeVar, get_args
+
+import click
+from rich.console import Console
+
+from gaitopt import __version__
+from gaitopt.gait.options import ControlModel, CostName, Formulation
+from gaitopt.robot import ModelError
+
+#: Exception types that are the user's to fix: shown as one line, exit status 2.
+USER_ERRORS: tuple[type[Exception], ...] = (ModelError,)
+
+#: Width of tables when the output is not a terminal (a pipe, a file, a CI log).
+PIPE_WIDTH = 120
+
+
+class UserError(click.ClickException):
+    """An error in what the user asked for: printed as one message, exit status 2."""
+
+    exit_code = 2
+
+    def __init__(self, message: str) -> None:
+        super().__init__(" ".join(message.split()))
+
+
+class _Group(click.Group):
+    """A click group that turns :data:`USER_ERRORS` into :class:`UserError`."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except USER_ERRORS as exc:
+            raise UserError(str(exc)) from None
+
+
+# -- option values shared by the commands ----------------------------------------------------
+
+def parse_free_or_value(text: str, option: str, unit: str, quantity: str) -> float | None:
+    """``free`` -> None, else a number with an optional unit suffix (``0.1m``, ``0.6s``)."""
+    if text.strip().lower() == "free":
+        return None
+    try:
+        return float(text.strip().removesuffix(unit))
+    except ValueError:
+        raise UserError(f"{option}: {text!r} is not a {quantity} in {unit} or 'free'") from None
+
+
+def parse_pair(text: str, option: str) -> tuple[float, float]:
+    """Two numbers ``LO,HI`` (a usage error otherwise)."""
+    parts = text.split(",")
+    try:
+        lo, hi = (float(v) for v in parts)
+    except ValueError:
+        raise click.BadParameter(f"expected two numbers LO,HI, got {text!r}",
+                                 param_hint=option) from None
+    return lo, hi
+
+
+def parse_knots(text: str) -> tuple[int, int]:
+    """``single,double`` knot counts (a usage error otherwise)."""
+    parts = text.split(",")
+    try:
+        values = tuple(int(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 2:
+        raise UserError(f"--knots: {text!r} must be two integers 'single,double', e.g. 8,5")
+    return (values[0], values[1])
+
+
+# -- options used by several commands (defined once) --------------------------------------------
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def model_option(f: F) -> F:
+    """``--model NAME_OR_FILE`` (parameter ``model_name``): a built-in model or a model file."""
+    return click.option("--model", "model_name", default="five-link", show_default=True,
+                        help="Built-in model name or model file.")(f)
+
+
+def knots_option(f: F) -> F:
+    """``--knots SINGLE,DOUBLE`` (text or None: the default grid; see :func:`grid_choice`)."""
+    from gaitopt.gait.options import GaitOptions
+
+    return click.option("--knots", default=None,
+                        help="Grid points per phase: single support, double support [default: "
+                             f"{','.join(map(str, GaitOptions().knots))}].")(f)
+
+
+def paper_grid_option(f: F) -> F:
+    """``--paper-grid``: the paper's 8 + 5 knots and control model (:func:`grid_choice`)."""
+    return click.option("--paper-grid", is_flag=True,
+                        help="The paper's setting: 8+5 knots and its control model "
+                             "(continuous, periodic controls); its cost is about 13 % above "
+                             "the converged one.")(f)
+
+
+def resting_power_option(f: F) -> F:
+    """``--resting-power`` in W/kg (None: the metabolic cost's default)."""
+    return click.option("--resting-power", type=float, default=None,
+                        help="Resting power of the metabolic cost, W/kg [default: 1.2].")(f)
+
+
+def formulation_option(help: str, default: str | None = "reduced") -> Callable[[F], F]:
+    """``--formulation reduced|full`` with this help text (``default`` None: the command
+    chooses, and says how in ``help``)."""
+    return click.option("--formulation", type=click.Choice(get_args(Formulation)),
+                        default=default, show_default=default is not None, help=help)
+
+
+def cost_option(help: str) -> Callable[[F], F]:
+    """``--cost paper|work|metabolic`` with this help text."""
+    return click.option("--cost", type=click.Choice(get_args(CostName)), default="paper",
+                        show_default=True, help=help)
+
+
+def control_model_option(help: str) -> Callable[[F], F]:
+    """``--control-model paper|jumps`` with this help text (None: the default, see
+    :func:`grid_choice`)."""
+    from gaitopt.gait.options import GaitOptions
+
+    return click.option("--control-model", type=click.Choice(get_args(ControlModel)),
+                        default=None,
+                        help=f"{help} [default: {GaitOptions().control_model}]")
+
+
+def grid_choice(knots: str | None, control_model: str | None,
+                paper_grid: bool) -> dict[str, Any]:
+    """The ``knots`` and ``control_model`` of ``--knots``, ``--control-model`` and
+    ``--paper-grid`` (the paper's 8 + 5 knots and control model, ``GaitOptions.paper``);
+    unset ones keep the :class:`~gaitopt.gait.options.GaitOptions` defaults. ``--paper-grid``
+    with either of the others is a usage error."""
+    from gaitopt.gait.options import PAPER_GRID
+
+    if paper_grid:
+        given = [o for o, v in (("--knots", knots), ("--control-model", control_model)) if v]
+        if given:
+            raise UserError(f"--paper-grid sets the knots (8,5) and the control model "
+                            f"(paper); do not combine it with {' or '.join(given)}")
+        return dict(PAPER_GRID)
+    out: dict[str, Any] = {}
+    if knots is not None:
+        out["knots"] = parse_knots(knots)
+    if control_model is not None:
+        out["control_model"] = control_model
+    return out
+
+
+def make_console() -> Console:
+    """A rich console on stdout; at least :data:`PIPE_WIDTH` columns when not a terminal
+    (unless ``COLUMNS`` says otherwise), so piped tables are not squeezed to 80 columns.
+
+    Markup is off: text such as ``[kg]`` or ``[-2, 2]`` is printed as it is.
+    """
+    console = Console(markup=False, highlight=False)
+    if not console.is_terminal and "COLUMNS" not in os.environ:
+        console = Console(markup=False, highlight=False, width=max(console.width, PIPE_WIDTH))
+    return console
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="gaitopt")
+def cli() -> None:
+    """gaitopt: energy-optimal walking gaits for planar multibody bipeds."""

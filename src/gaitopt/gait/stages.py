@@ -1,0 +1,124 @@
+"""The continuation stages of the staged solve, described as data, and what each one holds.
+
+:data:`CONTACT_STAGES` run on the coarse grid (:func:`coarse_knots`) from each naive guess
+with everything that :data:`RELEASES` frees held (:func:`held_bounds`, :func:`held_ankles`);
+then each of :data:`RELEASES` that runs for the options frees one quantity, holding what the
+later ones free. :func:`gaitopt.gait.solve.solve_walking` walks these lists; the IPOPT
+options of the stages (and why) are here too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, Relaxation, parameter_bounds
+from gaitopt.ocp import Bounds, Result, Transcription
+from gaitopt.robot.model import RobotModel
+
+#: Relaxation of the first stage (N, N s): large enough to switch the conditions off.
+RELAXED = Relaxation(force=1e4, impulse=1e3)
+#: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
+#: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
+#: the lower local optimum more often than the default monotone one: over 20 speeds with and
+#: without ankle torques (IPOPT 3.14.19 with MUMPS 5.8.2, as CasADi 3.8 bundles it) the
+#: monotone update took up to 522 iterations and stopped in worse optima at 6-12 m/min, and
+#: failed at 3 m/min with ankle torques. The later stages start from a solution and keep the
+#: monotone update with a small initial barrier (see :meth:`gaitopt.ocp.Transcription.solve`).
+COLD_START_OPTIONS = {"ipopt.mu_strategy": "adaptive"}
+#: IPOPT options of a stage started from the values of a solution without its multipliers
+#: (a coarse solution interpolated onto the target grid, a neighbouring gait): the start is
+#: close to the optimum, so a small initial barrier and a small push off the bounds keep it
+#: there instead of moving it to the interior first. At 40 + 10 knots this took the target
+#: grid stage from 102 to 33 iterations. (With the multipliers, the transcription's own
+#: warm-start options apply instead.)
+PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
+                       "ipopt.bound_frac": 1e-6}
+#: The Hessian of the target-grid stages of a cold solve: a limited-memory quasi-Newton
+#: approximation (as SNOPT's, which the paper used). Deriving the exact Hessian of the
+#: expanded NLP costs far more than these stages: at 40 + 10 knots 9-12 s against 2 s for
+#: the functions without it, while the two stages took 78 + 27 quasi-Newton iterations (about
+#: 2 s) to the same optimum and tolerance. Warm starts on a fine grid (a sweep's neighbours)
+#: use the exact Hessian, built once per process.
+FINE_STAGE_OPTIONS = {"ipopt.hessian_approximation": "limited-memory"}
+
+
+def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
+    """:data:`FINE_STAGE_OPTIONS` in the reduced formulation; the exact Hessian in the full
+    one, where the quasi-Newton stages took 365 + 228 iterations at 16 + 6 knots and ended
+    at IPOPT's acceptable level, against 23 + 13 with the exact Hessian (12 m/min), and for
+    the separated form, whose derivatives are assembled from compiled point functions
+    (:func:`gaitopt.gait.transcriptions.evaluation_mode`): its exact Hessian costs no
+    derivation of the whole NLP (at 40 + 10: 38 + 18 iterations against 99 + 25)."""
+    if options.formulation != "reduced" or options.transcription == "hermite-simpson-separated":
+        return {}
+    return dict(FINE_STAGE_OPTIONS)
+
+
+def coarse_knots(options: GaitOptions) -> tuple[int, int]:
+    """The grid of the first stages: the requested one, at most the paper's 8 + 5."""
+    return (min(8, options.knots[0]), min(5, options.knots[1]))
+
+
+#: What the release stages free besides parameters: the ankle torques (held at zero before).
+ANKLES = "ankle torques"
+
+
+@dataclass(frozen=True)
+class StageSpec:
+    """One continuation stage as data: its name, whether it runs for the options, the
+    contact relaxation, the quantity it frees (:data:`ANKLES` or a parameter name; every
+    earlier stage holds it) and IPOPT options merged over the transcription's."""
+
+    name: str
+    runs: Callable[[GaitOptions], bool] = lambda options: True
+    relax: Relaxation = Relaxation()
+    frees: str | None = None
+    solver_options: dict[str, Any] | None = None
+
+
+#: Stages 1-2, on the coarse grid from each naive guess, everything in :data:`RELEASES`
+#: held: the contact conditions relaxed, then enforced (the paper's two-stage process).
+CONTACT_STAGES: tuple[StageSpec, ...] = (
+    StageSpec("relaxed contact", relax=RELAXED, solver_options=COLD_START_OPTIONS),
+    StageSpec("enforced contact"),
+)
+#: Stage 3: what the contact stages held, freed one at a time in this order (the impulse
+#: from the no-impulse gait keeps the impulse variants out of worse local minima).
+RELEASES: tuple[StageSpec, ...] = (
+    StageSpec("ankle torques free", runs=lambda o: o.ankle, frees=ANKLES),
+    StageSpec("liftoff impulse free", runs=lambda o: o.impulse and o.double_support,
+              frees=IMPULSE),
+    StageSpec("single-support fraction free",
+              runs=lambda o: o.single_support_fraction_bounds is not None, frees=FRACTION),
+    StageSpec("speed free", runs=lambda o: o.speed is None, frees=SPEED),
+)
+
+
+def held_bounds(options: GaitOptions, held: set[str], speed: float,
+                result: Result | None = None) -> dict[str, Any]:
+    """The parameter bounds with the quantities in ``held`` held: the speed at ``speed``, the
+    impulse at 0, a free single-support fraction at ``result``'s value (or at its first
+    guess ``options.single_support_fraction``); the ankle torques are held by the stage."""
+    bounds = dict(parameter_bounds(options))
+    if SPEED in held:
+        bounds[SPEED] = (speed, speed)
+    if IMPULSE in held:
+        bounds[IMPULSE] = (0.0, 0.0)
+    if FRACTION in held and FRACTION in bounds:
+        value = (result.parameters[FRACTION] if result is not None
+                 else options.single_support_fraction)
+        bounds[FRACTION] = (value, value)
+    return bounds
+
+
+def held_ankles(model: RobotModel, tr: Transcription, bounds: Bounds) -> Bounds:
+    """``bounds`` with every ankle torque of every phase bounded to zero."""
+    ankles = {a.name for a in model.actuators if a.contact is not None}
+    for ph in tr.problem.phases:
+        for name in ph.controls:
+            if name in ankles:
+                bounds = bounds.with_control(ph.name, name, 0.0, 0.0)
+    return bounds

@@ -1,0 +1,195 @@
+"""The walking problem's transcriptions, built once per process for each NLP structure.
+
+A transcription (the NLP and its IPOPT solver) depends on the model, the options that shape
+the NLP, the grid and the compilation mode. Speed, step length and impulse enter through
+parameter bounds only, so problems that differ in those share one transcription: the cache key
+is an :class:`NlpStructure`, derived from every :class:`~gaitopt.gait.options.GaitOptions`
+field except :data:`BOUNDS_ONLY_OPTIONS` (a new option shapes the NLP until listed there).
+
+A grid is knots per phase (single support, double support), uniform, or one array of
+normalised knot times in [0, 1] per phase of the problem (a refined mesh).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import functools
+import hashlib
+import pickle
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from gaitopt import codegen
+from gaitopt.fileio import write_bytes_atomic
+from gaitopt.gait.formulation import problem_for
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.ocp import Guess, Result, Transcription, WarmStart, transcribe
+from gaitopt.robot.model import RobotModel
+
+#: A grid: knots per phase (single support, double support), uniform, or one array of
+#: normalised knot times in [0, 1] per phase of the problem (a refined mesh).
+Grid = tuple[int, int] | tuple[np.ndarray, ...]
+
+#: Options that enter a solve only through bounds or the solve's own logic, never the NLP's
+#: structure: problems that differ only in these share one transcription.
+BOUNDS_ONLY_OPTIONS = frozenset({"speed", "step_length", "step_time", "knots", "multistart",
+                                 "continuation", "mesh_tol"})
+
+
+def is_mesh(grid: Grid) -> bool:
+    """Whether ``grid`` is a mesh (arrays of normalised knots) rather than knot counts."""
+    return not all(isinstance(k, int | np.integer) for k in grid)
+
+
+def grid_knots(grid: Grid, options: GaitOptions) -> tuple[int, int]:
+    """Knots per phase of a grid (a phase the problem lacks keeps ``options.knots``)."""
+    if not is_mesh(grid):
+        return (int(grid[0]), int(grid[1]))
+    sizes = [np.asarray(m).size for m in grid]
+    return (sizes[0], sizes[1] if len(sizes) > 1 else options.knots[1])
+
+
+@dataclass(frozen=True)
+class NlpStructure:
+    """Everything that shapes the walking NLP; equal structures share one transcription.
+
+    ``options`` holds ``(field, repr(value))`` for every :class:`GaitOptions` field but
+    :data:`BOUNDS_ONLY_OPTIONS`, sorted by field name; ``grid`` the knot counts or the mesh's
+    knot times; ``step_time_row`` whether the step-time constraint row exists.
+    """
+
+    model_hash: str
+    grid: tuple[Any, ...]
+    step_time_row: bool
+    compiled: str | None
+    options: tuple[tuple[str, str], ...]
+
+    @classmethod
+    def of(cls, model: RobotModel, options: GaitOptions, grid: Grid,
+           compiled: str | None) -> NlpStructure:
+        shaping = sorted((f.name, repr(getattr(options, f.name)))
+                         for f in dataclasses.fields(options)
+                         if f.name not in BOUNDS_ONLY_OPTIONS)
+        if is_mesh(grid):
+            key: tuple[Any, ...] = tuple(tuple(float(v) for v in np.asarray(m)) for m in grid)
+        else:
+            key = tuple(int(k) for k in grid)
+        return cls(model_hash=model.content_hash(), grid=key,
+                   step_time_row=options.step_time is not None, compiled=compiled,
+                   options=tuple(shaping))
+
+
+_CACHE: dict[NlpStructure, Transcription] = {}
+
+
+def clear_cache() -> None:
+    """Forget every cached transcription (a benchmark's fresh start)."""
+    _CACHE.clear()
+
+
+def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
+    """How the NLP of ``options`` is evaluated (``transcribe(..., compiled=...)``): the
+    separated Hermite-Simpson form always by ``"points"``, its derivatives assembled from
+    compiled functions of one grid point (:mod:`gaitopt.ocp.pointwise`: compiled once per
+    model and problem structure into the disk cache, CasADi's VM without a C compiler;
+    several times faster per iteration than the alternatives); other transcriptions as
+    ``compiled`` asks (``None``: CasADi's VM on the expanded NLP), but not ``"codegen"``,
+    whose one C file of the whole NLP does not compile in minutes."""
+    if options.transcription == "hermite-simpson-separated":
+        return "points"
+    if compiled == "codegen":
+        raise GaitOptionsError(
+            f"compiled: the {options.transcription!r} NLP generated as one C file does not "
+            "compile in minutes (34 MB of C at 8 + 5 knots); use transcription "
+            "'hermite-simpson-separated', whose derivatives are always compiled per grid "
+            "point")
+    return compiled
+
+
+#: Version of the disk cache of the walking problem's symbolic functions (part of its key).
+FUNCTIONS_FORMAT = "gaitopt-walking-functions-1"
+
+
+@functools.cache
+def source_hash() -> str:
+    """A hash of every Python file of the installed gaitopt package: the symbolic functions
+    cached on disk are those this code builds."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:20]
+
+
+def functions_file(key: NlpStructure) -> Path:
+    """Where the symbolic functions (``Transcription.functions``) of the problem of the
+    structure ``key`` are cached on disk: keyed by the model, every shaping option, the
+    gaitopt sources and CasADi's version, not the grid or the evaluation mode."""
+    text = repr((FUNCTIONS_FORMAT, source_hash(), ca.CasadiMeta.version(), key.model_hash,
+                 key.step_time_row, key.options))
+    name = hashlib.sha256(text.encode()).hexdigest()[:24]
+    return codegen.cache_dir() / f"walking-functions-{name}.pickle"
+
+
+def cached_functions(path: Path) -> Any:
+    """The functions pickled at ``path``, or None (missing, unreadable or stale: rebuilt)."""
+    try:
+        return pickle.loads(path.read_bytes())
+    except Exception:  # noqa: BLE001 - any unreadable cache file is rebuilt and replaced
+        return None
+
+
+def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
+                      compiled: str | None = None) -> Transcription:
+    """The (process-wide cached) transcription of the walking problem on ``knots`` (knot
+    counts per phase, or a mesh: normalised knot times per phase). Its symbolic functions
+    (independent of the grid) come from another grid's transcription in this process, or
+    from the disk cache (:func:`functions_file`), or are built and saved there."""
+    compiled = evaluation_mode(options, compiled)
+    key = NlpStructure.of(model, options, knots, compiled)
+    if key not in _CACHE:
+        same = [tr.functions for k, tr in _CACHE.items()
+                if dataclasses.replace(k, grid=key.grid) == key]
+        path = functions_file(key)
+        functions = same[0] if same else cached_functions(path)
+        counts = grid_knots(knots, options)
+        problem = problem_for(model, options.replace(knots=counts))
+        intervals: dict[str, Any] = {
+            ph.name: (np.asarray(knots[i], dtype=float) if is_mesh(knots)
+                      else counts[min(i, len(counts) - 1)] - 1)
+            for i, ph in enumerate(problem.phases)}
+        _CACHE[key] = transcribe(
+            problem, method=options.transcription, intervals=intervals, compiled=compiled,
+            options={"ipopt.tol": options.tol, "ipopt.max_iter": options.max_iter,
+                     "ipopt.acceptable_tol": max(options.tol * 100, 1e-6),
+                     "show_eval_warnings": False},
+            build_solver=False, functions=functions)
+        if functions is None:
+            with contextlib.suppress(OSError):  # a read-only cache: build again next time
+                write_bytes_atomic(path, pickle.dumps(_CACHE[key].functions))
+    return _CACHE[key]
+
+
+def warm_start_grid(options: GaitOptions, warm_start: Guess | Result | WarmStart) -> Grid:
+    """The grid of a warm start: ``options.knots``; with ``mesh_tol``, the warm start's own
+    mesh (a refined gait's non-uniform knots), every other knot of it when each phase has an
+    odd number >= 5: the mesh before the halving that ended its refinement, so that a chain
+    of warm starts (a sweep) does not double the grid at every point."""
+    if options.mesh_tol is None or isinstance(warm_start, WarmStart):
+        return options.knots
+    if isinstance(warm_start, Result):
+        taus = [np.asarray(m, dtype=float) for m in warm_start.mesh]
+    else:
+        taus = [np.asarray(g.tau, dtype=float) for g in warm_start.phases.values()
+                if g.tau is not None]
+    phases = 2 if options.double_support else 1
+    if len(taus) != phases or any(t.size < 2 for t in taus):
+        return options.knots
+    if all(t.size % 2 == 1 and t.size >= 5 for t in taus):
+        taus = [t[::2] for t in taus]
+    return tuple(taus)

@@ -1,0 +1,463 @@
+"""The cost study: which cost puts a model's optimal walk where people walk (docs/costs.md).
+
+For every model asked for, the speed-free optimal walk of each *case*: the paper's cost, the
+mechanical cost of transport (``work``) and the metabolic cost at each resting power
+``P_rest`` (W/kg) of a list (the human value, about 1.2-1.5 W/kg, among them). Each case is a
+small sweep (:mod:`gaitopt.study.plan`: the 12 m/min walk solved cold, the speed-free optimum
+warm-started from it) in its own folder, so everything the sweeps do holds here too: points
+written atomically as they finish, resumable, refused when the folder holds other settings.
+
+The problems have several local optima, and the speed-free optimum reached from the 12 m/min
+walk is not always the lowest (metabolic cost, 4.8 W/kg: 42.2 m/min with 0.39 m steps, 1.8 %
+above the 43.9 m/min, 0.26 m optimum of the staged solve). So each case is also solved
+*directly*, the staged solve of ``gaitopt solve --speed free`` (the paper's cost through its
+stages, then the case's cost), and the lower of the two optima is the case's result; the
+table keeps which start won and the other's cost::
+
+    DIR/cost_study.json                      the study's settings (written first)
+    DIR/costs.csv                            one row per (model, case): the speed-free optimum
+    DIR/<model>/<case>/sweep.json, summary.csv, gaits/<variant>/...   each case's sweep
+    DIR/<model>/<case>/direct.gait.json      the direct solve (written atomically; kept on a
+                                             rerun when it matches the case's options)
+    DIR/report/report.html                   figure, table, findings (gaitopt.viz.cost_report)
+
+``<model>`` is the model's name, ``<case>`` ``paper``, ``work`` or ``metabolic-rest-1.2``
+(the resting power in W/kg). The formulation of a model is ``reduced`` (the paper's) when the
+model is the five-link biped that formulation describes and ``full`` otherwise (a model with
+feet or more links), unless one is asked for; its gait is the paper's walk, or the heel-toe
+walk for a model with feet (two contact points on a foot link).
+
+The distance of an optimum from human walking is
+``d = sqrt((v / v_h - 1)^2 + (L / L_h - 1)^2)`` with ``v_h = 80 m/min`` and ``L_h = 0.75 m``
+(the paper's reference, :data:`gaitopt.study.findings.HUMAN_OPTIMAL_SPEED_M_MIN` and
+:data:`~gaitopt.study.findings.HUMAN_STEP_LENGTH`): 0 where people walk, sqrt(2) = 1.41 for
+standing still, 0.5 at half people's speed with people's step.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from gaitopt import __version__
+from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.options import Formulation, GaitOptions
+from gaitopt.robot.biped import BipedStructureError
+from gaitopt.robot.model import RobotModel
+from gaitopt.study.executors import Backend
+from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH
+from gaitopt.study.plan import START_SPEED, SweepPoint, SweepSpec
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, SummaryError, read_summary, rows_of
+from gaitopt.study.worker import PointOutcome, PointTask, gait_file_matches, solve_point
+
+CostStudyFormulation = Literal["auto", "reduced", "full"]
+
+#: Resting powers (W/kg) of the metabolic cases by default: none, half, the human value
+#: (adults at rest, about 1.2 W/kg), twice and four times it.
+DEFAULT_RESTING_POWERS: tuple[float, ...] = (0.0, 0.6, 1.2, 2.4, 4.8)
+#: People's resting metabolic power (W/kg): the band marked in the figure and used by the
+#: findings (docs/costs.md gives the sources).
+HUMAN_RESTING_POWER: tuple[float, float] = (1.2, 1.5)
+COST_STUDY_FILE = "cost_study.json"
+COST_STUDY_FORMAT = "gaitopt.cost-study"
+COST_TABLE_FILE = "costs.csv"
+DIRECT_FILE = "direct.gait.json"
+#: How a case's optimum was reached (the ``start`` column).
+STARTS = ("from 12 m/min", "direct")
+COST_COLUMNS: tuple[str, ...] = (
+    "model", "formulation", "case", "cost", "resting_power", "success", "status",
+    "speed_m_min", "step_length", "step_time", "cost_value", "human_distance", "start",
+    "other_cost_value", "file")
+
+
+class CostStudyError(ValueError):
+    """A cost study request or its files are invalid (names the setting or the file)."""
+
+
+@dataclass(frozen=True)
+class CostCase:
+    """One cost: ``paper``, ``work`` or ``metabolic`` with its resting power (W/kg)."""
+
+    cost: str
+    resting_power: float | None = None
+
+    @property
+    def tag(self) -> str:
+        """The case's folder name: ``paper``, ``work``, ``metabolic-rest-1.2``."""
+        if self.cost != "metabolic":
+            return self.cost
+        return f"metabolic-rest-{self.resting_power:g}"
+
+    @property
+    def label(self) -> str:
+        if self.cost != "metabolic":
+            return {"paper": "paper (u'u per metre)",
+                    "work": "work (mechanical cost of transport)"}[self.cost]
+        return f"metabolic, resting {self.resting_power:g} W/kg"
+
+    def options(self) -> dict[str, Any]:
+        """The :class:`GaitOptions` fields of this case."""
+        if self.cost == "metabolic":
+            return {"cost": "metabolic", "resting_power": self.resting_power}
+        return {"cost": self.cost}
+
+
+@dataclass(frozen=True)
+class CostSweep:
+    """One (model, case) of the study: its folder (relative to the study directory), its
+    formulation and its sweep."""
+
+    model: str
+    case: CostCase
+    formulation: str
+    subdir: str
+    spec: SweepSpec
+
+    @property
+    def free_point(self) -> SweepPoint:
+        return next(p for p in self.spec.points if p.speed is None)
+
+    def direct_task(self) -> PointTask:
+        """The direct (staged, cold) solve of the speed-free optimum, as a sweep worker's
+        task: :func:`gaitopt.study.worker.solve_point` runs it anywhere."""
+        point = self.free_point
+        return PointTask(key=f"{self.subdir}/{DIRECT_FILE}", model=self.spec.model,
+                         options=self.spec.options(point), variant=point.variant,
+                         speed_mode="free", structure=point.structure, warm=None,
+                         relfile=DIRECT_FILE)
+
+
+@dataclass(frozen=True, kw_only=True)
+class CostStudySpec:
+    """What the cost study solves (SI units; resting powers W/kg).
+
+    ``costs`` a subset of paper, work, metabolic (the metabolic cost once per resting power);
+    ``regularization`` the weight of ``int sum (u / u_max)^2 dt / T`` added to the work and
+    metabolic costs (``GaitOptions.cost_regularization``); ``gait`` ``auto`` (see
+    :meth:`gait_of`), ``walk`` or ``heel-toe``; ``swing_clearance`` (m) the least
+    mid-swing height of the swing tip in every case (``GaitOptions.swing_clearance``; None: no
+    such constraint); ``formulation`` ``auto`` (see the
+    module docstring), ``reduced`` or ``full``; ``variant`` one of
+    :data:`gaitopt.study.summary.VARIANTS`; ``knots`` per phase.
+    """
+
+    models: tuple[RobotModel, ...]
+    costs: tuple[str, ...] = ("paper", "work", "metabolic")
+    resting_powers: tuple[float, ...] = DEFAULT_RESTING_POWERS
+    regularization: float = 0.0
+    swing_clearance: float | None = None
+    formulation: CostStudyFormulation = "auto"
+    gait: str = "auto"
+    variant: str = "ankle+impulse"
+    knots: tuple[int, int] = (8, 5)
+
+    def __post_init__(self) -> None:
+        if not self.models:
+            raise CostStudyError("models: at least one model is needed")
+        names = [m.name for m in self.models]
+        if len(set(names)) != len(names):
+            raise CostStudyError(f"models: two models share a name ({', '.join(names)}); "
+                                 "each model's results go to a folder named after it")
+        for name in names:
+            if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.+-]*", name):
+                raise CostStudyError(f"models: the name {name!r} cannot name a folder (letters, "
+                                     "digits, '_', '.', '+', '-')")
+        unknown = [c for c in self.costs if c not in ("paper", "work", "metabolic")]
+        if unknown or not self.costs or len(set(self.costs)) != len(self.costs):
+            raise CostStudyError(f"costs: {', '.join(self.costs) or 'none'}; allowed: each of "
+                                 "paper, work, metabolic at most once, at least one")
+        if "metabolic" in self.costs:
+            if not self.resting_powers:
+                raise CostStudyError("resting powers: at least one for the metabolic cost")
+            for p in self.resting_powers:
+                if not (math.isfinite(p) and p >= 0.0):
+                    raise CostStudyError(f"resting powers: {p!r} W/kg; allowed: finite, >= 0")
+            if len(set(self.resting_powers)) != len(self.resting_powers):
+                raise CostStudyError("resting powers: each value at most once")
+        if not (math.isfinite(self.regularization) and self.regularization >= 0.0):
+            raise CostStudyError(f"regularization: {self.regularization!r}; allowed: >= 0")
+        if self.swing_clearance is not None and not (math.isfinite(self.swing_clearance)
+                                                     and self.swing_clearance >= 0.0):
+            raise CostStudyError(f"swing clearance: {self.swing_clearance!r} m; allowed: >= 0")
+        if self.formulation not in ("auto", "reduced", "full"):
+            raise CostStudyError(f"formulation: {self.formulation!r}; allowed: auto, reduced, "
+                                 "full")
+        if self.gait not in ("auto", "walk", "heel-toe"):
+            raise CostStudyError(f"gait: {self.gait!r}; allowed: auto, walk, heel-toe")
+        if self.variant not in VARIANTS:
+            raise CostStudyError(f"variant: {self.variant!r}; allowed: {', '.join(VARIANTS)}")
+
+    @property
+    def cases(self) -> tuple[CostCase, ...]:
+        """The cases in study order: paper, work, then metabolic by ascending resting power."""
+        out = [CostCase(c) for c in ("paper", "work") if c in self.costs]
+        if "metabolic" in self.costs:
+            out += [CostCase("metabolic", p) for p in sorted(self.resting_powers)]
+        return tuple(out)
+
+    def formulation_of(self, model: RobotModel) -> Formulation:
+        """``reduced`` or ``full`` for ``model`` (see the module docstring)."""
+        if self.formulation != "auto":
+            return self.formulation
+        from gaitopt.dynamics.reduced import checked_biped
+
+        try:
+            checked_biped(model)
+        except BipedStructureError:
+            return "full"
+        return "reduced"
+
+    def gait_of(self, model: RobotModel) -> str:
+        """``walk`` or ``heel-toe`` for ``model``: with ``gait="auto"``, ``heel-toe`` when the
+        link of the model's first contact carries two contact points (a foot with heel and
+        toe), else the paper's ``walk``."""
+        if self.gait != "auto":
+            return self.gait
+        link = model.contacts[0].link if model.contacts else None
+        on_link = [c for c in model.contacts if c.link == link]
+        return "heel-toe" if len(on_link) == 2 else "walk"
+
+    def sweeps(self) -> tuple[CostSweep, ...]:
+        """Every (model, case) sweep: the 12 m/min walk and the speed-free optimum."""
+        out = []
+        for model in self.models:
+            formulation = self.formulation_of(model)
+            for case in self.cases:
+                extra: dict[str, Any] = ({"cost_regularization": self.regularization}
+                         if self.regularization > 0.0 and case.cost != "paper" else {})
+                if self.swing_clearance is not None:
+                    extra["swing_clearance"] = self.swing_clearance
+                if self.gait_of(model) != "walk":
+                    extra["gait"] = self.gait_of(model)
+                base = GaitOptions(knots=self.knots, formulation=formulation, **case.options(),
+                                   **extra)
+                spec = SweepSpec(model=model, speeds=(START_SPEED,), variants=(self.variant,),
+                                 free_speed=True, base=base)
+                out.append(CostSweep(model=model.name, case=case, formulation=formulation,
+                                     subdir=f"{model.name}/{case.tag}", spec=spec))
+        return tuple(out)
+
+    def settings(self) -> dict[str, Any]:
+        """The study's settings (``cost_study.json``)."""
+        return {"format": COST_STUDY_FORMAT, "version": 1, "gaitopt_version": __version__,
+                "models": [{"name": m.name, "content_hash": m.content_hash(),
+                            "formulation": self.formulation_of(m), "gait": self.gait_of(m)}
+                           for m in self.models],
+                "cases": [c.tag for c in self.cases], "regularization": self.regularization,
+                "swing_clearance": self.swing_clearance,
+                "variant": self.variant, "knots": list(self.knots),
+                "human": {"speed_m_min": HUMAN_OPTIMAL_SPEED_M_MIN,
+                          "step_length": HUMAN_STEP_LENGTH,
+                          "resting_power_w_kg": list(HUMAN_RESTING_POWER)}}
+
+
+def write_settings(spec: CostStudySpec, directory: str | os.PathLike[str]) -> Path:
+    """Write ``cost_study.json`` atomically (it marks the folder as a cost study)."""
+    path = Path(directory) / COST_STUDY_FILE
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(path, json.dumps(spec.settings(), indent=2) + "\n")
+    return path
+
+
+# -- the results table ---------------------------------------------------------------------------
+
+def human_distance(speed_m_min: float, step_length: float) -> float:
+    """``sqrt((v / 80 - 1)^2 + (L / 0.75 - 1)^2)``: 0 at people's walk (module docstring)."""
+    return math.hypot(speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN - 1.0,
+                      step_length / HUMAN_STEP_LENGTH - 1.0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class CostRow:
+    """The speed-free optimum of one (model, case): speed m/min, step m, step time s, the
+    cost's value (its own units, docs/costs.md), NaN where the solve failed; ``file`` the gait
+    file relative to the study directory."""
+
+    model: str
+    formulation: str
+    case: str
+    cost: str
+    resting_power: float
+    success: bool
+    status: str
+    speed_m_min: float
+    step_length: float
+    step_time: float
+    cost_value: float
+    file: str
+    start: str = ""
+    other_cost_value: float = math.nan
+    human_distance: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "human_distance",
+                           human_distance(self.speed_m_min, self.step_length)
+                           if self.success else math.nan)
+
+    def as_csv_dict(self) -> dict[str, str]:
+        out = {}
+        for col in COST_COLUMNS:
+            value = getattr(self, col)
+            if isinstance(value, bool):
+                out[col] = "true" if value else "false"
+            elif isinstance(value, float):
+                out[col] = "" if math.isnan(value) else repr(value)
+            else:
+                out[col] = str(value)
+        return out
+
+
+def direct_gait(sweep: CostSweep, directory: str | os.PathLike[str]) -> Gait | None:
+    """The case's direct solve if its file exists, loads, converged and matches the case's
+    options and model; else None (it is to be solved)."""
+    path = Path(directory) / sweep.subdir / DIRECT_FILE
+    if not path.exists():
+        return None
+    try:
+        gait = Gait.load(path)
+    except GaitFileError:
+        return None
+    task = sweep.direct_task()
+    return None if gait_file_matches(gait, task.model, task.options) else gait
+
+
+def save_direct(sweep: CostSweep, directory: str | os.PathLike[str],
+                outcome: PointOutcome) -> Path | None:
+    """Write a direct solve's gait file atomically (None, nothing written, if it failed)."""
+    if not outcome.success or outcome.gait is None:
+        return None
+    path = Path(directory) / sweep.subdir / DIRECT_FILE
+    Gait.from_dict(outcome.gait, source=str(path)).save(path)
+    return path
+
+
+DirectFn = Callable[[CostSweep, "PointOutcome | None", "Path | None"], None]
+
+
+def run_direct_solves(spec: CostStudySpec, directory: str | os.PathLike[str],
+                      backend: Backend, on_done: DirectFn | None = None) -> tuple[int, int, int]:
+    """Solve every case's direct optimum not kept from an earlier run, all at once on
+    ``backend`` (its workers write nothing; each gait file is written here, atomically, as it
+    arrives). ``on_done(sweep, outcome, path)`` after each (``outcome`` None if the worker
+    raised; ``path`` None if nothing was written). Returns ``(kept, solved, failed)``."""
+    sweeps = spec.sweeps()
+    todo = [s for s in sweeps if direct_gait(s, directory) is None]
+    pending = {backend.submit(solve_point, s.direct_task()): s for s in todo}
+    solved = failed = 0
+    while pending:
+        future = backend.next_finished()
+        if future is None or future not in pending:
+            continue
+        sweep = pending.pop(future)
+        try:
+            outcome: PointOutcome | None = future.result()
+        except Exception:  # noqa: BLE001  (a dead worker: the case keeps its sweep's optimum)
+            outcome = None
+        path = save_direct(sweep, directory, outcome) if outcome is not None else None
+        solved, failed = (solved + 1, failed) if path is not None else (solved, failed + 1)
+        if on_done is not None:
+            on_done(sweep, outcome, path)
+    return len(sweeps) - len(todo), solved, failed
+
+
+def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list[CostRow]:
+    """The speed-free optimum of every (model, case): the lower of the sweep's speed-free point
+    (its ``summary.csv``) and the direct solve (``direct.gait.json``); a case with neither
+    gives a failed row."""
+    top = Path(directory)
+    rows = []
+    for sweep in spec.sweeps():
+        rest = sweep.case.resting_power if sweep.case.resting_power is not None else math.nan
+        common: dict[str, Any] = {"model": sweep.model, "formulation": sweep.formulation,
+                                  "case": sweep.case.tag, "cost": sweep.case.cost,
+                                  "resting_power": rest}
+        try:
+            summary = read_summary(top / sweep.subdir / SUMMARY_FILE)
+        except SummaryError:
+            summary = []
+        free = rows_of(summary, spec.variant, speed_mode="free", success=None)
+        candidates: list[tuple[float, str, dict[str, Any]]] = []
+        if free and free[0].success:
+            r = free[0]
+            candidates.append((r.cost, STARTS[0], {
+                "status": r.status, "speed_m_min": r.speed_m_min, "step_length": r.step_length,
+                "step_time": r.step_time, "file": f"{sweep.subdir}/{r.file}"}))
+        gait = direct_gait(sweep, top)
+        if gait is not None:
+            candidates.append((gait.cost_value, STARTS[1], {
+                "status": gait.status, "speed_m_min": gait.speed * 60.0,
+                "step_length": gait.step_length, "step_time": gait.step_time,
+                "file": f"{sweep.subdir}/{DIRECT_FILE}"}))
+        if not candidates:
+            status = free[0].status if free else "not solved"
+            rows.append(CostRow(**common, success=False, status=status, speed_m_min=math.nan,
+                                step_length=math.nan, step_time=math.nan,
+                                cost_value=math.nan, file=""))
+            continue
+        candidates.sort(key=lambda c: c[0])
+        value, start, fields = candidates[0]
+        other = candidates[1][0] if len(candidates) > 1 else math.nan
+        rows.append(CostRow(**common, success=True, cost_value=value, start=start,
+                            other_cost_value=other, **fields))
+    return rows
+
+
+def cost_table_csv(rows: Sequence[CostRow]) -> str:
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COST_COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow(row.as_csv_dict())
+    return buffer.getvalue()
+
+
+def write_cost_table(directory: str | os.PathLike[str], rows: Sequence[CostRow]) -> Path:
+    """Write ``costs.csv`` atomically."""
+    path = Path(directory) / COST_TABLE_FILE
+    write_text_atomic(path, cost_table_csv(rows))
+    return path
+
+
+def read_cost_table(path: str | os.PathLike[str]) -> list[CostRow]:
+    """Read ``costs.csv``; errors name the file, the line and the column."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise CostStudyError(f"{source}: cannot read the cost table ({exc})") from None
+    reader = csv.DictReader(io.StringIO(text))
+    missing = [c for c in COST_COLUMNS if c not in (reader.fieldnames or [])]
+    if missing:
+        raise CostStudyError(f"{source}: line 1: missing columns {', '.join(missing)}")
+    rows = []
+    for line, raw in enumerate(reader, start=2):
+        def number(col: str, raw: dict[str, str] = raw, line: int = line) -> float:
+            value = (raw[col] or "").strip()
+            try:
+                return float(value) if value else math.nan
+            except ValueError:
+                raise CostStudyError(f"{source}: line {line}: column {col}: expected a "
+                                     f"number, got {value!r}") from None
+
+        success = (raw["success"] or "").strip().lower()
+        if success not in ("true", "false"):
+            raise CostStudyError(f"{source}: line {line}: column success: expected true or "
+                                 f"false, got {success!r}")
+        rows.append(CostRow(model=raw["model"], formulation=raw["formulation"],
+                            case=raw["case"], cost=raw["cost"],
+                            resting_power=number("resting_power"), success=success == "true",
+                            status=raw["status"] or "", speed_m_min=number("speed_m_min"),
+                            step_length=number("step_length"), step_time=number("step_time"),
+                            cost_value=number("cost_value"), file=raw["file"] or "",
+                            start=raw["start"] or "",
+                            other_cost_value=number("other_cost_value")))
+    return rows

@@ -1,0 +1,73 @@
+"""The staged solve as data: which stages run for which options, what each holds, and the
+structure key of the transcription cache (derived from the option fields, none listed by hand
+except those that only enter bounds). Fast: nothing is solved."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, parameter_bounds
+from gaitopt.gait.stages import ANKLES, RELEASES, held_bounds
+from gaitopt.gait.transcriptions import BOUNDS_ONLY_OPTIONS, NlpStructure
+from gaitopt.robot import load_model
+
+FIELDS = {f.name for f in dataclasses.fields(GaitOptions)}
+
+
+def _released(options: GaitOptions) -> list[str]:
+    return [spec.name for spec in RELEASES if spec.runs(options)]
+
+
+@pytest.mark.parametrize(("options", "names"), [
+    (GaitOptions(), ["ankle torques free", "liftoff impulse free"]),
+    (GaitOptions(speed=None), ["ankle torques free", "liftoff impulse free", "speed free"]),
+    (GaitOptions(speed=None, ankle=False, impulse=False), ["speed free"]),
+    (GaitOptions(ankle=False, impulse=False), []),
+    (GaitOptions(formulation="full", single_support_fraction_bounds=(0.6, 0.95)),
+     ["ankle torques free", "liftoff impulse free", "single-support fraction free"]),
+])
+def test_the_release_stages_that_run_for_each_variant(options: GaitOptions,
+                                                      names: list[str]) -> None:
+    assert _released(options) == names
+
+
+def test_each_release_frees_a_different_quantity() -> None:
+    frees = [spec.frees for spec in RELEASES]
+    assert None not in frees and len(set(frees)) == len(frees)
+    assert set(frees) == {ANKLES, IMPULSE, FRACTION, SPEED}
+
+
+def test_held_bounds_hold_exactly_what_is_asked() -> None:
+    o = GaitOptions(speed=None, single_support_fraction_bounds=(0.6, 0.95))
+    free = parameter_bounds(o)
+    assert held_bounds(o, set(), 0.3) == free
+    held = held_bounds(o, {SPEED, IMPULSE, FRACTION}, 0.3)
+    assert held[SPEED] == (0.3, 0.3) and held[IMPULSE] == (0.0, 0.0)
+    assert held[FRACTION] == (o.single_support_fraction, o.single_support_fraction)
+    assert held["step_length"] == free["step_length"]
+
+
+def test_bounds_only_options_are_option_fields() -> None:
+    assert BOUNDS_ONLY_OPTIONS <= FIELDS
+
+
+def test_the_structure_key_changes_with_every_field_but_the_bounds_only_ones() -> None:
+    """Changing any option field (to a sentinel: the key only reads values) changes the
+    structure unless the field only enters bounds; so a new field shapes the NLP until it is
+    listed in BOUNDS_ONLY_OPTIONS, never silently shares a transcription."""
+    model = load_model("five-link")
+    base = GaitOptions()
+    key = NlpStructure.of(model, base, (8, 5), None)
+    assert NlpStructure.of(model, GaitOptions(), (8, 5), None) == key
+    for name in sorted(FIELDS):
+        changed = NlpStructure.of(model, dataclasses.replace(base, **{name: object()}),
+                                  (8, 5), None)
+        if name in BOUNDS_ONLY_OPTIONS and name != "step_time":
+            assert changed == key, name
+        else:
+            assert changed != key, name
+    assert NlpStructure.of(model, base, (16, 6), None) != key
+    assert NlpStructure.of(model, base, (8, 5), "codegen") != key

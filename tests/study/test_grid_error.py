@@ -1,0 +1,126 @@
+"""The grid error of a study (:mod:`gaitopt.study.grid_error`): pairing the study's points
+with the check sweep's, the estimates and the sentences the report prints, and the report's
+statements next to each figure (synthetic sweeps, no solve)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from gaitopt.gait.options import GaitOptions
+from gaitopt.study.grid_error import CHECK_DIR, GridError, check_knots, grid_error, sweep_grid
+from gaitopt.study.plan import SETTINGS_FILE, with_option_defaults
+from gaitopt.study.summary import SummaryRow, variant_flags, write_summary
+from gaitopt.viz.report import write_report
+from tests.viz.synthetic import synthetic_sweep
+
+
+def row(variant: str, speed_m_min: float, cost: float, step: float, *,
+        free: bool = False, success: bool = True) -> SummaryRow:
+    ankle, impulse = variant_flags(variant)
+    return SummaryRow(variant=variant, ankle=ankle, impulse=impulse,
+                      speed_mode="free" if free else "fixed", speed_m_s=speed_m_min / 60.0,
+                      speed_m_min=speed_m_min, step_length=step, step_time=step * 60.0
+                      / speed_m_min, cost=cost if success else math.nan, status="ok",
+                      success=success, iterations=10, wall_time_s=1.0, file="")
+
+
+STUDY = [row("ankle", 12.0, 431.56, 0.1081), row("ankle", 30.0, 642.61, 0.2082),
+         row("ankle", 60.0, 1769.8, 0.3574), row("ankle", 13.33, 428.67, 0.1172, free=True),
+         row("plain", 12.0, 539.68, 0.1090)]
+CHECK = [row("ankle", 12.0, 431.17, 0.1090), row("ankle", 30.0, 640.0, 0.2100),
+         row("ankle", 60.0, 1750.0, 0.3600, success=False),
+         row("ankle", 13.21, 428.70, 0.1178, free=True)]
+
+
+def test_points_pair_by_variant_mode_and_speed() -> None:
+    errors = GridError.compare(STUDY, CHECK, knots=(16, 6), control_model="jumps",
+                               check=(24, 8))
+    pairs = {(p.row.variant, p.row.speed_mode, p.row.speed_m_min) for p in errors.points}
+    # 60 m/min failed on the check grid; plain was not checked.
+    assert pairs == {("ankle", "fixed", 12.0), ("ankle", "fixed", 30.0),
+                     ("ankle", "free", 13.33)}
+    free = errors.free("ankle")
+    assert free is not None
+    assert free.speed_m_min == pytest.approx(13.21 - 13.33)
+    assert free.step_length == pytest.approx(0.1178 - 0.1172)
+    assert free.cost == pytest.approx(abs(428.67 - 428.70) / 428.70)
+    worst = abs(642.61 - 640.0) / 640.0
+    assert errors.statement() == (
+        "Grid: 16+6 knots, control model jumps. Error estimate (change to 24+8 knots at 2 "
+        f"fixed-speed points, 1 speed-free optimum): cost within {100 * worst:.2f} %.")
+    assert "step length within 0.0018 m" in errors.statement(what="step length")
+    only12 = errors.statement(errors.of([STUDY[0]]))
+    assert f"at 1 fixed-speed point): cost within {100 * 0.39 / 431.17:.2f} %" in only12
+
+
+def test_without_a_check_sweep_the_statement_gives_the_grid_only() -> None:
+    errors = GridError((8, 5), "paper", None, ())
+    assert errors.statement() == ("Grid: 8+5 knots, control model paper; no error estimate "
+                                  "(no point solved on a finer grid).")
+
+
+def test_check_grids() -> None:
+    assert check_knots(GaitOptions().knots) == (24, 8)
+    assert check_knots(GaitOptions.paper().knots) == (16, 6)
+    assert check_knots((40, 10)) == (60, 15)
+
+
+def settings(folder: Path, knots: tuple[int, int], control_model: str | None) -> None:
+    options: dict[str, object] = {"knots": list(knots)}
+    if control_model is not None:
+        options["control_model"] = control_model
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / SETTINGS_FILE).write_text(json.dumps({"settings": {"options": options}}))
+
+
+def test_the_grid_of_a_sweep_written_before_control_models_is_the_papers(
+        tmp_path: Path) -> None:
+    settings(tmp_path, (8, 5), None)
+    assert sweep_grid(tmp_path) == ((8, 5), "paper")
+    assert sweep_grid(tmp_path / "missing") is None
+    old = with_option_defaults({"options": {"knots": [8, 5]}})
+    assert old["options"]["control_model"] == "paper"
+    saved = GaitOptions.paper().to_dict()
+    del saved["control_model"]
+    assert GaitOptions.from_dict(saved) == GaitOptions.paper()
+
+
+def test_the_report_states_each_figures_grid_and_error(tmp_path: Path) -> None:
+    """A synthetic sweep on 16+6 and its check sweep with every cost 1 % higher at 12 and
+    24 m/min and the free optimum 0.5 m/min faster: the captions and the headline say so."""
+    rows = synthetic_sweep(tmp_path / "sweep", speeds_m_min=(6, 12, 24, 50), n_samples=21)
+    settings(tmp_path / "sweep", (16, 6), "jumps")
+    check = tmp_path / "sweep" / CHECK_DIR
+    settings(check, (24, 8), "jumps")
+    moved = [row(r.variant, r.speed_m_min + (0.5 if r.speed_mode == "free" else 0.0),
+                 r.cost * 1.01, r.step_length + 0.001, free=r.speed_mode == "free")
+             for r in rows if r.speed_mode == "free" or r.speed_m_min in (12.0, 24.0)]
+    write_summary(check / "summary.csv", moved)
+    errors = grid_error(tmp_path / "sweep", rows)
+    assert errors is not None and len(errors.points) == len(moved)
+    html = (write_report(tmp_path / "sweep", tmp_path / "out", svg=False).html
+            .read_text(encoding="utf-8"))
+    expected = f"cost within {100 * 0.01 / 1.01:.2f} %"
+    assert html.count("Grid: 16+6 knots, control model jumps. Error estimate (change to 24+8 "
+                      "knots") >= 8  # headline, Figs. 3-8, stick figures
+    assert f"at 8 fixed-speed points, 4 speed-free optima): {expected}" in html  # Fig. 3
+    assert "step length within 0.0010 m" in html  # Fig. 4
+    assert "speed +0.50 m/min, step +0.0010 m" in html  # headline, free optimum
+    # Fig. 7 shows the optima without impulse (checked) and gaits at 50 m/min (not checked).
+    assert f"at 2 speed-free optima): {expected}" in html
+
+
+def test_the_statement_says_where_the_estimate_exceeds_one_percent() -> None:
+    study = [row("plain", v, 1000.0, 0.3) for v in (12.0, 45.0, 60.0)]
+    check = [row("plain", 12.0, 999.0, 0.3), row("plain", 45.0, 1015.0, 0.3),
+             row("plain", 60.0, 1020.0, 0.3)]
+    errors = GridError.compare(study, check, knots=(16, 6), control_model="jumps",
+                               check=(24, 8))
+    text = errors.statement()
+    assert f"cost within {100 * 20 / 1020:.2f} %" in text
+    assert f"above 1 % at 2 of 3 points (45-60 m/min), within {100 / 999:.2f} % at the " \
+           "others" in text
