@@ -129,3 +129,14 @@ def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> 
             for c in ("heel_1", "toe_1", "heel_2", "toe_2"):
                 p = np.asarray(contact_position(seven, q, c), dtype=float).ravel()
                 assert p[1] > -2e-3, (ph.name, c, p)
+
+
+def test_phase_knots_keep_the_density_of_phase_0(five: RobotModel, seven: RobotModel) -> None:
+    from gaitopt.gait.contact_sequence import phase_knots
+
+    assert phase_knots(walking_sequence(five, 0.85, impulse=True), (8, 5)) == (8, 5)
+    assert phase_knots(walking_sequence(five, 1.0, impulse=False), (8, 5)) == (8,)
+    seq = heel_toe_sequence(seven, swap(seven), 0.85, impulse=True)
+    # 15 intervals over 0.425 of the step: 35.3 per step; heel off 0.2975 -> 11 intervals,
+    # double support 0.15 -> 6, heel rocker 0.1275 -> 5 (at least 6 knots everywhere).
+    assert phase_knots(seq, (16, 6)) == (16, 12, 7, 6)

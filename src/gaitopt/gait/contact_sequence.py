@@ -40,6 +40,7 @@ section of a YAML file; docs/formulations.md).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -135,6 +136,20 @@ def phase_holds(sequence: Mapping[str, Any] | None, i: int, contacts: Sequence[s
             if [hold_name(c) for c in held] == list(contacts):
                 return held
     return tuple(contacts)
+
+
+def phase_knots(seq: ContactSequence, knots: Sequence[int]) -> tuple[int, ...]:
+    """Knots of each phase from ``knots = (first, others)``: two-phase sequences (and one)
+    take them as they are (the paper's single and double support); longer ones give phase
+    0 ``first`` knots and every other phase at least ``others``, more when the density of
+    phase 0 (intervals per share of the step) asks for more, so that long phases are not
+    coarser than phase 0."""
+    first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
+    if len(seq.phases) <= 2:
+        return tuple(first if i == 0 else others for i in range(len(seq.phases)))
+    density = (first - 1) / seq.phases[0].fraction
+    return (first,) + tuple(max(others, 1 + math.ceil(density * ph.fraction - 1e-9))
+                            for ph in seq.phases[1:])
 
 
 def swap_spec(spec: str, contact_swap: Mapping[str, str]) -> str:

@@ -48,7 +48,12 @@ from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait import cost
-from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, check_sequence
+from gaitopt.gait.contact_sequence import (
+    ContactSequence,
+    EventSpec,
+    check_sequence,
+    phase_knots,
+)
 from gaitopt.gait.full_physics import (
     PointValues,
     Symmetry,
@@ -157,6 +162,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         return b
 
     phases: list[Phase] = []
+    counts = phase_knots(seq, options.knots)
     actuators_of: dict[str, tuple[str, ...]] = {}
     for ph in seq.phases:
         held = ph.held
@@ -244,7 +250,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
             control_scales={n: PROJECTION_SCALE for n in proj},
-            intervals=options.knots[min(len(phases), len(options.knots) - 1)] - 1))
+            intervals=counts[len(phases)] - 1))
 
     linkages: list[Linkage | ControlLinkage] = []
     events: list[BoundaryConstraint] = []

@@ -160,8 +160,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
         counts = grid_knots(knots, options)
         problem = problem_for(model, options.replace(knots=counts))
         intervals: dict[str, Any] = {
-            ph.name: (np.asarray(knots[i], dtype=float) if is_mesh(knots)
-                      else counts[min(i, len(counts) - 1)] - 1)
+            ph.name: (np.asarray(knots[i], dtype=float) if is_mesh(knots) else ph.intervals)
             for i, ph in enumerate(problem.phases)}
         _CACHE[key] = transcribe(
             problem, method=options.transcription, intervals=intervals, compiled=compiled,
