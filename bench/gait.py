@@ -31,17 +31,33 @@ on this machine: warm solve under 0.25 s at 8 + 5 and under 1.5 s at 40 + 10; co
 Timings on a shared machine are noisy: the load average is printed before and after, and
 ``--repeat N`` keeps the best of N for the warm and cached-cold solves.
 
-Run: ``python bench/gait.py [--repeat 3] [--grids 8,5 40,10] [--formulation full]``
+``--targets`` prints only the rows of the issue's table (warm starts from a saved gait file at
+8 + 5 and 40 + 10 knots, the first one in a fresh process, whole ``gaitopt solve``
+processes, the share of the solve spent in NLP evaluations) for this branch's fast path
+(separated Hermite-Simpson, derivatives from compiled point functions) and for a reference
+git revision (``--reference``, default ``main``: its sources extracted into a temporary
+folder and run by the same interpreter, on the paper's compressed form, main's default),
+each row measured for both one after the other in fresh processes (``bench/gait_child.py``),
+with the ratios.
+
+Run: ``python bench/gait.py [--repeat 3] [--grids 8,5 40,10] [--formulation full]
+[--transcription hermite-simpson-separated]`` or ``python bench/gait.py --targets``
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import os
+import resource
+import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from gaitopt.gait.api import solve_gait_solution
@@ -140,11 +156,11 @@ def best_of(repeat: int, name: str, knots: tuple[int, int],
     return min(runs, key=lambda mr: mr[0].wall_s)
 
 
-def bench_grid(knots: tuple[int, int], repeat: int,
-               formulation: str = "reduced") -> list[Measure]:
+def bench_grid(knots: tuple[int, int], repeat: int, formulation: str = "reduced",
+               transcription: str = "hermite-simpson") -> list[Measure]:
     model = load_model("five-link")
-    options = GaitOptions.paper(speed=SPEED, knots=knots,
-                          formulation=formulation)  # type: ignore[arg-type]
+    options = GaitOptions.paper(speed=SPEED, knots=knots, formulation=formulation,  # type: ignore
+                                transcription=transcription)  # type: ignore[arg-type]
     clear_cache()  # the process-wide NLP cache: a fresh start
     fresh, _ = measure("cold (fresh)", knots, lambda: solve_walking(model, options))
     cached, solution = best_of(repeat, "cold (cache built)", knots,
@@ -191,6 +207,139 @@ def table(measures: list[Measure]) -> str:
     return "\n".join(rows)
 
 
+# -- the issue's targets, against a reference revision measured in the same run ------------
+
+#: The issue's targets (s; the share as a fraction), by row.
+ISSUE_TARGETS = {"warm 8+5": 0.05, "warm 40+10": 0.15, "first warm 40+10": 0.5,
+                 "cli 8+5": 1.0, "cli 40+10": 2.0, "share 8+5": 0.5, "share 40+10": 0.5}
+#: The transcription measured on this branch (the reference runs the paper's compressed form,
+#: main's default, evaluated as main evaluates it).
+FAST = "hermite-simpson-separated"
+PAPER_FORM = "hermite-simpson"
+REPO = Path(__file__).resolve().parent.parent
+
+
+def reference_sources(rev: str, into: Path) -> Path:
+    """The ``src`` folder of git revision ``rev`` of this repository, extracted into
+    ``into`` (the same interpreter and packages run it)."""
+    archive = subprocess.run(["git", "-C", str(REPO), "archive", rev, "src"], check=True,
+                             capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    return into / "src"
+
+
+def run_child(src: Path, *args: str) -> tuple[dict[str, Any], float]:
+    """``bench/gait_child.py args`` in a fresh process with ``src`` first on the path: its
+    JSON output and the wall time of the whole process."""
+    env = dict(os.environ, PYTHONPATH=str(src))
+    start = time.perf_counter()
+    proc = subprocess.run([sys.executable, str(REPO / "bench" / "gait_child.py"), *args],
+                          env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    if proc.returncode != 0:
+        raise RuntimeError(f"gait_child {' '.join(args)} failed:\n{proc.stderr[-3000:]}")
+    return json.loads(proc.stdout.strip().splitlines()[-1]), wall
+
+
+def run_cli(src: Path, transcription: str, knots: str, out: Path,
+            formulation: str = "reduced") -> tuple[float, float]:
+    """Wall and CPU time (user + system) of a whole ``gaitopt solve`` process (12 m/min)."""
+    env = dict(os.environ, PYTHONPATH=str(src))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "gaitopt", "solve", "--speed", "12m/min",
+                           "--knots", knots, "--control-model", "paper",
+                           "--transcription", transcription,
+                           "--formulation", formulation, "-o", str(out)],
+                          env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if proc.returncode != 0:
+        raise RuntimeError(f"gaitopt solve failed:\n{proc.stderr[-3000:]}")
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
+    """Every row of the issue's table for the reference revision (the paper's compressed
+    form, as main solves it by default) and this branch (:data:`FAST`), each row measured
+    for both one after the other, and the ratios."""
+    here = REPO / "src"
+    with tempfile.TemporaryDirectory(prefix="gaitopt-bench-") as tmp_name:
+        tmp = Path(tmp_name)
+        ref = reference_sources(reference, tmp)
+        variants = (("reference", ref, PAPER_FORM), ("this branch", here, FAST))
+        rows: dict[str, dict[str, float]] = {}
+        cpu: dict[str, dict[str, float]] = {}
+        notes: list[str] = []
+
+        def record(row: str, name: str, value: float, cpu_s: float | None = None) -> None:
+            rows.setdefault(row, {})[name] = value
+            if cpu_s is not None:
+                cpu.setdefault(row, {})[name] = cpu_s
+
+        for knots in ("8,5", "40,10"):
+            grid = knots.replace(",", "+")
+            for name, src, form in variants:
+                gait_file = tmp / f"{name.replace(' ', '_')}-{grid}.gait.json"
+                out, _ = run_child(src, "warm", knots, form, str(repeat), str(gait_file),
+                                   formulation)
+                record(f"warm {grid}", name, out["warm_s"], out["warm_cpu_s"])
+                record(f"share {grid}", name, out["cold_eval_s"] / max(out["cold_ipopt_s"],
+                                                                       1e-12))
+                notes.append(f"{name} {grid}: cold {out['cold_first_s']:.2f} s (NLPs built), "
+                             f"{out['cold_cached_s']:.2f} s again ({out['cold_iterations']} it,"
+                             f" J {out['cost']:.4f}); warm from the file {out['warm_s']:.3f} s "
+                             f"({out['warm_iterations']} it, J {out['warm_cost']:.4f}, "
+                             f"{out['warm_eval_s'] / max(out['warm_ipopt_s'], 1e-12):.0%} in "
+                             f"evaluations)")
+                print(notes[-1], flush=True)
+                if grid == "40+10":
+                    first, proc = run_child(src, "first-warm", knots, form, str(gait_file),
+                                            formulation)
+                    record("first warm 40+10", name, first["first_warm_s"],
+                           first["first_warm_cpu_s"])
+                    notes.append(f"{name} 40+10 fresh process: first warm start "
+                                 f"{first['first_warm_s']:.2f} s ({first['iterations']} it), "
+                                 f"imports {first['imports_s']:.2f} s, whole process "
+                                 f"{proc:.2f} s")
+                    print(notes[-1], flush=True)
+        for knots in ("8,5", "40,10"):
+            grid = knots.replace(",", "+")
+            for name, src, form in variants:
+                runs = [run_cli(src, form, knots, tmp / "cli.gait.json", formulation)
+                        for _ in range(1 + repeat)]
+                best_run = min(runs[1:])
+                record(f"cli {grid}", name, best_run[0], best_run[1])
+                notes.append(f"{name} gaitopt solve --knots {knots}: "
+                             + ", ".join(f"{r[0]:.2f} ({r[1]:.2f} CPU)" for r in runs)
+                             + " s (first run, then with the disk caches warm; best of the "
+                               "latter)")
+                print(notes[-1], flush=True)
+    labels = {
+        "warm 8+5": "warm start from a saved gait, +5 % speed, 8+5 knots (public API), s",
+        "warm 40+10": "the same, 40+10 knots, s",
+        "first warm 40+10": "the first such warm start at 40+10 in a fresh process, s",
+        "cli 8+5": "cold `gaitopt solve`, whole process, 8+5 knots (disk caches warm), s",
+        "cli 40+10": "cold `gaitopt solve --knots 40,10`, whole process, s",
+        "share 8+5": "share of the cold solve's IPOPT time in NLP evaluations, 8+5",
+        "share 40+10": "the same, 40+10",
+    }
+    print()
+    print(f"formulation: {formulation}")
+    print(f"| figure | reference ({reference}, {PAPER_FORM}) | this branch ({FAST}) | "
+          "this / reference | target | met | CPU s: reference, this branch |")
+    print("| --- | ---: | ---: | ---: | ---: | :---: | ---: |")
+    for row, label in labels.items():
+        r, b = rows[row]["reference"], rows[row]["this branch"]
+        fmt = "{:.0%}" if row.startswith("share") else "{:.3f}"
+        target = ISSUE_TARGETS[row]
+        c = cpu.get(row)
+        cpu_text = f"{c['reference']:.3f}, {c['this branch']:.3f}" if c else ""
+        print(f"| {label} | {fmt.format(r)} | {fmt.format(b)} | {b / r:.2f} | "
+              f"{fmt.format(target)} | {'yes' if b <= target else 'no'} | {cpu_text} |")
+    print("| 80-point sweep, 2 workers | see `bench/sweep.py --reference` | | | 8 | |")
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeat", type=int, default=3,
@@ -199,13 +348,25 @@ def main(argv: list[str] | None = None) -> None:
                         help="knots per phase, single,double")
     parser.add_argument("--formulation", choices=["reduced", "full"], default="reduced",
                         help="the walking problem's coordinates (docs/formulations.md)")
+    parser.add_argument("--transcription", default=PAPER_FORM,
+                        help="the transcription of the detailed table")
+    parser.add_argument("--targets", action="store_true",
+                        help="only the issue's table: this branch against --reference, every "
+                             "row measured in fresh processes in the same run")
+    parser.add_argument("--reference", default="main",
+                        help="git revision of the reference for --targets (default: main)")
     args = parser.parse_args(argv)
+    if args.targets:
+        print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
+        targets(args.reference, args.repeat, args.formulation)
+        print(f"load average after: {load_average()}")
+        return
     grids = [tuple(int(k) for k in g.split(",")) for g in args.grids]
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
     measures: list[Measure] = []
     for knots in grids:
         k = (knots[0], knots[1])
-        for m in bench_grid(k, args.repeat, args.formulation):
+        for m in bench_grid(k, args.repeat, args.formulation, args.transcription):
             measures.append(m)
             print(f"  {k[0]}+{k[1]} {m.name:<20} {m.wall_s:8.3f} s  it {m.iterations:4d}  "
                   f"{'ok' if m.success else 'FAILED'}", flush=True)

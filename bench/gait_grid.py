@@ -175,8 +175,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
     parser.add_argument("--no-verify", action="store_true", help="skip the verify column")
     parser.add_argument("--json", type=Path, help="also write the points as JSON")
-    parser.add_argument("--transcription", default="hermite-simpson", choices=TRANSCRIPTIONS,
-                        help="GaitOptions.transcription of every point")
+    parser.add_argument("--transcription", default=GaitOptions().transcription,
+                        choices=TRANSCRIPTIONS,
+                        help="GaitOptions.transcription of every point (default: the default)")
     args = parser.parse_args(argv)
 
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")

@@ -8,14 +8,22 @@ references measured in the same run: a worker pool's start-up and one transcript
 this process. Target: under 60 s for the 80 points on the 2-core reference machine.
 
     PYTHONPATH=src python bench/sweep.py [--workers 2] [--speeds 3:60:3] [--free]
-        [--start-methods forkserver,spawn]
+        [--start-methods forkserver,spawn] [--transcription T] [--reference main]
+
+``--reference main`` first runs the same benchmark on git revision ``main`` (its sources
+extracted into a temporary folder, the same interpreter) with the paper's compressed form,
+then this branch with ``--transcription`` (default: the separated form), and prints the
+ratios of the from-scratch times.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -93,11 +101,18 @@ def main() -> None:
     parser.add_argument("--speeds", default="3:60:3", help="m/min, as for gaitopt sweep")
     parser.add_argument("--free", action="store_true", help="also the speed-free optima")
     parser.add_argument("--start-methods", default="forkserver")
+    parser.add_argument("--transcription", default="hermite-simpson-separated",
+                        help="the sweep's transcription (GaitOptions.transcription)")
+    parser.add_argument("--reference", default=None,
+                        help="a git revision (e.g. main) to measure first in the same run, "
+                             "with the paper's compressed form, as the reference of the ratios")
+    parser.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    reference = run_reference(args) if args.reference else None
 
     spec = SweepSpec(model=load_model("five-link"), speeds=parse_speeds(args.speeds),
                      variants=VARIANTS, free_speed=args.free,
-                     base=GaitOptions.paper())  # the figures of docs/studies.md: 8+5 knots
+                     base=GaitOptions.paper(transcription=args.transcription))  # type: ignore
     n = len(spec.points)
     load = os.getloadavg()[0]
     print(f"sweep benchmark: {len(spec.variants)} variants x {len(spec.speeds)} speeds"
@@ -148,7 +163,40 @@ def main() -> None:
     for method, cold, resumed, ok, again_n, _ in rows:
         print(f"| {method} | {n} | {ok} | {cold:.1f} | {60 * n / cold:.0f} | {resumed:.2f} | "
               f"{again_n} |")
+    if reference is not None:
+        print(f"\n| start method | reference {args.reference} (hermite-simpson), from scratch (s)"
+              f" | this branch ({args.transcription}) (s) | this / reference | target (s) |")
+        print("|---|---:|---:|---:|---:|")
+        for method, cold, *_ in rows:
+            ref = reference.get(method, float("nan"))
+            print(f"| {method} | {ref:.1f} | {cold:.1f} | {cold / ref:.2f} | 8 |")
+    if args.json:
+        print(json.dumps({method: cold for method, cold, *_ in rows}))
     print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+def run_reference(args: argparse.Namespace) -> dict[str, float]:
+    """This benchmark on git revision ``args.reference`` (its sources extracted into a
+    temporary folder, the same interpreter), with the compressed form: the wall time from
+    scratch by start method."""
+    repo = Path(__file__).resolve().parent.parent
+    with tempfile.TemporaryDirectory(prefix="gaitopt-bench-ref-") as tmp:
+        archive = subprocess.run(["git", "-C", str(repo), "archive", args.reference, "src"],
+                                 check=True, capture_output=True).stdout
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+        cmd = [sys.executable, str(Path(__file__).resolve()), "--workers", str(args.workers),
+               "--speeds", args.speeds, "--start-methods", args.start_methods,
+               "--transcription", "hermite-simpson", "--json"] + (["--free"] if args.free
+                                                                  else [])
+        print(f"reference: {args.reference} ({' '.join(cmd[2:])})", flush=True)
+        proc = subprocess.run(cmd, env=dict(os.environ, PYTHONPATH=str(Path(tmp) / "src")),
+                              capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise SystemExit(f"reference run failed:\n{proc.stderr[-3000:]}")
+    print("\n".join("  | " + line for line in proc.stdout.splitlines()), flush=True)
+    line = [t for t in proc.stdout.splitlines() if t.startswith("{")][-1]
+    out: dict[str, float] = json.loads(line)
+    return out
 
 
 if __name__ == "__main__":

@@ -45,6 +45,15 @@ def compiler() -> str:
     raise CompileError("no C compiler found (set CC, or install gcc)")
 
 
+def has_compiler() -> bool:
+    """Whether a C compiler is available (see :func:`compiler`)."""
+    try:
+        compiler()
+    except CompileError:
+        return False
+    return True
+
+
 def generate_source(functions: Sequence[ca.Function], name: str) -> str:
     """C source defining every function in ``functions`` (CasADi's generated code)."""
     gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "casadi_real": "double"})
@@ -53,30 +62,63 @@ def generate_source(functions: Sequence[ca.Function], name: str) -> str:
     return str(gen.dump())
 
 
+def library_path(source: str, name: str, flags: Sequence[str] = DEFAULT_FLAGS) -> Path:
+    """Where the library of C ``source`` compiled with ``flags`` is (or will be) cached:
+    ``<cache>/<name>-<hash of source, compiler and flags>.so``."""
+    key = hashlib.sha256("\0".join([source, compiler(), *flags]).encode()).hexdigest()[:20]
+    return cache_dir() / f"{name}-{key}.so"
+
+
 def compile_library(source: str, name: str, *, flags: Sequence[str] = DEFAULT_FLAGS) -> Path:
     """Compile C ``source`` to a shared library in the cache and return its path.
 
     A library with the same source and flags already in the cache is reused as it is.
     """
+    return compile_libraries({name: source}, flags=flags)[name]
+
+
+def compile_libraries(sources: dict[str, str], *, flags: Sequence[str] = DEFAULT_FLAGS,
+                      targets: dict[str, Path] | None = None,
+                      flags_by_name: dict[str, Sequence[str]] | None = None
+                      ) -> dict[str, Path]:
+    """Compile several C sources (by library name) to shared libraries in the cache, the
+    compilers running in parallel, and return their paths by name. Libraries already in the
+    cache (same source, compiler and flags) are reused as they are. ``targets`` gives the
+    paths instead (a caller that keys the cache by what generates the source);
+    ``flags_by_name`` other flags for some libraries."""
     cc = compiler()
-    key = hashlib.sha256("\0".join([source, cc, *flags]).encode()).hexdigest()[:20]
-    target = cache_dir() / f"{name}-{key}.so"
-    if target.exists():
-        return target
+    flags_of = {name: tuple((flags_by_name or {}).get(name, flags)) for name in sources}
+    if targets is None:
+        targets = {name: library_path(src, name, flags_of[name])
+                   for name, src in sources.items()}
+    todo = [name for name, path in targets.items() if not path.exists()]
+    if not todo:
+        return targets
     with tempfile.TemporaryDirectory(prefix="gaitopt-cc-") as tmp:
-        c_file = Path(tmp) / f"{name}.c"
-        c_file.write_text(source)
-        so_tmp = Path(tmp) / f"{name}.so"
-        cmd = [cc, *flags, str(c_file), "-o", str(so_tmp), "-lm"]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise CompileError(f"{' '.join(cmd)} failed:\n{proc.stderr[-2000:]}")
-        # Atomic publish: concurrent processes may compile the same key.
-        fd, staged = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
-        os.close(fd)
-        shutil.copyfile(so_tmp, staged)
-        os.replace(staged, target)
-    return target
+        running = []
+        for name in todo:
+            c_file = Path(tmp) / f"{name}.c"
+            c_file.write_text(sources[name])
+            so_tmp = Path(tmp) / f"{name}.so"
+            cmd = [cc, *flags_of[name], str(c_file), "-o", str(so_tmp), "-lm"]
+            running.append((name, cmd, so_tmp,
+                            subprocess.Popen(cmd, stdout=subprocess.PIPE,
+                                             stderr=subprocess.PIPE, text=True)))
+        failed = []
+        for name, cmd, so_tmp, proc in running:
+            _, err = proc.communicate()
+            if proc.returncode != 0:
+                failed.append(f"{' '.join(cmd)} failed:\n{err[-2000:]}")
+                continue
+            # Atomic publish: concurrent processes may compile the same key.
+            target = targets[name]
+            fd, staged = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
+            os.close(fd)
+            shutil.copyfile(so_tmp, staged)
+            os.replace(staged, target)
+        if failed:
+            raise CompileError("\n".join(failed))
+    return targets
 
 
 def compile_functions(functions: Sequence[ca.Function], name: str, *,

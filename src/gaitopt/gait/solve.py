@@ -94,7 +94,13 @@ from gaitopt.gait.stages import (
     held_ankles,
     held_bounds,
 )
-from gaitopt.gait.transcriptions import Grid, grid_knots, transcription_for, warm_start_grid
+from gaitopt.gait.transcriptions import (
+    Grid,
+    evaluation_mode,
+    grid_knots,
+    transcription_for,
+    warm_start_grid,
+)
 from gaitopt.ocp import Guess, Result, WarmStart, refined_mesh
 from gaitopt.ocp.mesh import split_intervals
 from gaitopt.robot.model import RobotModel
@@ -391,6 +397,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     """
     validate_options(options, biped_of(model, options))
     checked_sequence(model, options)
+    evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()
     run = _Run(model, options, progress, compiled)
     result: Result | None = None

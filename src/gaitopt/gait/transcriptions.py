@@ -12,14 +12,22 @@ normalised knot times in [0, 1] per phase of the problem (a refined mesh).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import functools
+import hashlib
+import pickle
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
+from gaitopt import codegen
+from gaitopt.fileio import write_bytes_atomic
 from gaitopt.gait.formulation import problem_for
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.ocp import Guess, Result, Transcription, WarmStart, transcribe
 from gaitopt.robot.model import RobotModel
 
@@ -84,12 +92,71 @@ def clear_cache() -> None:
     _CACHE.clear()
 
 
+def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
+    """How the NLP of ``options`` is evaluated (``transcribe(..., compiled=...)``): the
+    separated Hermite-Simpson form always by ``"points"``, its derivatives assembled from
+    compiled functions of one grid point (:mod:`gaitopt.ocp.pointwise`: compiled once per
+    model and problem structure into the disk cache, CasADi's VM without a C compiler;
+    several times faster per iteration than the alternatives); other transcriptions as
+    ``compiled`` asks (``None``: CasADi's VM on the expanded NLP), but not ``"codegen"``,
+    whose one C file of the whole NLP does not compile in minutes."""
+    if options.transcription == "hermite-simpson-separated":
+        return "points"
+    if compiled == "codegen":
+        raise GaitOptionsError(
+            f"compiled: the {options.transcription!r} NLP generated as one C file does not "
+            "compile in minutes (34 MB of C at 8 + 5 knots); use transcription "
+            "'hermite-simpson-separated', whose derivatives are always compiled per grid "
+            "point")
+    return compiled
+
+
+#: Version of the disk cache of the walking problem's symbolic functions (part of its key).
+FUNCTIONS_FORMAT = "gaitopt-walking-functions-1"
+
+
+@functools.cache
+def source_hash() -> str:
+    """A hash of every Python file of the installed gaitopt package: the symbolic functions
+    cached on disk are those this code builds."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:20]
+
+
+def functions_file(key: NlpStructure) -> Path:
+    """Where the symbolic functions (``Transcription.functions``) of the problem of the
+    structure ``key`` are cached on disk: keyed by the model, every shaping option, the
+    gaitopt sources and CasADi's version, not the grid or the evaluation mode."""
+    text = repr((FUNCTIONS_FORMAT, source_hash(), ca.CasadiMeta.version(), key.model_hash,
+                 key.step_time_row, key.options))
+    name = hashlib.sha256(text.encode()).hexdigest()[:24]
+    return codegen.cache_dir() / f"walking-functions-{name}.pickle"
+
+
+def cached_functions(path: Path) -> Any:
+    """The functions pickled at ``path``, or None (missing, unreadable or stale: rebuilt)."""
+    try:
+        return pickle.loads(path.read_bytes())
+    except Exception:  # noqa: BLE001 - any unreadable cache file is rebuilt and replaced
+        return None
+
+
 def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
                       compiled: str | None = None) -> Transcription:
     """The (process-wide cached) transcription of the walking problem on ``knots`` (knot
-    counts per phase, or a mesh: normalised knot times per phase)."""
+    counts per phase, or a mesh: normalised knot times per phase). Its symbolic functions
+    (independent of the grid) come from another grid's transcription in this process, or
+    from the disk cache (:func:`functions_file`), or are built and saved there."""
+    compiled = evaluation_mode(options, compiled)
     key = NlpStructure.of(model, options, knots, compiled)
     if key not in _CACHE:
+        same = [tr.functions for k, tr in _CACHE.items()
+                if dataclasses.replace(k, grid=key.grid) == key]
+        path = functions_file(key)
+        functions = same[0] if same else cached_functions(path)
         counts = grid_knots(knots, options)
         problem = problem_for(model, options.replace(knots=counts))
         intervals: dict[str, Any] = {
@@ -100,7 +167,10 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
             options={"ipopt.tol": options.tol, "ipopt.max_iter": options.max_iter,
                      "ipopt.acceptable_tol": max(options.tol * 100, 1e-6),
                      "show_eval_warnings": False},
-            build_solver=False)
+            build_solver=False, functions=functions)
+        if functions is None:
+            with contextlib.suppress(OSError):  # a read-only cache: build again next time
+                write_bytes_atomic(path, pickle.dumps(_CACHE[key].functions))
     return _CACHE[key]
 
 

@@ -19,7 +19,9 @@ The NLP handed to the solver is ``min J / objective_scale`` over ``w_hat = w / d
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -59,14 +61,14 @@ class _Rows:
     """Accumulates constraint rows with names, bounds and scales."""
 
     def __init__(self) -> None:
-        self.exprs: list[ca.MX] = []
+        self.exprs: list[Any] = []
         self.blocks: list[ConstraintBlock] = []
         self.lower: list[Array] = []
         self.upper: list[Array] = []
         self.scale: list[Array] = []
         self.size = 0
 
-    def add(self, name: str, phase: str | None, kind: str, expr: ca.MX,
+    def add(self, name: str, phase: str | None, kind: str, expr: Any,
             shape: tuple[int, ...], lower: Array, upper: Array, scale: Array) -> None:
         rows = int(np.prod(shape))
         if rows == 0:
@@ -85,24 +87,75 @@ class _Rows:
         return np.concatenate(arrs) if arrs else np.zeros(0)
 
 
-def flat(m: ca.MX) -> ca.MX:
+def flat(m: Any) -> Any:
     """Column-major flattening of an (a, b) matrix to (a*b, 1): entry (i, j) -> row j*a + i."""
     return ca.reshape(m, m.numel(), 1)
+
+
+#: How the point function of phase ``i`` is evaluated at M grid points:
+#: ``(i, point, X (n, M), U (m, M), p (n_p, 1), t (1, M)) -> (xdot (n, M), path (r, M),
+#: L (1, M))``. The default maps the point function (:func:`mapped_points`);
+#: :mod:`gaitopt.ocp.pointwise` substitutes symbols for the outputs instead.
+PointCalls = Callable[[int, ca.Function, Any, Any, Any, Any], tuple[Any, Any, Any]]
+
+
+def mapped_points(i: int, point: ca.Function, X: Any, U: Any, p: Any, t: Any
+                  ) -> tuple[Any, Any, Any]:
+    """The point function mapped over the M columns of ``X, U, t`` (one call per point)."""
+    XD, C, L = point.map(int(X.shape[1]))(X, U, p, t)
+    return XD, C, L
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """The NLP expressions in the symbol type they were built with (MX or SX)."""
+
+    w_hat: Any
+    f: Any
+    g: Any
+    g_unscaled: Any
+    rows: _Rows
+    numerator: Any
+    denominator: Any
+    durations: Any
 
 
 def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
              phase_fns: tuple[PhaseFunction, ...], ends_fn: EndsFunction, d_w: Array,
              state_scales: tuple[Array, ...]) -> Nlp:
     """Build the symbolic NLP (see the module docstring)."""
-    w_hat = ca.MX.sym("w", layout.size)
+    a = assemble_expressions(problem, method, mesh, layout, phase_fns, ends_fn, d_w,
+                             state_scales)
+    rows = a.rows
+    d_g = rows.cat(rows.scale)
+    w_plain = ca.MX.sym("w_plain", layout.size)
+    evaluate = ca.Function("evaluate", [a.w_hat],
+                           [a.g_unscaled, a.numerator, a.denominator, a.durations])
+    evaluate = ca.Function("evaluate_unscaled", [w_plain],
+                           evaluate.call([w_plain / ca.DM(d_w)]),
+                           ["w"], ["g", "numerator", "denominator", "durations"])
+    return Nlp(a.w_hat, a.f, a.g, layout,
+               ConstraintLayout(tuple(rows.blocks), rows.size), d_w, d_g,
+               rows.cat(rows.lower), rows.cat(rows.upper), problem.objective_scale, evaluate)
+
+
+def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
+                         phase_fns: tuple[PhaseFunction, ...], ends_fn: EndsFunction,
+                         d_w: Array, state_scales: tuple[Array, ...], *,
+                         symbols: Any = ca.MX, point_calls: PointCalls = mapped_points
+                         ) -> Assembly:
+    """The scaled objective and constraints as expressions of ``w_hat`` (a ``symbols``
+    symbol: ``ca.MX`` or ``ca.SX``), the point functions evaluated by ``point_calls``."""
+    sym = symbols
+    w_hat = sym.sym("w", layout.size)
     w = w_hat * ca.DM(d_w)
     p = w[layout.parameter_start:layout.size]
     durations_expr = ends_fn.durations(p)
     rows = _Rows()
-    numerator: ca.MX = ca.MX(0.0)
-    ends_parts: list[ca.MX] = []
-    durations: list[ca.MX] = []
-    t_start: ca.MX = ca.MX(problem.t0)
+    numerator = sym(0.0)
+    ends_parts: list[Any] = []
+    durations: list[Any] = []
+    t_start = sym(problem.t0)
     for i, (ph, pl, pf, tau) in enumerate(zip(problem.phases, layout.phases, phase_fns, mesh,
                                               strict=True)):
         spec = ph.duration_spec()
@@ -112,7 +165,7 @@ def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
         elif pl.duration_index is not None:
             T = w[pl.duration_index]
         else:
-            T = ca.MX(spec.lower)
+            T = sym(spec.lower)
         durations.append(T)
         Z = ca.reshape(w[pl.knot_block()], pl.stride, K)
         X, U = Z[:n, :], Z[n:, :]
@@ -128,18 +181,18 @@ def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
             # Separated form: one call of the point function per knot and per midpoint, all
             # in one map, at the variable midpoint states (no dynamics nested in dynamics).
             Xm = ca.reshape(w[pl.midpoint_block()], n, N)
-            XD, C, L = pf.point.map(K + N)(ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
-                                           ca.horzcat(tk, tm))
+            XD, C, L = point_calls(i, pf.point, ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
+                                   ca.horzcat(tk, tm))
             f_m, Cm, L_m = XD[:, K:], C[:, K:], L[:, K:]
             XD, C, L = XD[:, :K], C[:, :K], L[:, :K]
             x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
             mid_defects = Xm - method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
         else:
-            XD, C, L = pf.point.map(K)(X, U, p, tk)
+            XD, C, L = point_calls(i, pf.point, X, U, p, tk)
             x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
             if method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0:
                 Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
-                f_m, Cm, L_m = pf.point.map(N)(Xm, Um, p, tm)
+                f_m, Cm, L_m = point_calls(i, pf.point, Xm, Um, p, tm)
         defects = method.defects(x_k, x_k1, f_k, f_k1, f_m, Hn)
         dx = state_scales[i]
         rows.add(f"{ph.name}/defects", ph.name, "defects", flat(defects), (N, n),
@@ -178,15 +231,9 @@ def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
                  ends_fn.boundary_scale[sl])
     numerator = numerator + mayer + pcost
     J = numerator / den if ends_fn.has_denominator else numerator
-    g = ca.vertcat(*rows.exprs) if rows.exprs else ca.MX(0, 1)
+    g = ca.vertcat(*rows.exprs) if rows.exprs else sym(0, 1)
     d_g = rows.cat(rows.scale)
     f_scaled = J / problem.objective_scale
     g_scaled = g / ca.DM(d_g) if rows.size else g
-    w_plain = ca.MX.sym("w_plain", layout.size)
-    evaluate = ca.Function("evaluate", [w_hat], [g, numerator, den, ca.vertcat(*durations)])
-    evaluate = ca.Function("evaluate_unscaled", [w_plain],
-                           evaluate.call([w_plain / ca.DM(d_w)]),
-                           ["w"], ["g", "numerator", "denominator", "durations"])
-    return Nlp(w_hat, f_scaled, g_scaled, layout, ConstraintLayout(tuple(rows.blocks), rows.size),
-               d_w, d_g, rows.cat(rows.lower), rows.cat(rows.upper), problem.objective_scale,
-               evaluate)
+    return Assembly(w_hat, f_scaled, g_scaled, g, rows, numerator, den,
+                    ca.vertcat(*durations))

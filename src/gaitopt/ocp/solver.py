@@ -12,6 +12,9 @@ Modes (``compiled``):
   size and compile time do not grow with the mesh.
 * ``"jit"``: CasADi's own just-in-time compilation (``jit=True``, shell compiler); compiled at
   every build, nothing cached.
+* ``"points"``: the derivatives are assembled from compiled functions of one grid point
+  (:mod:`gaitopt.ocp.pointwise`; :func:`solver_from_functions`), for transcriptions that
+  evaluate the dynamics at single grid points (the separated Hermite-Simpson form).
 
 A solve never raises: :func:`call_solver` returns the solution or an error message.
 """
@@ -39,7 +42,7 @@ DEFAULT_OPTIONS: dict[str, Any] = {
     "ipopt.linear_solver": "mumps",
 }
 
-COMPILED_MODES = (None, "codegen", "jit")
+COMPILED_MODES = (None, "codegen", "jit", "points")
 EVAL_KINDS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l")
 
 
@@ -155,7 +158,16 @@ def solver_sharing_derivatives(name: str, base: ca.Function, n_w: int,
     solver. ``base`` must have the functions ``options`` need (:func:`derivative_kinds`): an
     exact-Hessian solver cannot share from a limited-memory one.
     """
-    fns = {k: base.get_function(k) for k in derivative_kinds(options)}
+    return solver_from_functions(name, {k: base.get_function(k) for k in EVAL_KINDS
+                                        if k in derivative_kinds(options)}, n_w, options)
+
+
+def solver_from_functions(name: str, functions: Mapping[str, ca.Function], n_w: int,
+                          options: Mapping[str, Any]) -> ca.Function:
+    """An IPOPT solver whose objective, constraints and derivatives are the given functions
+    (by :data:`EVAL_KINDS` name, with nlpsol's signatures, e.g. ``nlp_jac_g: (x, p) -> (g,
+    jac_g_x)``); ``nlp_hess_l`` is used only when ``options`` ask for the exact Hessian."""
+    fns = {k: functions[k] for k in derivative_kinds(options)}
     x = ca.MX.sym("w", n_w)
     p = ca.MX.sym("p", 0)
     opts = dict(options)

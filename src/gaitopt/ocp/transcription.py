@@ -18,13 +18,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt import codegen
+from gaitopt.ocp import pointwise
 from gaitopt.ocp.bounds import Bounds, variable_bounds
 from gaitopt.ocp.estimate import interval_errors
-from gaitopt.ocp.functions import PhaseFunction, build_ends_function, build_phase_function
+from gaitopt.ocp.functions import (
+    EndsFunction,
+    PhaseFunction,
+    build_ends_function,
+    build_phase_function,
+)
 from gaitopt.ocp.guess import Guess, WarmStart, guess_vector
 from gaitopt.ocp.layout import Layout
 from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
-from gaitopt.ocp.nlp import Nlp, assemble
+from gaitopt.ocp.nlp import Nlp, assemble, assemble_expressions
+from gaitopt.ocp.pointwise import PointwiseNlp
 from gaitopt.ocp.problem import Problem
 from gaitopt.ocp.result import METHODS, NlpSize, PhaseTrajectory, Result, point_values
 from gaitopt.ocp.scaling import state_scales, variable_scales
@@ -39,6 +46,7 @@ from gaitopt.ocp.solver import (
     merge_options,
     nlp_symbols,
     options_key,
+    solver_from_functions,
     solver_sharing_derivatives,
 )
 from gaitopt.ocp.validate import ProblemError, check_problem
@@ -62,7 +70,9 @@ class Transcription:
                  compiled: str | None = None, options: Mapping[str, Any] | None = None,
                  scaling: bool = True, cse: bool = True,
                  compile_flags: Sequence[str] | None = None, build_solver: bool = True,
-                 midpoint_bounds: bool = True) -> None:
+                 midpoint_bounds: bool = True,
+                 functions: tuple[tuple[PhaseFunction, ...], EndsFunction] | None = None
+                 ) -> None:
         check_problem(problem)
         if method not in METHODS:
             raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -84,11 +94,18 @@ class Transcription:
             [(ph.name, ph.states, ph.controls, tau.size, ph.duration_spec().kind == "free")
              for ph, tau in zip(problem.phases, mesh, strict=True)], problem.parameter_names,
             midpoint_states=METHODS[method].midpoint_variables)
-        self.phase_functions: tuple[PhaseFunction, ...] = tuple(
-            build_phase_function(ph, n_p, cse=cse) for ph in problem.phases)
         sx = tuple(state_scales(ph, scaling) for ph in problem.phases)
-        ends = build_ends_function(problem, {ph.name: s for ph, s in zip(problem.phases, sx,
-                                                                          strict=True)}, cse=cse)
+        if functions is None:
+            self.phase_functions: tuple[PhaseFunction, ...] = tuple(
+                build_phase_function(ph, n_p, cse=cse) for ph in problem.phases)
+            ends = build_ends_function(problem, {ph.name: s for ph, s in
+                                                 zip(problem.phases, sx, strict=True)}, cse=cse)
+        else:
+            self.phase_functions, ends = functions
+        #: The problem's symbolic functions, which do not depend on the mesh: another
+        #: transcription of the same problem (and scaling, cse) may take them (``functions``).
+        self.functions: tuple[tuple[PhaseFunction, ...], EndsFunction] = (
+            self.phase_functions, ends)
         d_w = variable_scales(problem, self.layout, scaling)
         self.nlp: Nlp = assemble(problem, METHODS[method], mesh, self.layout,
                                  self.phase_functions, ends, d_w, sx)
@@ -97,7 +114,22 @@ class Transcription:
         self._bounds = Bounds(self.layout, self.nlp.constraints, lbw, ubw, self.nlp.lbg,
                               self.nlp.ubg, midpoint_bounds)
         self._bounds.check()
-        self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
+        self._pointwise: PointwiseNlp | None = None
+        if compiled == "points":
+            has_mid = any(pf.midpoint_rows.size > 0 for pf in self.phase_functions)
+            if not pointwise.supports(METHODS[method], has_mid):
+                raise ProblemError(f"compiled='points' needs a method that evaluates the "
+                                   f"dynamics at single grid points (hermite-simpson-separated,"
+                                   f" or trapezoidal without midpoint path constraints), not "
+                                   f"{method!r}")
+            recorder = pointwise.PointRecorder()
+            outer = assemble_expressions(problem, METHODS[method], mesh, self.layout,
+                                         self.phase_functions, ends, d_w, sx, symbols=ca.SX,
+                                         point_calls=recorder)
+            self._pointwise = pointwise.build_pointwise(outer, recorder.groups, compile_c=True)
+            self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, False)
+        else:
+            self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
         self.builds["nlp"] += 1
         # Solvers by options, and whether each has the exact Hessian (see solver()).
         self._solvers: dict[str, tuple[ca.Function, bool]] = {}
@@ -117,7 +149,10 @@ class Transcription:
             name = f"ocp_solver_{len(self._solvers)}"
             exact = exact_hessian(options)
             base = next((fn for fn, ex in self._solvers.values() if ex == exact), None)
-            if base is not None:
+            if self._pointwise is not None:
+                solver = solver_from_functions(name, self._pointwise.functions,
+                                               self.layout.size, dict(options))
+            elif base is not None:
                 solver = solver_sharing_derivatives(name, base, self.layout.size,
                                                     dict(options))
             else:
@@ -282,7 +317,9 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
                expand: bool | None = None, compiled: str | None = None,
                options: Mapping[str, Any] | None = None, scaling: bool = True,
                cse: bool = True, compile_flags: Sequence[str] | None = None,
-               build_solver: bool = True, midpoint_bounds: bool = True) -> Transcription:
+               build_solver: bool = True, midpoint_bounds: bool = True,
+               functions: tuple[tuple[PhaseFunction, ...], EndsFunction] | None = None
+               ) -> Transcription:
     """Validate ``problem``, build its NLP and solver once, and return the transcription.
 
     Args:
@@ -295,7 +332,10 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
             Default: True when not compiled (fastest interpreted), False when compiled (the
             generated C loops over the grid, so compiling takes seconds at any mesh size).
         compiled: None, ``"codegen"`` (C via gaitopt.codegen, cached on disk; recommended for
-            repeated solves of one problem) or ``"jit"`` (CasADi's jit, not cached).
+            repeated solves of one problem), ``"jit"`` (CasADi's jit, not cached) or
+            ``"points"`` (separated Hermite-Simpson or trapezoidal without midpoint path
+            constraints: exact derivatives assembled from compiled functions of one grid
+            point, :mod:`gaitopt.ocp.pointwise`; the fastest where the dynamics are costly).
         options: solver options over the defaults (``{"ipopt.tol": 1e-10}`` or
             ``{"ipopt": {"tol": 1e-10}}``).
         scaling: scale variables and constraints from bounds or given scales.
@@ -309,6 +349,9 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
         midpoint_bounds: separated Hermite-Simpson only: the state box bounds hold at the
             midpoint state variables too (default). ``False`` leaves them unbounded, which
             makes the NLP equivalent to the compressed one (the same optimum on every mesh).
+        functions: the symbolic functions of ``problem`` from another transcription of it
+            with the same ``scaling`` and ``cse`` (``other.functions``): they do not depend
+            on the mesh or the method, and building them is most of a build.
     """
     if method not in METHODS:
         raise ProblemError(f"method must be one of {list(METHODS)}, got {method!r}")
@@ -316,4 +359,5 @@ def transcribe(problem: Problem, *, method: str = "hermite-simpson",
     mesh = make_mesh(problem, intervals)
     return Transcription(problem, method, mesh, expand=expand, compiled=compiled,
                          options=options, scaling=scaling, cse=cse, compile_flags=compile_flags,
-                         build_solver=build_solver, midpoint_bounds=midpoint_bounds)
+                         build_solver=build_solver, midpoint_bounds=midpoint_bounds,
+                         functions=functions)

@@ -1,0 +1,300 @@
+"""Exact NLP derivatives assembled from derivatives at single grid points (compiled once).
+
+In a transcription whose constraints touch the dynamics at single grid points only (separated
+Hermite-Simpson; trapezoidal without midpoint path constraints) the scaled NLP has the form::
+
+    f(w) = F(w, Y),   g(w) = G(w, Y),   Y_j = phi(z_j(w))   at every grid point j,
+
+where ``phi(z) -> y = (xdot (n), path (r), L (1))`` is the phase's point function of one
+point, ``z_j = (x_j, u_j, p, t_j)`` its input (a selection of w and the time, a cheap
+expression of w), and ``F``, ``G`` (the "outer" functions: defects, quadrature, linkages,
+boundary rows, scaling) are cheap expressions, linear in ``Y`` for collocation. With
+``J = blockdiag_j dphi/dz (z_j)`` (ny x nz per point), ``Dz = dz/dw``, the Lagrangian
+``L = sigma F + lambda^T G``, ``mu = dL/dY`` (ny per point), ``nu = J^T mu`` and
+``H = blockdiag_j Hess_z (mu_j^T phi)(z_j)`` (nz x nz per point), the chain rule gives::
+
+    grad f  = F_w + Dz^T J^T F_Y                                          (nw,)
+    jac g   = G_w + G_Y J Dz                                              (ng, nw)
+    hess L  = L_ww + (L_wY J Dz) + (L_wY J Dz)^T + (J Dz)^T L_YY (J Dz)
+              + Dz^T H Dz + Hess_w (nu^T z(w))                            (nw, nw)
+
+(IPOPT receives the upper triangle; ``f``, ``g`` and ``grad f`` are evaluated instead as one SX
+graph with the point functions inlined, since ``f`` reads only the cheap integrand of each
+point). Only ``phi``, its Jacobian and the weighted Hessian
+``Hess_z (mu^T phi)`` see the dynamics; they are functions of one point, so their size and
+the time to compile them do not depend on the mesh. They are generated as C once per point
+function and compiled into the disk cache of :mod:`gaitopt.codegen` (keyed by a hash of the
+serialized point function, which determines the C, see :func:`library_key`: a changed model
+or problem compiles anew; an unchanged one loads in milliseconds) and mapped over the grid.
+Without a C compiler the same functions run in CasADi's virtual machine. The outer functions
+are small SX functions, always interpreted.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from gaitopt import codegen
+from gaitopt.ocp.method import Method
+from gaitopt.ocp.nlp import Assembly
+
+#: C compiler flags of the point libraries: ``-O1`` compiles the five-link biped's point
+#: Hessians about twice as fast as ``-O2`` (3-6 s against 4-13 s per phase on an idle
+#: machine).
+POINT_FLAGS: tuple[str, ...] = ("-O1", "-fPIC", "-shared")
+#: Flags for large point functions (more than :data:`LARGE_POINT` instructions, e.g. the
+#: seven-link model with feet): ``-O0`` compiles 5-6x faster than ``-O1`` and evaluates
+#: 3-4x slower, still about 5x faster than CasADi's VM (the five-link point Hessians on a
+#: busy machine: 3-5 s against 16-33 s to compile, 70-92 against 16-29 us per point, VM
+#: 330-480 us). The size of a point's Hessian grows with its instructions, and the time of
+#: ``-O1`` faster than linearly with the size of one C function.
+LARGE_POINT_FLAGS: tuple[str, ...] = ("-O0", "-fPIC", "-shared")
+LARGE_POINT = 1300
+
+
+def point_flags(point: ca.Function) -> tuple[str, ...]:
+    """The compiler flags of ``point``'s library (by its number of instructions)."""
+    return POINT_FLAGS if point.n_instructions() <= LARGE_POINT else LARGE_POINT_FLAGS
+#: Version of the generated point libraries (part of their cache key): change it when the
+#: functions a library holds change.
+FORMAT = "gaitopt-points-1"
+
+
+def supports(method: Method, has_midpoint_rows: bool) -> bool:
+    """Whether the NLP of ``method`` evaluates the dynamics at single grid points only (no
+    point function of an expression of point outputs): the separated Hermite-Simpson form,
+    or a method without midpoint dynamics and without path constraints at midpoints."""
+    if method.midpoint_variables:
+        return True
+    return not (method.needs_midpoint_dynamics or has_midpoint_rows)
+
+
+def stacked_point(point: ca.Function) -> ca.Function:
+    """``point(x, u, p, t) -> (xdot, path, L)`` as one function of ``z = [x; u; p; t]``
+    (nz, 1) returning ``y = [xdot; path; L]`` (ny, 1)."""
+    sizes = [point.size1_in(i) for i in range(point.n_in())]
+    z = ca.SX.sym("z", int(sum(sizes)))
+    parts = ca.vertsplit(z, np.concatenate([[0], np.cumsum(sizes)]).astype(int).tolist())
+    y = ca.vertcat(*point(*parts))
+    return ca.Function(stacked_name(point), [z], [y], ["z"], ["y"])
+
+
+def stacked_name(point: ca.Function) -> str:
+    """The name of :func:`stacked_point` of ``point`` (its derivatives add ``_jac``,
+    ``_hess``)."""
+    return f"{point.name()}_y"
+
+
+@dataclass(frozen=True)
+class PointDerivatives:
+    """The functions of one point: ``value(z) -> y``, ``jacobian(z) -> (y, J)`` with J
+    (ny, nz), ``hessian(z, mu) -> (J, H)`` with H = Hess_z (mu^T y) (nz, nz), symmetric.
+    ``compiled``: loaded from a C library (else CasADi SX functions)."""
+
+    value: ca.Function
+    jacobian: ca.Function
+    hessian: ca.Function
+    compiled: bool
+
+    @staticmethod
+    def of(functions: list[ca.Function], compiled: bool) -> PointDerivatives:
+        """From ``[value, jacobian, hessian]``."""
+        value, jacobian, hessian = functions
+        return PointDerivatives(value, jacobian, hessian, compiled)
+
+    @staticmethod
+    def derive(point: ca.Function) -> list[ca.Function]:
+        """The three SX functions of ``point`` (see the class docstring)."""
+        phi = stacked_point(point)
+        z = ca.SX.sym("z", phi.size1_in(0))
+        y = phi(z)
+        mu = ca.SX.sym("mu", y.shape[0])
+        jac = ca.jacobian(y, z)
+        hess, _ = ca.hessian(ca.dot(mu, y), z)
+        base = phi.name()
+        return [phi,
+                ca.Function(f"{base}_jac", [z], list(ca.cse([y, jac])), ["z"], ["y", "J"]),
+                ca.Function(f"{base}_hess", [z, mu], list(ca.cse([jac, hess])), ["z", "mu"],
+                            ["J", "H"])]
+
+
+def library_key(point: ca.Function, flags: tuple[str, ...] = POINT_FLAGS) -> str:
+    """The cache key of the point library of ``point``: a hash of the serialized point
+    function, CasADi's version, the compiler and its flags, and :data:`FORMAT` (the C is a
+    deterministic function of these, so a cached library is found without deriving or
+    generating anything)."""
+    text = "\0".join([FORMAT, point.serialize(), ca.CasadiMeta.version(), codegen.compiler(),
+                      *flags])
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def point_derivatives(points: list[ca.Function], compile_c: bool
+                      ) -> list[PointDerivatives]:
+    """The :class:`PointDerivatives` of each point function; with ``compile_c`` compiled
+    (one library per point function, compiled in parallel, cached on disk by
+    :func:`library_key`), else, or when no C compiler is found or it fails (a warning),
+    CasADi SX functions."""
+    if not (compile_c and codegen.has_compiler()):
+        return [PointDerivatives.of(PointDerivatives.derive(p), compiled=False) for p in points]
+    libs = {f"pt_{p.name()}": p for p in points}
+    flags = {lib: point_flags(p) for lib, p in libs.items()}
+    paths = {lib: codegen.cache_dir() / f"{lib}-{library_key(p, flags[lib])}.so"
+             for lib, p in libs.items()}
+    missing = [lib for lib, path in paths.items() if not path.exists()]
+    if missing:
+        sources = {lib: codegen.generate_source(PointDerivatives.derive(libs[lib]), lib)
+                   for lib in missing}
+        try:
+            codegen.compile_libraries(sources, targets={lib: paths[lib] for lib in missing},
+                                      flags_by_name={lib: flags[lib] for lib in missing})
+        except codegen.CompileError as exc:
+            warnings.warn(f"compiling the point functions failed, evaluating them in CasADi's "
+                          f"VM instead: {str(exc)[:300]}", RuntimeWarning, stacklevel=2)
+            return point_derivatives(points, compile_c=False)
+    out = []
+    for lib, p in libs.items():
+        base = stacked_name(p)
+        ext = [ca.external(name, str(paths[lib]))
+               for name in (base, f"{base}_jac", f"{base}_hess")]
+        out.append(PointDerivatives.of(ext, compiled=True))
+    return out
+
+
+@dataclass(frozen=True)
+class _Group:
+    """The M grid points of one phase: their inputs z (nz, M) as an SX expression of w and
+    the symbols standing for their outputs (ny, M)."""
+
+    phase: int
+    point: ca.Function
+    z: ca.SX
+    y: ca.SX
+
+
+class PointRecorder:
+    """A :data:`gaitopt.ocp.nlp.PointCalls` that records the inputs of every point call
+    (SX) and returns fresh symbols for the outputs."""
+
+    def __init__(self) -> None:
+        self.groups: list[_Group] = []
+
+    def __call__(self, i: int, point: ca.Function, X: Any, U: Any, p: Any, t: Any
+                 ) -> tuple[Any, Any, Any]:
+        M = int(X.shape[1])
+        z = ca.vertcat(X, U, ca.repmat(p, 1, M), t)
+        n, r = point.size1_out(0), point.size1_out(1)
+        y = ca.SX.sym(f"y{len(self.groups)}", n + r + 1, M)
+        self.groups.append(_Group(i, point, z, y))
+        return y[:n, :], y[n:n + r, :], y[n + r:, :]
+
+
+def _block_diagonal(mapped: ca.MX, block: ca.Sparsity, count: int) -> ca.MX:
+    """The block-diagonal matrix of ``count`` blocks of sparsity ``block`` from their
+    horizontal concatenation ``mapped`` (a map's output): both store the nonzeros in the same
+    (column-major) order."""
+    sp = ca.diagcat(*[ca.DM(block, 1.0)] * count).sparsity()
+    return ca.MX(sp, mapped.nz[:])
+
+
+@dataclass(frozen=True)
+class PointwiseNlp:
+    """The solver functions of an NLP with the signatures ``nlpsol`` uses:
+    ``nlp_f (w, p) -> f``, ``nlp_g (w, p) -> g``, ``nlp_grad_f (w, p) -> (f, grad)``,
+    ``nlp_jac_g (w, p) -> (g, jac)``, ``nlp_hess_l (w, p, lam_f, lam_g) -> triu(hess)``."""
+
+    functions: dict[str, ca.Function]
+    compiled: bool
+
+
+def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
+                    ) -> PointwiseNlp:
+    """The exact derivative functions of the SX ``assembly`` whose point outputs are the
+    recorded ``groups`` (see the module docstring)."""
+    w = assembly.w_hat
+    nw = int(w.shape[0])
+    ng = int(assembly.g.shape[0])
+    Y = ca.vertcat(*[ca.vec(gr.y) for gr in groups])
+    Z = ca.vertcat(*[ca.vec(gr.z) for gr in groups])
+    F, G = assembly.f, assembly.g
+    sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
+    lagrangian = sigma * F + ca.dot(lam, G)
+    L_w, L_Y = ca.gradient(lagrangian, w), ca.gradient(lagrangian, Y)
+    outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), ca.jacobian(G, Y)])
+    L_YY = ca.jacobian(L_Y, Y)
+    outer_hess = ca.Function("outer_hess", [w, Y, sigma, lam],
+                             [ca.jacobian(L_w, w), ca.jacobian(L_w, Y), L_YY, L_Y])
+    nu = ca.SX.sym("nu", Z.shape[0])
+    z_of_w = ca.Function("z_of_w", [w], [Z, ca.jacobian(Z, w)])
+    z_hess = ca.Function("z_hess", [w, nu], [ca.hessian(ca.dot(nu, Z), w)[0]])
+
+    derivs = point_derivatives([gr.point for gr in groups], compile_c)
+    W, P = ca.MX.sym("w", nw), ca.MX.sym("p", 0)
+    Zv, Dz = z_of_w(W)
+    sizes = [(int(gr.z.shape[0]), int(gr.y.shape[0]), int(gr.z.shape[1])) for gr in groups]
+
+    def split(v: ca.MX, rows_of: int) -> list[ca.MX]:
+        out, pos = [], 0
+        for s in sizes:
+            rows, M = s[rows_of], s[2]
+            out.append(ca.reshape(v[pos:pos + rows * M], rows, M))
+            pos += rows * M
+        return out
+
+    Zs = split(Zv, 0)
+
+    def values() -> ca.MX:
+        return ca.vertcat(*[ca.vec(d.value.map(s[2])(z))
+                            for d, s, z in zip(derivs, sizes, Zs, strict=True)])
+
+    def jacobian_of_points(jac_outputs: list[ca.MX]) -> ca.MX:
+        blocks = [_block_diagonal(Jm, d.jacobian.sparsity_out(1), s[2])
+                  for d, s, Jm in zip(derivs, sizes, jac_outputs, strict=True)]
+        return ca.diagcat(*blocks)
+
+    Yv = values()
+    # The objective and constraints themselves as one SX graph (the point functions inlined
+    # at every point): a few VM instructions per point, cheaper than a call of a compiled
+    # function per point, and no derivative of it is ever taken.
+    Y_sx = ca.vertcat(*[ca.vec(stacked_point(gr.point).map(int(gr.z.shape[1]))(gr.z))
+                        for gr in groups])
+    F_sx, G_sx = ca.substitute([F, G], [Y], [ca.densify(Y_sx)])
+    P_sx = ca.SX.sym("p", 0)
+    # The objective's gradient by reverse AD of that graph: the objective reads only the
+    # integrand L of each point (cheap next to the dynamics), so its graph and its gradient
+    # are small, smaller than the point Jacobians the chain rule would need.
+    fns: dict[str, ca.Function] = {
+        "nlp_f": ca.Function("nlp_f", [w, P_sx], [F_sx], ["x", "p"], ["f"]),
+        "nlp_g": ca.Function("nlp_g", [w, P_sx], [G_sx], ["x", "p"], ["g"]),
+        "nlp_grad_f": ca.Function("nlp_grad_f", [w, P_sx], [F_sx, ca.gradient(F_sx, w)],
+                                  ["x", "p"], ["f", "grad_f_x"]),
+    }
+    jac_calls = [d.jacobian.map(s[2])(z) for d, s, z in zip(derivs, sizes, Zs, strict=True)]
+    Yj = ca.vertcat(*[ca.vec(c[0]) for c in jac_calls])
+    JD = ca.mtimes(jacobian_of_points([c[1] for c in jac_calls]), Dz)
+    g1, G_w, G_Y = outer_jac(W, Yj)
+    fns["nlp_jac_g"] = ca.Function("nlp_jac_g", [W, P], [g1, G_w + ca.mtimes(G_Y, JD)],
+                                   ["x", "p"], ["g", "jac_g_x"])
+
+    S, Lam = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", ng)
+    L_ww, L_wY, L_YYv, mu = outer_hess(W, Yv, S, Lam)
+    mus = split(mu, 1)
+    hess_calls = [d.hessian.map(s[2])(z, m)
+                  for d, s, z, m in zip(derivs, sizes, Zs, mus, strict=True)]
+    JBh = jacobian_of_points([c[0] for c in hess_calls])
+    HB = ca.diagcat(*[_block_diagonal(Hm, d.hessian.sparsity_out(1), s[2])
+                      for d, s, Hm in zip(derivs, sizes, [c[1] for c in hess_calls],
+                                          strict=True)])
+    JDh = ca.mtimes(JBh, Dz)
+    cross = ca.mtimes(L_wY, JDh)
+    H = L_ww + cross + cross.T + ca.mtimes([Dz.T, HB, Dz]) + z_hess(W, ca.mtimes(JBh.T, mu))
+    if L_YY.nnz() > 0:
+        H = H + ca.mtimes([JDh.T, L_YYv, JDh])
+    fns["nlp_hess_l"] = ca.Function("nlp_hess_l", [W, P, S, Lam], [ca.triu(H)],
+                                    ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
+    return PointwiseNlp(fns, compiled=all(d.compiled for d in derivs))

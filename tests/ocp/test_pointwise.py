@@ -1,0 +1,189 @@
+"""Derivatives assembled from point functions (``compiled="points"``, gaitopt.ocp.pointwise):
+the same values as CasADi's derivatives of the expanded NLP (compiled and in the VM), the
+same optima, and the disk cache of the compiled point libraries (reused; rebuilt when the
+model changes)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import problems as P
+import pytest
+
+from gaitopt import codegen
+from gaitopt.ocp import (
+    Duration,
+    Parameter,
+    PathConstraint,
+    Phase,
+    Problem,
+    ProblemError,
+    Transcription,
+    transcribe,
+)
+from gaitopt.ocp.solver import EVAL_KINDS
+
+SEPARATED = "hermite-simpson-separated"
+
+
+def nonlinear(gain: float = 1.0, intervals: int = 5) -> Problem:
+    """A pendulum-like phase whose dynamics, path constraint and integrand depend nonlinearly
+    on the states, controls, time and parameters, with a duration that is a nonlinear
+    expression of a free parameter (so the knot times are nonlinear in w): every term of the
+    chain rule (outer, cross, point and time Hessians) is nonzero."""
+    def f(x: ca.SX, u: ca.SX, p: ca.SX, t: ca.SX) -> ca.SX:
+        return ca.vertcat(x[1] * p[0], -gain * ca.sin(x[0]) * p[1] + u[0] * ca.cos(t * x[0]))
+
+    duration = Duration.of_parameters(lambda p: 0.5 + p[0] ** 2)
+    swing = Phase("swing", ["q", "w"], ["tau"], f, duration,
+                  initial_state={"q": 0.0, "w": 0.0}, final_state={"q": 1.0},
+                  lagrange=lambda x, u, p, t: u[0] ** 2 * (1 + x[1] ** 2) + p[0] * t,
+                  path_constraints=[PathConstraint("reach", lambda x, u, p, t:
+                                                   x[0] * x[1] + ca.exp(0.1 * u[0] * t),
+                                                   lower=-5.0, upper=5.0)],
+                  intervals=intervals)
+    return Problem([swing], parameters=[Parameter("a", 0.5, 2.0, guess=1.0),
+                                        Parameter("b", 1.0, 1.0)])
+
+
+def solver_values(tr: Transcription, w: np.ndarray, lam: np.ndarray
+                  ) -> dict[str, list[np.ndarray]]:
+    """Every solver function of ``tr`` at scaled ``w`` (dense outputs)."""
+    solver = tr.solver(tr.options)
+    out = {}
+    for kind in EVAL_KINDS:
+        fn = solver.get_function(kind)
+        args = [w, []] + ([0.7, lam] if kind == "nlp_hess_l" else [])
+        res = fn(*args)
+        res = res if isinstance(res, list | tuple) else [res]
+        out[kind] = [np.asarray(ca.DM(r).full()) for r in res]
+    return out
+
+
+@pytest.mark.parametrize("make", [nonlinear, lambda: P.periodic_ratio(intervals=4),
+                                  lambda: P.brachistochrone(intervals=6)],
+                         ids=["nonlinear", "periodic_ratio", "brachistochrone"])
+@pytest.mark.parametrize("compiled_points", [True, False], ids=["compiled", "vm"])
+def test_point_derivatives_equal_those_of_the_expanded_nlp(
+        make: object, compiled_points: bool, tmp_path: Path,
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    if not compiled_points:
+        monkeypatch.setattr(codegen, "has_compiler", lambda: False)
+    problem = make()  # type: ignore[operator]
+    ref = transcribe(problem, method=SEPARATED)
+    tr = transcribe(problem, method=SEPARATED, compiled="points")
+    assert tr._pointwise is not None and tr._pointwise.compiled == compiled_points
+    rng = np.random.default_rng(3)
+    w = ref.initial_guess() / ref.nlp.d_w * (1 + 0.1 * rng.standard_normal(ref.layout.size))
+    w += 0.05 * rng.standard_normal(w.size)
+    lam = rng.standard_normal(ref.nlp.lbg.size)
+    expected, got = solver_values(ref, w, lam), solver_values(tr, w, lam)
+    for kind in EVAL_KINDS:
+        for e, g in zip(expected[kind], got[kind], strict=True):
+            assert g.shape == e.shape, kind
+            assert np.max(np.abs(g - e)) <= 1e-11 * max(1.0, np.max(np.abs(e))), kind
+    # The Hessian is not trivially zero anywhere it matters (the test could fail).
+    assert np.count_nonzero(expected["nlp_hess_l"][0]) > ref.layout.size
+
+
+def test_points_mode_reaches_the_same_optimum(tmp_path: Path,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    plain = transcribe(P.periodic_ratio(intervals=6), method=SEPARATED).solve()
+    res = transcribe(P.periodic_ratio(intervals=6), method=SEPARATED,
+                     compiled="points").solve()
+    assert res.success and plain.success
+    assert res.objective == pytest.approx(4.0, rel=1e-6)       # J* = 2 sqrt(c), c = 4
+    assert res.objective == pytest.approx(plain.objective, rel=1e-10)
+    assert res.iterations == plain.iterations
+    assert np.allclose(res.w, plain.w, rtol=1e-8, atol=1e-10)
+
+
+def test_point_libraries_are_cached_and_rebuilt_when_the_model_changes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    first = transcribe(nonlinear(1.0), method=SEPARATED, compiled="points")
+    libs = sorted(tmp_path.glob("pt_*.so"))
+    assert len(libs) == 1
+    stamp = libs[0].stat().st_mtime_ns
+
+    def no_compiling(*args: object, **kwargs: object) -> None:
+        raise AssertionError("compiled although the library is cached")
+
+    # Another mesh and another process-level build: the library is loaded, not compiled.
+    monkeypatch.setattr(codegen, "compile_libraries", no_compiling)
+    again = transcribe(nonlinear(1.0, intervals=9), method=SEPARATED, compiled="points")
+    assert sorted(tmp_path.glob("pt_*.so")) == libs and libs[0].stat().st_mtime_ns == stamp
+    assert again.solve().success
+    monkeypatch.undo()
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    # A changed model (another gain in the dynamics) compiles a new library.
+    changed = transcribe(nonlinear(2.0), method=SEPARATED, compiled="points")
+    assert len(list(tmp_path.glob("pt_*.so"))) == 2
+    a, b = first.solve(), changed.solve()
+    assert a.success and b.success and not math.isclose(a.objective, b.objective)
+
+
+def test_points_mode_refuses_the_compressed_form() -> None:
+    with pytest.raises(ProblemError, match="compiled='points' needs a method"):
+        transcribe(P.double_integrator(4), compiled="points")
+
+
+@pytest.mark.slow
+def test_walking_optimum_of_the_points_mode_is_optimal_for_the_expanded_nlp() -> None:
+    # The walking solve evaluates the separated form by points; from its optimum, the same
+    # NLP evaluated by CasADi's derivatives of the expanded graph converges to the same point.
+    from gaitopt.gait.formulation import problem_for, stage_bounds
+    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.problem import Relaxation, parameter_bounds, with_step_time
+    from gaitopt.gait.solve import solve_walking
+    from gaitopt.gait.transcriptions import transcription_for
+    from gaitopt.robot import load_model
+
+    model = load_model("five-link")
+    options = GaitOptions.paper(speed=0.2, transcription=SEPARATED)
+    solution = solve_walking(model, options)
+    assert solution.success
+    tr = transcription_for(model, options, options.knots)
+    assert tr.compiled == "points"
+    problem = problem_for(model, options)
+    vm = transcribe(problem, method=SEPARATED, options=tr.options, intervals={
+        ph.name: k - 1 for ph, k in zip(problem.phases, options.knots, strict=True)})
+    bounds = with_step_time(stage_bounds(vm, Relaxation(), options), options)
+    again = vm.solve(solution.result, bounds=bounds, parameters=parameter_bounds(options),
+                     warm_start_multipliers=True)
+    assert again.success
+    assert again.objective == pytest.approx(solution.result.objective, rel=1e-9)
+    assert again.parameters["step_length"] == pytest.approx(
+        solution.result.parameters["step_length"], rel=1e-6)
+
+
+def test_a_failing_compiler_falls_back_to_the_vm(tmp_path: Path,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("CC", str(tmp_path / "broken-cc"))
+    (tmp_path / "broken-cc").write_text("#!/bin/sh\necho 'cc: internal error' >&2\nexit 1\n")
+    (tmp_path / "broken-cc").chmod(0o755)
+    with pytest.warns(RuntimeWarning, match="compiling the point functions failed"):
+        tr = transcribe(P.periodic_ratio(intervals=3), method=SEPARATED, compiled="points")
+    assert tr._pointwise is not None and not tr._pointwise.compiled
+    assert tr.solve().objective == pytest.approx(4.0, rel=1e-6)
+    assert not list(tmp_path.glob("pt_*.so"))
+
+
+def test_large_point_functions_compile_with_the_fast_flags() -> None:
+    from gaitopt.ocp.pointwise import LARGE_POINT, LARGE_POINT_FLAGS, POINT_FLAGS, point_flags
+
+    x = ca.SX.sym("x", 2)
+    small = ca.Function("small", [x], [ca.sin(x[0]) * x[1]])
+    big_expr = x[0]
+    for k in range(LARGE_POINT):
+        big_expr = ca.sin(big_expr + k * x[1])
+    big = ca.Function("big", [x], [big_expr])
+    assert small.n_instructions() <= LARGE_POINT < big.n_instructions()
+    assert point_flags(small) == POINT_FLAGS and "-O1" in POINT_FLAGS
+    assert point_flags(big) == LARGE_POINT_FLAGS and "-O0" in LARGE_POINT_FLAGS
