@@ -205,3 +205,13 @@ def test_warm_start_from_a_gait_file_solves_a_nearby_speed_in_one_stage(
     bad = solve("--warm-start", str(broken), "-o", str(tmp_path / "x.gait.json"))
     assert bad.exit_code == 2 and "--warm-start" in " ".join(bad.output.split())
     assert "Traceback" not in bad.output
+
+
+def test_a_coarse_grid_for_a_heel_toe_step_is_noted(no_solve: None, tmp_path: Path) -> None:
+    """The seven-link heel-toe walk fails verify between knots on coarse grids
+    (docs/feet.md): the solve says so before it starts."""
+    result = solve("--model", "seven-link", "--gait", "heel-toe", "--speed", "30m/min",
+                   "-o", str(tmp_path / "g.gait.json"))
+    text = " ".join(result.output.split())
+    assert "full coordinates" in text
+    assert "4-phase step on 16+6 knots is coarse" in text and "24,16" in text

@@ -54,6 +54,11 @@ def _speed(text: str) -> float | None:
 FAR_FROM_REFERENCE = 0.25
 
 
+#: The grid on which the seven-link heel-toe walk passes ``verify`` (docs/feet.md: 8+5 and
+#: 16+10 do not, 24+16 does at 30-80 m/min).
+FOUR_PHASE_KNOTS = (24, 16)
+
+
 def read_sequence(path: Path) -> dict[str, Any]:
     """A contact sequence file (YAML): its data, checked for form (the model check comes with
     the options)."""
@@ -223,6 +228,13 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
         console.print("note: far from 12 m/min a cold solve can end in a worse local optimum; "
                       "--multistart also tries the continuation in speed and keeps the best")
+    sequence_used = checked_sequence(model, options)
+    if (sequence_used is not None and len(sequence_used.phases) > 2
+            and tuple(options.knots) < FOUR_PHASE_KNOTS):
+        console.print(f"note: a {len(sequence_used.phases)}-phase step on {options.knots[0]}+"
+                      f"{options.knots[1]} knots is coarse; the heel-toe walk passes verify on "
+                      f"{FOUR_PHASE_KNOTS[0]},{FOUR_PHASE_KNOTS[1]} or finer (--knots; "
+                      "docs/feet.md)")
     if start is not None and not warm_start_usable(start, options):
         console.print(f"note: {warm_start} was solved with other ankle torques or another "
                       "single-support fraction; starting cold")
