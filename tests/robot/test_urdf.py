@@ -49,6 +49,17 @@ def test_five_link_round_trip_is_the_same_model() -> None:
     assert [link.shape for link in back.links] == [link.shape for link in original.links]
 
 
+def test_seven_link_round_trip_keeps_feet_and_the_declared_symmetry() -> None:
+    """The model with feet: heel and toe frames, joint ankles, and the declared symmetry
+    (in ``<gaitopt>`` as ``<swap>`` pairs) come back as they were."""
+    original = load_model("seven-link")
+    text = urdf_from_model(original)
+    assert '<swap kind="contact" a="heel_1" b="heel_2"' in text
+    back = model_from_urdf(text)
+    assert back == original and back.symmetry == original.symmetry
+    assert back.content_hash() == original.content_hash()
+
+
 # names with characters XML must escape; contact names apart from link names (one namespace)
 names = st.text(st.sampled_from("ab_1 <&\"'é"), min_size=1, max_size=6).filter(
     lambda s: s == s.strip() and s not in ("x", "y"))

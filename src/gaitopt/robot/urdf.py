@@ -373,4 +373,6 @@ class _Importer:
             data["gravity"] = ext.gravity
         if ext.description is not None:
             data["description"] = ext.description
+        if ext.symmetry is not None:
+            data["symmetry"] = ext.symmetry
         return data

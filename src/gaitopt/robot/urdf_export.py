@@ -98,5 +98,10 @@ def urdf_from_model(model: RobotModel) -> str:
         target = {"joint": a.joint} if a.joint is not None else {"contact": a.contact or ""}
         ET.SubElement(ext, "actuator", {"name": a.name, **target, "lower": _num(a.limits[0]),
                                         "upper": _num(a.limits[1])})
+    if model.symmetry is not None:  # a declared symmetry: <swap kind="link|contact" a= b=>
+        for kind, pairs in (("link", model.symmetry.links),
+                            ("contact", model.symmetry.contacts)):
+            for a_name, b_name in pairs:
+                ET.SubElement(ext, "swap", kind=kind, a=a_name, b=b_name)
     ET.indent(robot, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"

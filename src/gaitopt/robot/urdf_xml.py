@@ -188,6 +188,8 @@ class Extension:
         self.description: str | None = None
         self.shapes: dict[str, dict[str, Any]] = {}
         self.links: dict[str, tuple[str, float]] = {}
+        #: The declared symmetry (``<swap kind="link|contact" a=... b=...>``), or None.
+        self.symmetry: dict[str, list[list[str]]] | None = None
         if elem is None:
             return
         where = "<gaitopt>"
@@ -216,6 +218,15 @@ class Extension:
             if s.get("radius") is not None:
                 shape["radius"] = r.number(f"{where} shape {link!r} radius", s.get("radius"))
             self.shapes[link] = shape
+        swaps = elem.findall("swap")
+        if swaps:
+            self.symmetry = {"links": [], "contacts": []}
+            for e in swaps:
+                kind = e.get("kind")
+                if kind not in ("link", "contact"):
+                    raise r.fail(f"{where} swap kind", kind, "link or contact")
+                pair = [r.name(f"{where} <swap>", e, "a"), r.name(f"{where} <swap>", e, "b")]
+                self.symmetry[f"{kind}s"].append(pair)
         for e in elem.findall("link"):
             link = r.name(f"{where} <link>", e)
             direction = e.get("direction")
