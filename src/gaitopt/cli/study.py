@@ -357,9 +357,10 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @click.option("--paper-grid", is_flag=True,
               help="The paper's setting: 8+5 knots and its control model (continuous, "
                    "periodic controls); checked against 16+6 knots.")
+@knots_option
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
-                  paper_grid: bool, cost_study: bool, costs: tuple[str, ...],
+                  paper_grid: bool, knots: str | None, cost_study: bool, costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, clearance: float | None, gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
@@ -377,14 +378,14 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                        costs=costs or ("paper", "work", "metabolic"),
                        resting_powers=resting_powers, regularization=regularization,
                        clearance=clearance, gait=gait_kind, formulation=formulation,
-                       workers=workers, scheduler=scheduler)
+                       knots=knots, workers=workers, scheduler=scheduler)
         return
     if len(model_names) > 1:
         raise UserError("--model: the paper's study takes one model (several only with "
                         "--costs)")
     directory = directory or STUDY_DIR
     start = time.perf_counter()
-    grid = grid_choice(None, None, paper_grid)
+    grid = grid_choice(knots, None, paper_grid)
     model_name = model_names[0] if model_names else "five-link"
     spec = make_spec(model_name=model_name, speeds=speeds,
                      variants="all", free=True, step_length="free", single_support="0.85",
@@ -428,7 +429,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
 def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
                    costs: Sequence[str], resting_powers: str, regularization: float,
                    formulation: str, clearance: float | None = None, gait: str = "auto",
-                   workers: int | None, scheduler: str | None) -> None:
+                   knots: str | None = None, workers: int | None,
+                   scheduler: str | None) -> None:
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
     processes keep their built problems), then ``costs.csv``, the report and the findings."""
     from gaitopt.gait.api import as_model
@@ -455,7 +457,8 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                              costs=tuple(dict.fromkeys(costs)),
                              resting_powers=tuple(powers), regularization=regularization,
                              swing_clearance=clearance, gait=gait,
-                             formulation=formulation)  # type: ignore[arg-type]
+                             formulation=formulation,  # type: ignore[arg-type]
+                             knots=(8, 5) if knots is None else parse_knots(knots))
         sweeps = spec.sweeps()
     except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
