@@ -212,7 +212,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     try:
         validate_options(options, biped_of(model, options))
-        checked_sequence(model, options)
+        sequence_used = checked_sequence(model, options)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     console.print(f"solving {options.variant} on model {model.name}: speed "
@@ -228,7 +228,6 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
             and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
         console.print("note: far from 12 m/min a cold solve can end in a worse local optimum; "
                       "--multistart also tries the continuation in speed and keeps the best")
-    sequence_used = checked_sequence(model, options)
     if (sequence_used is not None and len(sequence_used.phases) > 2
             and tuple(options.knots) < FOUR_PHASE_KNOTS):
         console.print(f"note: a {len(sequence_used.phases)}-phase step on {options.knots[0]}+"

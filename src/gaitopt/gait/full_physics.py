@@ -9,6 +9,7 @@ the projection controls ``gamma, nu`` of its held points (docs/formulations.md Â
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -34,6 +35,7 @@ class Symmetry:
     contacts: Mapping[str, str]
 
 
+@functools.lru_cache(maxsize=16)
 def model_symmetry(model: RobotModel) -> Symmetry:
     """The leg swap of a model (declared in its file or inferred:
     :mod:`gaitopt.robot.symmetry`)."""
