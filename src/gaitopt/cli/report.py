@@ -27,18 +27,28 @@ def sweep_dirs(directory: Path) -> list[Path]:
     return subs
 
 
-def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
-    """Write the report of each (sub-)sweep, print where and the findings."""
+def write_reports(console: Console, directory: Path, out: Path,
+                  compare: tuple[Path, ...] = ()) -> list[Path]:
+    """Write the report of each (sub-)sweep, print where and the findings; ``compare``: other
+    sweep folders drawn beside each (printed: their optima against people's walk)."""
     from gaitopt.study.findings import findings_text
     from gaitopt.viz.report import write_report
+    from gaitopt.viz.sweep_comparison import comparison_text, load_compared_sweep
 
+    for other in compare:
+        if not (other / SUMMARY_FILE).exists():
+            raise UserError(f"--compare {other}: no sweep here (no {SUMMARY_FILE})")
     pages = []
     for sweep in sweep_dirs(directory):
         target = out if sweep == directory else out / sweep.name
         try:
-            info = write_report(sweep, target)
+            info = write_report(sweep, target, compare=compare)
+            if compare:
+                compared = [load_compared_sweep(d) for d in (sweep, *compare)]
         except SummaryError as exc:
             raise UserError(str(exc)) from None
+        if compare:
+            console.print("\n".join(["compared:", *comparison_text(compared)]), soft_wrap=True)
         console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)",
                       soft_wrap=True)
         for problem in info.problems:
@@ -52,7 +62,11 @@ def write_reports(console: Console, directory: Path, out: Path) -> list[Path]:
 @click.argument("directory", type=click.Path(file_okay=False, path_type=Path))
 @click.option("-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder of the report (default: DIRECTORY/report).")
-def report_command(directory: Path, output: Path | None) -> None:
+@click.option("--compare", "compare", multiple=True,
+              type=click.Path(file_okay=False, path_type=Path),
+              help="Another sweep folder to draw beside this one (energy and step length "
+                   "against speed, optima, people's walk); repeatable.")
+def report_command(directory: Path, output: Path | None, compare: tuple[Path, ...]) -> None:
     """Write the figures and the HTML report of a sweep (or of a cost study), and print the
     findings."""
     from gaitopt.study.cost_study import COST_STUDY_FILE
@@ -60,9 +74,11 @@ def report_command(directory: Path, output: Path | None) -> None:
     if not directory.is_dir():
         raise UserError(f"{directory}: no such directory")
     if (directory / COST_STUDY_FILE).exists():
+        if compare:
+            raise UserError("--compare: a cost study's report compares costs; give sweeps")
         write_cost_reports(make_console(), directory, output or directory / "report")
         return
-    write_reports(make_console(), directory, output or directory / "report")
+    write_reports(make_console(), directory, output or directory / "report", compare)
 
 
 def write_cost_reports(console: Console, directory: Path, out: Path) -> Path:

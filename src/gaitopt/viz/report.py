@@ -57,6 +57,14 @@ from gaitopt.study.summary import (
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
 from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import VARIANT_LABELS, gait_style, png_data_uri, save_figure
+from gaitopt.viz.sweep_comparison import (
+    ComparedSweep,
+    comparison_caption,
+    comparison_figure,
+    comparison_table_html,
+    load_compared_sweep,
+    sweep_label,
+)
 from gaitopt.viz.sweep_figures import energy_figure, step_length_figure
 
 #: The paper's solver statistics (section 5.1): one sample solve, 8 + 5 knots.
@@ -97,10 +105,13 @@ class _Selected:
 
 def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
                  svg: bool = True,
-                 check_dir: str | os.PathLike[str] | None = None) -> ReportInfo:
+                 check_dir: str | os.PathLike[str] | None = None,
+                 compare: Sequence[str | os.PathLike[str]] = ()) -> ReportInfo:
     """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
     ``svg=False`` skips the SVG copies of the figures; ``check_dir`` is the check sweep on a
-    finer grid (default ``<sweep_dir>/check-grid`` when it exists).
+    finer grid (default ``<sweep_dir>/check-grid`` when it exists); ``compare``: other sweep
+    folders drawn beside this one (:mod:`gaitopt.viz.sweep_comparison`, figure
+    ``compare_sweeps``).
 
     Raises :class:`gaitopt.study.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
@@ -156,6 +167,13 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         "four variants; the human curve on the right axis for comparing shapes." + grid_note())
     add(step_length_figure(rows), "fig4_step_length", "Fig. 4: optimal step length against "
         "speed." + grid_note(what="step length"))
+
+    if compare:
+        compared = [ComparedSweep(sweep_label(sweep), tuple(rows), sweep)]
+        compared += [load_compared_sweep(d) for d in compare]
+        sections.append("<h2>Compared with other sweeps</h2>"
+                        + comparison_table_html(compared))
+        add(comparison_figure(compared), "compare_sweeps", comparison_caption(compared))
 
     shown: dict[tuple[str, str], list[SummaryRow]] = {}
 
