@@ -114,6 +114,13 @@ def resting_power_option(f: F) -> F:
                         help="Resting power of the metabolic cost, W/kg [default: 1.2].")(f)
 
 
+def min_knee_flexion_option(f: F) -> F:
+    """``--min-knee-flexion`` in rad (None: the option's default)."""
+    return click.option("--min-knee-flexion", type=click.FloatRange(min=0.0), default=None,
+                        help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; "
+                             "0 lets the stance knee straighten, with --formulation full].")(f)
+
+
 def formulation_option(help: str, default: str | None = "reduced") -> Callable[[F], F]:
     """``--formulation reduced|full`` with this help text (``default`` None: the command
     chooses, and says how in ``help``)."""

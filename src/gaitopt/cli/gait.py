@@ -21,6 +21,7 @@ from gaitopt.cli.base import (
     grid_choice,
     knots_option,
     make_console,
+    min_knee_flexion_option,
     model_option,
     paper_grid_option,
     parse_free_or_value,
@@ -119,9 +120,7 @@ def _step_time(text: str) -> float | None:
                    "tree's q, qd with the held points as constraints (any model and contact "
                    "sequence, knees may straighten) [default: reduced for the five-link shape "
                    "and the walk, else full].", default=None)
-@click.option("--min-knee-flexion", type=float, default=None,
-              help="Smallest knee bend (rad) of a leg on the ground [default: 0.1; 0 lets the "
-                   "stance knee straighten, with --formulation full].")
+@min_knee_flexion_option
 @click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default="walk",
               show_default=True,
               help="The contact sequence: walk, run (stance then flight; needs --no-impulse) "

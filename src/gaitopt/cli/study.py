@@ -35,6 +35,7 @@ from gaitopt.cli.base import (
     grid_choice,
     knots_option,
     make_console,
+    min_knee_flexion_option,
     model_option,
     paper_grid_option,
     parse_free_or_value,
@@ -290,12 +291,14 @@ def _workers_option(f: Any) -> Any:
 @resting_power_option
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
+@min_knee_flexion_option
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
                   paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
                   resting_power: float | None, control_model: str | None,
-                  workers: int | None, scheduler: str | None) -> None:
+                  min_knee_flexion: float | None, workers: int | None,
+                  scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
     Writes DIR/sweep.json (the settings), a gait file per solved point and DIR/summary.csv.
@@ -314,6 +317,8 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
                                "gait": gait_kind, **grid_choice(knots, control_model, paper_grid)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
+    if min_knee_flexion is not None:
+        problem["min_stance_knee_flexion"] = min_knee_flexion
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
                      step_length=step_length, single_support=single_support,
                      step_time=step_time, problem=problem)
