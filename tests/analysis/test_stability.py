@@ -401,3 +401,22 @@ def test_cli_analyses_a_run(run_gait: Gait, tmp_path: Path) -> None:
     data = json.loads(out.read_text())
     assert data["verdict"] == "unstable"
     assert len(data["multipliers"]) == 2 * run_gait.model.nq - 4
+
+
+def test_report_table_shows_both_analyses_of_a_gait(gait: Gait) -> None:
+    from gaitopt.viz.stability_table import REPORT_PD, stability_rows, stability_table_html
+
+    (row,) = stability_rows([("optimum", gait)])
+    about = gait_stability(gait, about="gait", check=False)
+    tracked = gait_stability(gait, pd=REPORT_PD, check=False)
+    assert row.open_loop.report is not None and row.tracked.report is not None
+    assert row.open_loop.report.spectral_radius == pytest.approx(about.spectral_radius, rel=1e-9)
+    assert row.tracked.report.spectral_radius == pytest.approx(tracked.spectral_radius, rel=1e-9)
+    table = stability_table_html([row])
+    assert f"{about.spectral_radius:.3g} (unstable" in table
+    assert f"{tracked.spectral_radius:.3g} ({tracked.verdict}" in table
+    # a gait the return map cannot replay shows why instead of a number
+    failed = dataclasses.replace(gait, solver={**gait.solver, "success": False,
+                                               "status": "Infeasible_Problem_Detected"})
+    (bad,) = stability_rows([("failed", failed)])
+    assert bad.open_loop.report is None and "did not converge" in bad.open_loop.text()

@@ -52,6 +52,7 @@ def test_report_html_is_self_contained(report: ReportInfo) -> None:
 def test_report_sections_carry_our_numbers_beside_the_papers(report: ReportInfo) -> None:
     page = report.html.read_text()
     for heading in ("Energy-optimal walk of each variant", "Solver statistics",
+                    "Orbital stability of the optimal gaits",
                     "Findings of the paper, checked", "All sweep points"):
         assert heading in page
     assert "<td>ankle+impulse</td><td>12.2</td>" in page  # speed-free optimum, m/min

@@ -55,6 +55,7 @@ from gaitopt.study.summary import (
     rows_of,
 )
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
+from gaitopt.viz.stability_table import stability_rows, stability_table_html
 from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import VARIANT_LABELS, gait_style, png_data_uri, save_figure
 from gaitopt.viz.sweep_comparison import (
@@ -106,12 +107,14 @@ class _Selected:
 def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
                  svg: bool = True,
                  check_dir: str | os.PathLike[str] | None = None,
-                 compare: Sequence[str | os.PathLike[str]] = ()) -> ReportInfo:
+                 compare: Sequence[str | os.PathLike[str]] = (),
+                 stability: bool = True) -> ReportInfo:
     """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
     ``svg=False`` skips the SVG copies of the figures; ``check_dir`` is the check sweep on a
     finer grid (default ``<sweep_dir>/check-grid`` when it exists); ``compare``: other sweep
     folders drawn beside this one (:mod:`gaitopt.viz.sweep_comparison`, figure
-    ``compare_sweeps``).
+    ``compare_sweeps``); ``stability``: the Floquet multipliers of each variant's optimal gait
+    (:mod:`gaitopt.viz.stability_table`; a few seconds per gait).
 
     Raises :class:`gaitopt.study.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
@@ -225,6 +228,11 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
                                f"{gait.speed * 60:.1f} m/min") if gait else None,
             f"stick_{v.replace('+', '-')}", f"One step of the optimal walk, {v}."
             + grid_note([optimal[v]]))
+    if stability:
+        optima = [(f"{v}, {row.speed_m_min:.1f} m/min", gait) for v in VARIANTS
+                  if (row := optimal[v]) is not None and (gait := load(row)) is not None]
+        sections.append("<h2>Orbital stability of the optimal gaits</h2>"
+                        + stability_table_html(stability_rows(optima)))
     sections.append("<h2>Solver statistics</h2>" + _solver_table(rows, optimal, load))
     sections.append("<h2>Findings of the paper, checked</h2>" + findings_html(findings))
     sections.append("<h2>All sweep points</h2>" + _summary_table(rows))
