@@ -74,7 +74,6 @@ from gaitopt.gait.problem import (
     parameter_bounds,
     with_step_time,
 )
-from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.gait.solution import (
     ProgressFn,
     StageReport,
@@ -191,6 +190,10 @@ class _Run:
         for step0 in steps:
             try:
                 if generic:
+                    # Imported here: it needs SciPy's optimizer (0.8 s to import), which the
+                    # paper's walk never uses.
+                    from gaitopt.gait.sequence_guess import sequence_guess
+
                     guess = sequence_guess(self.model, contact_sequence(self.model, o),
                                            model_symmetry(self.model).contacts, speed=speed,
                                            step_length=step0, knots=coarse, ankle=o.ankle,
