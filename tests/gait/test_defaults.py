@@ -127,4 +127,42 @@ def test_solve_paper_grid_writes_the_papers_gait(tmp_path: Path) -> None:
     assert "8+5 knots, control model paper (the paper's grid)" in result.output
     gait = Gait.load(out)
     assert gait.options["knots"] == [8, 5] and gait.options["control_model"] == "paper"
+    assert gait.options["transcription"] == "hermite-simpson"
     assert gait.cost_value == pytest.approx(487.94, abs=0.02)
+
+
+class _Stop(Exception):
+    """Raised by the stand-in solver once it has the options."""
+
+
+@pytest.mark.parametrize(("args", "expected"), [
+    ([], "hermite-simpson-separated"),
+    (["--paper-grid"], "hermite-simpson"),
+    (["--transcription", "hermite-simpson"], "hermite-simpson"),
+    (["--paper-grid", "--transcription", "hermite-simpson-separated"],
+     "hermite-simpson-separated"),
+])
+def test_solve_chooses_the_form_of_the_grid_unless_told(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path, args: list[str],
+        expected: str) -> None:
+    """``gaitopt solve``: the separated form by default, the paper's compressed form with
+    ``--paper-grid``; an explicit ``--transcription`` wins."""
+    seen: list[GaitOptions] = []
+
+    def fake_solve(model: object, options: GaitOptions, **_: object) -> None:
+        seen.append(options)
+        raise _Stop
+
+    monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", fake_solve)
+    result = CliRunner().invoke(cli, ["solve", *args, "-o", str(tmp_path / "g.gait.json")])
+    assert isinstance(result.exception, _Stop), result.output
+    assert [o.transcription for o in seen] == [expected]
+
+
+def test_saved_options_without_a_transcription_were_compressed() -> None:
+    """A gait file or sweep written before the field existed was solved in the compressed
+    form (the default then), not today's default."""
+    data = GaitOptions().to_dict()
+    del data["transcription"]
+    assert GaitOptions.from_dict(data).transcription == "hermite-simpson"
+    assert GaitOptions.saved_defaults()["transcription"] == "hermite-simpson"
