@@ -124,7 +124,7 @@ class GaitOptions:
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, take every distinct coarse optimum through the
-            remaining stages and keep the lowest final one (about twice the time; a cold solve
+            remaining stages and keep the lowest final one (3-4x the time; a cold solve
             can otherwise end in a worse local optimum: at 57 and 60 m/min on 16 + 6 knots
             the long-step branch, 19-25 % above the sweep's optimum). ``gaitopt solve`` turns
             it on by default at speeds 15 m/min or more from 12 m/min.
