@@ -9,6 +9,7 @@ this process. Target: under 60 s for the 80 points on the 2-core reference machi
 
     PYTHONPATH=src python bench/sweep.py [--workers 2] [--speeds 3:60:3] [--free]
         [--start-methods forkserver,spawn] [--transcription T] [--reference main]
+        [--grid paper|default]
 
 ``--reference main`` first runs the same benchmark on git revision ``main`` (its sources
 extracted into a temporary folder, the same interpreter) with the paper's compressed form,
@@ -103,6 +104,10 @@ def main() -> None:
     parser.add_argument("--start-methods", default="forkserver")
     parser.add_argument("--transcription", default="hermite-simpson-separated",
                         help="the sweep's transcription (GaitOptions.transcription)")
+    parser.add_argument("--grid", choices=["paper", "default"], default="paper",
+                        help="paper: GaitOptions.paper() (8+5 knots, the paper's control "
+                             "model); default: GaitOptions() (16+6 knots, jumps), what "
+                             "gaitopt sweep solves")
     parser.add_argument("--reference", default=None,
                         help="a git revision (e.g. main) to measure first in the same run, "
                              "with the paper's compressed form, as the reference of the ratios")
@@ -112,10 +117,12 @@ def main() -> None:
 
     spec = SweepSpec(model=load_model("five-link"), speeds=parse_speeds(args.speeds),
                      variants=VARIANTS, free_speed=args.free,
-                     base=GaitOptions.paper(transcription=args.transcription))  # type: ignore
+                     base=(GaitOptions.paper if args.grid == "paper" else GaitOptions)(
+                         transcription=args.transcription))  # type: ignore[arg-type]
     n = len(spec.points)
     load = os.getloadavg()[0]
-    print(f"sweep benchmark: {len(spec.variants)} variants x {len(spec.speeds)} speeds"
+    print(f"sweep benchmark ({args.grid} grid, {spec.knots[0]}+{spec.knots[1]} knots, "
+          f"{args.transcription}): {len(spec.variants)} variants x {len(spec.speeds)} speeds"
           f"{' + free' if args.free else ''} = {n} points, {args.workers} workers, "
           f"{os.cpu_count()} CPUs, load average before: {load:.2f}")
     ref_build = build_s()
@@ -186,8 +193,8 @@ def run_reference(args: argparse.Namespace) -> dict[str, float]:
         subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
         cmd = [sys.executable, str(Path(__file__).resolve()), "--workers", str(args.workers),
                "--speeds", args.speeds, "--start-methods", args.start_methods,
-               "--transcription", "hermite-simpson", "--json"] + (["--free"] if args.free
-                                                                  else [])
+               "--transcription", "hermite-simpson", "--grid", args.grid,
+               "--json"] + (["--free"] if args.free else [])
         print(f"reference: {args.reference} ({' '.join(cmd[2:])})", flush=True)
         proc = subprocess.run(cmd, env=dict(os.environ, PYTHONPATH=str(Path(tmp) / "src")),
                               capture_output=True, text=True)

@@ -22,14 +22,18 @@ from gaitopt.gait.options import PAPER_GRID, GaitOptions
 from tests.gait.conftest import SolveFn
 
 
-def test_the_paper_preset_changes_the_grid_and_the_control_model_only() -> None:
+def test_the_paper_preset_changes_the_grid_the_control_model_and_the_form_only() -> None:
+    """The paper's preset: its grid, control model and NLP (the compressed form); the
+    default: the converged grid in the separated form."""
     default, paper = GaitOptions(), GaitOptions.paper()
-    assert (paper.knots, paper.control_model) == ((8, 5), "paper") == (
-        PAPER_GRID["knots"], PAPER_GRID["control_model"])
-    assert (default.knots, default.control_model) == ((16, 6), "jumps")
+    assert (paper.knots, paper.control_model, paper.transcription) == (
+        (8, 5), "paper", "hermite-simpson") == (
+        PAPER_GRID["knots"], PAPER_GRID["control_model"], PAPER_GRID["transcription"])
+    assert (default.knots, default.control_model, default.transcription) == (
+        (16, 6), "jumps", "hermite-simpson-separated")
     differ = {f.name for f in dataclasses.fields(GaitOptions)
               if getattr(default, f.name) != getattr(paper, f.name)}
-    assert differ == {"knots", "control_model"}
+    assert differ == {"knots", "control_model", "transcription"}
     assert paper.paper_grid and not default.paper_grid
     assert GaitOptions.paper(speed=None).speed is None  # changes apply on top of the preset
     assert not GaitOptions.paper(knots=(16, 6)).paper_grid
@@ -50,10 +54,14 @@ def test_the_paper_preset_reproduces_the_papers_optima(solved: SolveFn) -> None:
         assert gait.options["control_model"] == "paper"
 
 
-def test_the_default_solve_reports_its_error_within_one_percent(solved: SolveFn) -> None:
+def test_the_default_solve_reports_its_error_within_about_one_percent(solved: SolveFn
+                                                                       ) -> None:
     """The default at 12 m/min: the cost on 16 + 6 knots with the change from the 8 + 5 stage
-    as its error estimate, below 1 % of J; the estimate is that difference exactly (the 8 + 5
-    cost recomputed by a separate solve of the same problem on that grid)."""
+    as its error estimate, about 1 % of J (1.04 % in the separated form, whose 8 + 5 optimum
+    keeps the states within their bounds at the midpoints too and so lies further above the
+    limit than the compressed one's 0.76 %; the cost itself is 0.11 % above the 48 + 16
+    value, docs/benchmarks-gait.md); the estimate is that difference exactly (the 8 + 5 cost
+    recomputed by a separate solve of the same problem on that grid)."""
     gait = solved(GaitOptions()).gait
     acc = gait.solver["accuracy"]
     assert [p.t.size for p in gait.phases] == [16, 6]
@@ -63,7 +71,7 @@ def test_the_default_solve_reports_its_error_within_one_percent(solved: SolveFn)
     assert acc["cost_error"] == pytest.approx(gait.cost_value - coarse.cost_value, rel=1e-5)
     assert acc["cost_error_relative"] == pytest.approx(
         abs(acc["cost_error"]) / gait.cost_value, rel=1e-9)
-    assert 0.0 < acc["cost_error_relative"] < 0.01
+    assert 0.0 < acc["cost_error_relative"] < 0.011
     assert acc["speed_change"] == 0.0  # the speed is given
     assert acc["step_length_change"] == pytest.approx(
         gait.step_length - coarse.step_length, abs=1e-7)
@@ -80,7 +88,7 @@ def test_the_speed_free_default_says_how_far_speed_and_step_moved(solved: SolveF
     assert acc["step_length_change"] == pytest.approx(gait.step_length - coarse.step_length,
                                                       abs=1e-6)
     assert acc["speed_change"] != 0.0
-    assert acc["cost_error_relative"] < 0.01
+    assert acc["cost_error_relative"] < 0.011  # 1.07 % (separated form; see above)
 
 
 @pytest.mark.slow
@@ -119,4 +127,42 @@ def test_solve_paper_grid_writes_the_papers_gait(tmp_path: Path) -> None:
     assert "8+5 knots, control model paper (the paper's grid)" in result.output
     gait = Gait.load(out)
     assert gait.options["knots"] == [8, 5] and gait.options["control_model"] == "paper"
+    assert gait.options["transcription"] == "hermite-simpson"
     assert gait.cost_value == pytest.approx(487.94, abs=0.02)
+
+
+class _Stop(Exception):
+    """Raised by the stand-in solver once it has the options."""
+
+
+@pytest.mark.parametrize(("args", "expected"), [
+    ([], "hermite-simpson-separated"),
+    (["--paper-grid"], "hermite-simpson"),
+    (["--transcription", "hermite-simpson"], "hermite-simpson"),
+    (["--paper-grid", "--transcription", "hermite-simpson-separated"],
+     "hermite-simpson-separated"),
+])
+def test_solve_chooses_the_form_of_the_grid_unless_told(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path, args: list[str],
+        expected: str) -> None:
+    """``gaitopt solve``: the separated form by default, the paper's compressed form with
+    ``--paper-grid``; an explicit ``--transcription`` wins."""
+    seen: list[GaitOptions] = []
+
+    def fake_solve(model: object, options: GaitOptions, **_: object) -> None:
+        seen.append(options)
+        raise _Stop
+
+    monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", fake_solve)
+    result = CliRunner().invoke(cli, ["solve", *args, "-o", str(tmp_path / "g.gait.json")])
+    assert isinstance(result.exception, _Stop), result.output
+    assert [o.transcription for o in seen] == [expected]
+
+
+def test_saved_options_without_a_transcription_were_compressed() -> None:
+    """A gait file or sweep written before the field existed was solved in the compressed
+    form (the default then), not today's default."""
+    data = GaitOptions().to_dict()
+    del data["transcription"]
+    assert GaitOptions.from_dict(data).transcription == "hermite-simpson"
+    assert GaitOptions.saved_defaults()["transcription"] == "hermite-simpson"

@@ -8,16 +8,19 @@ signals one by raising :class:`UserError`, or any exception type listed in
 
 from __future__ import annotations
 
+import importlib
 import os
 from collections.abc import Callable
-from typing import Any, TypeVar, get_args
+from typing import TYPE_CHECKING, Any, TypeVar, get_args
 
 import click
-from rich.console import Console
 
 from gaitopt import __version__
 from gaitopt.gait.options import ControlModel, CostName, Formulation
 from gaitopt.robot import ModelError
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 #: Exception types that are the user's to fix: shown as one line, exit status 2.
 USER_ERRORS: tuple[type[Exception], ...] = (ModelError,)
@@ -36,7 +39,25 @@ class UserError(click.ClickException):
 
 
 class _Group(click.Group):
-    """A click group that turns :data:`USER_ERRORS` into :class:`UserError`."""
+    """A click group that turns :data:`USER_ERRORS` into :class:`UserError` and imports each
+    command's module only when that command is looked up (:attr:`lazy_commands`: command name
+    -> module, whose import registers it on the group), so that ``gaitopt solve`` does not
+    import what ``study``, ``report`` or ``stability`` need."""
+
+    #: Command name -> the module that defines (and registers) it.
+    lazy_commands: dict[str, str]
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.lazy_commands = {}
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted({*super().list_commands(ctx), *self.lazy_commands})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in self.lazy_commands:
+            importlib.import_module(self.lazy_commands[cmd_name])
+        return super().get_command(ctx, cmd_name)
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
@@ -103,9 +124,10 @@ def knots_option(f: F) -> F:
 def paper_grid_option(f: F) -> F:
     """``--paper-grid``: the paper's 8 + 5 knots and control model (:func:`grid_choice`)."""
     return click.option("--paper-grid", is_flag=True,
-                        help="The paper's setting: 8+5 knots and its control model "
-                             "(continuous, periodic controls); its cost is about 13 % above "
-                             "the converged one.")(f)
+                        help="The paper's setting: 8+5 knots, its control model "
+                             "(continuous, periodic controls) and its NLP (compressed "
+                             "Hermite-Simpson); its cost is about 13 % above the converged "
+                             "one.")(f)
 
 
 def resting_power_option(f: F) -> F:
@@ -147,9 +169,9 @@ def control_model_option(help: str) -> Callable[[F], F]:
 def grid_choice(knots: str | None, control_model: str | None,
                 paper_grid: bool) -> dict[str, Any]:
     """The ``knots`` and ``control_model`` of ``--knots``, ``--control-model`` and
-    ``--paper-grid`` (the paper's 8 + 5 knots and control model, ``GaitOptions.paper``);
-    unset ones keep the :class:`~gaitopt.gait.options.GaitOptions` defaults. ``--paper-grid``
-    with either of the others is a usage error."""
+    ``--paper-grid`` (the paper's 8 + 5 knots, control model and compressed transcription,
+    ``GaitOptions.paper``); unset ones keep the :class:`~gaitopt.gait.options.GaitOptions`
+    defaults. ``--paper-grid`` with either of the others is a usage error."""
     from gaitopt.gait.options import PAPER_GRID
 
     if paper_grid:
@@ -172,6 +194,8 @@ def make_console() -> Console:
 
     Markup is off: text such as ``[kg]`` or ``[-2, 2]`` is printed as it is.
     """
+    from rich.console import Console  # here: a command that prints nothing never loads rich
+
     console = Console(markup=False, highlight=False)
     if not console.is_terminal and "COLUMNS" not in os.environ:
         console = Console(markup=False, highlight=False, width=max(console.width, PIPE_WIDTH))

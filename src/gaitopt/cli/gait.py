@@ -51,8 +51,19 @@ def _speed(text: str) -> float | None:
         raise UserError(f"--speed: {exc}") from None
 
 
-#: Speeds (m/s) this far from 12 m/min get the multistart hint (15 m/min).
+#: Speeds (m/s) this far from 12 m/min are solved with multistart unless told otherwise
+#: (15 m/min): the cold solves of 57 and 60 m/min end on the long-step branch, 19-25 % above
+#: the sweep's optimum (docs/benchmarks-gait.md, "Multistart").
 FAR_FROM_REFERENCE = 0.25
+
+
+def multistart_default(speed: float | None, formulation: str | None) -> bool:
+    """Whether ``gaitopt solve`` uses multistart when neither ``--multistart`` nor
+    ``--no-multistart`` is given: for the paper's walk in reduced coordinates (where it was
+    measured) at a given speed at least :data:`FAR_FROM_REFERENCE` from 12 m/min (the
+    speed-free optimal walk starts at 12 m/min)."""
+    return (formulation == "reduced" and speed is not None
+            and abs(speed - REFERENCE_SPEED) >= FAR_FROM_REFERENCE - 1e-12)
 
 
 #: The grid on which the seven-link heel-toe walk passes ``verify`` (docs/feet.md: 8+5 and
@@ -103,11 +114,13 @@ def _step_time(text: str) -> float | None:
                    "from --single-support (needs --formulation full).")
 @knots_option
 @paper_grid_option
-@click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)),
-              default=GaitOptions().transcription, show_default=True,
-              help="hermite-simpson-separated: the same scheme with the midpoint states as "
-                   "variables (bounded like the knots), faster per iteration; see "
-                   "docs/benchmarks-gait.md.")
+@click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)), default=None,
+              help="hermite-simpson: DIRCOL's compressed form, the paper's NLP; "
+                   "hermite-simpson-separated: the same scheme with the midpoint states as "
+                   "variables (bounded like the knots), several times faster; see "
+                   "docs/benchmarks-gait.md [default: "
+                   f"{GaitOptions().transcription}; with --paper-grid "
+                   f"{GaitOptions.paper().transcription}].")
 @click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,
               help="Controls periodic as well as states (the paper), or states only.")
 @click.option("--friction", type=float, default=None,
@@ -150,9 +163,11 @@ def _step_time(text: str) -> float | None:
               help="Clearance profile: c (4 s (1 - s))^2, or c 4 s (1 - s) (which also asks "
                    "for a least vertical tip velocity 4 c / T1 at liftoff and heel strike).")
 @click.option("--compiled", is_flag=True, help="Compile the NLP to C (cached on disk).")
-@click.option("--multistart", is_flag=True,
+@click.option("--multistart/--no-multistart", default=None,
               help="Solve from every naive guess and, away from 12 m/min, by continuation in "
-                   "speed; keep the lowest optimum (slower, fewer poor local optima).")
+                   "speed; keep the lowest optimum (slower, fewer poor local optima) "
+                   "[default: on at speeds 15 m/min or more from 12 m/min, where a single "
+                   "cold start can end on a worse branch; off otherwise].")
 @click.option("--warm-start", "warm_start", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="A gait file to start from (e.g. a neighbouring speed's "
                                  "gait); the cold path is the fallback.")
@@ -161,7 +176,7 @@ def _step_time(text: str) -> float | None:
 def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
                   impulse: bool,
                   single_support: float, knots: str | None, paper_grid: bool,
-                  transcription: str,
+                  transcription: str | None,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
@@ -169,7 +184,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   resting_power: float | None, regularization: float,
                   control_model: str | None, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
-                  multistart: bool,
+                  multistart: bool | None,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.metrics import gait_metrics
@@ -192,10 +207,12 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
         single_support_fraction=single_support,
-        **grid_choice(knots, control_model, paper_grid),
-        transcription=transcription,  # type: ignore[arg-type]
+        **{**grid_choice(knots, control_model, paper_grid),
+           **({"transcription": transcription} if transcription else {})},
         periodic_controls=periodic_controls, friction=friction,
-        unilateral_impulses=unilateral_impulses, multistart=multistart,
+        unilateral_impulses=unilateral_impulses,
+        multistart=(multistart_default(_speed(speed), formulation) if multistart is None
+                    else multistart),
         formulation=formulation,  # type: ignore[arg-type]
         gait=gait_kind, cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
@@ -223,10 +240,11 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   + (" (the paper's grid)" if options.paper_grid else "")
                   + f", {options.formulation} coordinates")
 
-    if (start is None and not multistart and options.speed is not None
-            and abs(options.speed - REFERENCE_SPEED) > FAR_FROM_REFERENCE):
+    if (start is None and not options.multistart
+            and multistart_default(options.speed, options.formulation)):
         console.print("note: far from 12 m/min a cold solve can end in a worse local optimum; "
-                      "--multistart also tries the continuation in speed and keeps the best")
+                      "--multistart (the default here) also tries the continuation in speed "
+                      "and keeps the best")
     if (sequence_used is not None and len(sequence_used.phases) > 2
             and tuple(options.knots) < FOUR_PHASE_KNOTS):
         console.print(f"note: a {len(sequence_used.phases)}-phase step on {options.knots[0]}+"

@@ -3,10 +3,12 @@
 Defaults follow the paper's problem (ankle torques and the liftoff impulse on, single support
 85 % of the step, the speed given at 12 m/min, the paper's globally optimal speed, and the step
 length free) on a grid whose cost is converged to well within 1 %: 16 + 6 knots with the
-torques free to jump at the events (``control_model="jumps"``). The paper's own setting, 8 + 5
-knots with continuous and periodic controls, is :meth:`GaitOptions.paper` (CLI:
-``--paper-grid``). The measurements behind the choice are in ``docs/walking.md`` (section 6);
-every field is documented there.
+torques free to jump at the events (``control_model="jumps"``), transcribed by separated
+Hermite-Simpson (derivatives compiled per grid point). The paper's own setting, 8 + 5 knots
+with continuous and periodic controls in DIRCOL's compressed Hermite-Simpson form (the paper's
+NLP), is :meth:`GaitOptions.paper` (CLI: ``--paper-grid``). The measurements behind the
+choices are in ``docs/walking.md`` (section 6) and ``docs/benchmarks-gait.md``; every field
+is documented there.
 """
 
 from __future__ import annotations
@@ -35,14 +37,17 @@ CONTROL_MODELS = ("paper", "jumps")
 ClearanceProfile = Literal["parabola", "quartic"]
 #: The swing clearance profiles (see ``docs/walking.md``, "Swing clearance").
 CLEARANCE_PROFILES = ("parabola", "quartic")
-#: The paper's grid and control model (8 + 5 knots, controls continuous at the heel strike and
-#: periodic): :meth:`GaitOptions.paper` and ``--paper-grid``. Its cost is about 13 % above
-#: the fine-grid limit (docs/walking.md, section 6); it is kept to reproduce the paper.
-PAPER_GRID: dict[str, Any] = {"knots": (8, 5), "control_model": "paper"}
+#: The paper's grid, control model and NLP (8 + 5 knots, controls continuous at the heel
+#: strike and periodic, DIRCOL's compressed Hermite-Simpson form): :meth:`GaitOptions.paper`
+#: and ``--paper-grid``. Its cost is about 13 % above the fine-grid limit (docs/walking.md,
+#: section 6); it is kept to reproduce the paper.
+PAPER_GRID: dict[str, Any] = {"knots": (8, 5), "control_model": "paper",
+                              "transcription": "hermite-simpson"}
 #: Fields whose default changed, with the value they had before: a gait file or sweep written
 #: before the field existed was solved with it (the control model arrived while the paper's
-#: was the default), so data that lacks the field means this value, not today's default.
-LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper"}
+#: was the default, the transcription field while the compressed form was), so data that
+#: lacks the field means this value, not today's default.
+LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper", "transcription": "hermite-simpson"}
 
 
 class GaitOptionsError(ValueError):
@@ -68,9 +73,13 @@ class GaitOptions:
         knots: grid points per phase (single support, double support): 16 + 6 by default
             (the cost within 0.1 % of the fine-grid limit with ``control_model="jumps"``);
             the paper's 8 + 5 with :meth:`paper`.
-        transcription: ``"hermite-simpson"`` (DIRCOL's compressed form),
-            ``"hermite-simpson-separated"`` (the same scheme and optimum with the midpoint
-            states as NLP variables; cheaper derivatives) or ``"trapezoidal"``.
+        transcription: ``"hermite-simpson-separated"`` (the default: the midpoint states
+            as NLP variables, bounded like the knots; derivatives assembled from compiled
+            functions of one grid point, several times faster per iteration),
+            ``"hermite-simpson"`` (DIRCOL's compressed form, the paper's NLP and
+            :meth:`paper`'s: the same scheme and fine-grid limit; its states may leave their
+            bounds between knots, so on a coarse grid its optimum is a little lower) or
+            ``"trapezoidal"``.
         periodic_controls: controls periodic (paper) as well as the states.
         friction: a friction coefficient for an optional friction-cone constraint, or None.
         unilateral_impulses: the ground only pushes at the heel strike and the liftoff (normal
@@ -114,8 +123,11 @@ class GaitOptions:
         cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs.
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
-            by continuation in speed, and keep the lowest optimum (slower; a cold solve can
-            otherwise end in a worse local optimum, e.g. at high speed without ankle torques).
+            by continuation in speed, take every distinct coarse optimum through the
+            remaining stages and keep the lowest final one (3-4x the time; a cold solve
+            can otherwise end in a worse local optimum: at 57 and 60 m/min on 16 + 6 knots
+            the long-step branch, 19-25 % above the sweep's optimum). ``gaitopt solve`` turns
+            it on by default at speeds 15 m/min or more from 12 m/min.
         mesh_tol: refine the mesh after the fixed-grid stages until every interval's
             collocation error estimate is <= mesh_tol (``None``: the fixed grid ``knots``).
         control_model: ``"jumps"`` (the default: no control linkages, the torques may jump
@@ -142,7 +154,7 @@ class GaitOptions:
     impulse: bool = True
     single_support_fraction: float = 0.85
     knots: tuple[int, int] = (16, 6)
-    transcription: Transcription = "hermite-simpson"
+    transcription: Transcription = "hermite-simpson-separated"
     periodic_controls: bool = True
     friction: float | None = None
     unilateral_impulses: bool = True
@@ -184,8 +196,9 @@ class GaitOptions:
     @staticmethod
     def paper(**changes: Any) -> GaitOptions:
         """The paper's setting: :data:`PAPER_GRID` (8 + 5 knots, controls continuous at the
-        heel strike and periodic) with every other default, then ``changes``. At 12 m/min it
-        gives J = 487.94 N^2 m s; speed free, 11.1 m/min with 0.107 m steps and 486.3."""
+        heel strike and periodic, the compressed Hermite-Simpson form) with every other
+        default, then ``changes``. At 12 m/min it gives J = 487.94 N^2 m s; speed free,
+        11.1 m/min with 0.107 m steps and 486.3."""
         return GaitOptions(**{**PAPER_GRID, **changes})
 
     @property

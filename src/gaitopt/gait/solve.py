@@ -34,9 +34,13 @@ linkages). From the naive guess the jumps model's first stage failed after 507 i
 
 If stage 1 or 2 fails, the same is tried from guesses with shorter and longer steps, then by
 continuation in speed from the reference speed (12 m/min). With ``multistart`` all three
-guesses and (away from 12 m/min) the continuation in speed are solved and the lowest
-coarse optimum is kept: the problem has several local optima (a long-step and a short-step
-branch at high speed), and a single cold start can end on the worse one. Given a warm start
+guesses and (away from 12 m/min) the continuation in speed are solved; every distinct coarse
+optimum among them (:func:`distinct`) is taken through the remaining stages (its stages named
+``start i/n: ...``) and the lowest final optimum is kept: the problem has several local optima
+(a long-step and a short-step branch at high speed), a single cold start can end on the worse
+one, and which branch is lower can change between the coarse problem of the cold stages (the
+paper's control model, ankle torques held) and the requested one (at 60 m/min on 16 + 6
+knots the long-step branch is 0.06 % lower there and 19 % higher in the end). Given a warm start
 (a neighbouring gait), the target problem is solved from it directly and the cold path is the
 fallback.
 Every stage is reported through ``progress`` and kept in the solution, so a failure says which
@@ -70,11 +74,11 @@ from gaitopt.gait.problem import (
     FRACTION,
     IMPULSE,
     SPEED,
+    STEP_LENGTH,
     Relaxation,
     parameter_bounds,
     with_step_time,
 )
-from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.gait.solution import (
     ProgressFn,
     StageReport,
@@ -129,6 +133,8 @@ class _Run:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
         self.stages: list[StageReport] = []
+        #: Put before every stage name (the start being completed, with several).
+        self.prefix = ""
         self.results: list[Result] = []
         self.named_results: list[tuple[str, Result]] = []
         self.grid_costs: list[tuple[tuple[int, ...], float]] = []
@@ -155,23 +161,30 @@ class _Run:
         full = (relax == Relaxation() and not hold_ankles and problem in (None, self.options)
                 and dict(bounds) == dict(parameter_bounds(self.options)))
         report = StageReport(
-            name=name, knots=grid_knots(knots, self.options), status=result.status,
+            name=self.prefix + name, knots=grid_knots(knots, self.options),
+            status=result.status,
             success=result.success, iterations=result.iterations, objective=result.objective,
             violation=result.constraint_violation, wall_time_s=time.perf_counter() - start,
             parameters=dict(result.parameters), full_problem=full)
         self.stages.append(report)
         self.results.append(result)
-        self.named_results.append((name, result))
+        self.named_results.append((self.prefix + name, result))
         if full and result.success:
             self.grid_costs.append((tuple(m.size for m in result.mesh), result.objective))
         if self.progress is not None:
             self.progress(report)
         return result
 
-    def cold(self, speed: float, *, every_start: bool = False) -> Result | None:
+    def cold(self, speed: float) -> Result | None:
         """Stages 1-2 on the coarse grid at ``speed`` without impulse, from naive guesses
         (the requested step length, or a speed-based guess and two others): the first that
-        converges, or with ``every_start`` the best of all that converge."""
+        converges."""
+        found = self.cold_starts(speed, every_start=False)
+        return found[0] if found else None
+
+    def cold_starts(self, speed: float, *, every_start: bool) -> list[Result]:
+        """The converged results of :meth:`cold`'s naive guesses: the first one, or with
+        ``every_start`` all of them."""
         o, coarse = self.options, coarse_knots(self.options)
         biped = biped_of(self.model, o)
         generic = biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
@@ -191,6 +204,10 @@ class _Run:
         for step0 in steps:
             try:
                 if generic:
+                    # Imported here: it needs SciPy's optimizer (0.8 s to import), which the
+                    # paper's walk never uses.
+                    from gaitopt.gait.sequence_guess import sequence_guess
+
                     guess = sequence_guess(self.model, contact_sequence(self.model, o),
                                            model_symmetry(self.model).contacts, speed=speed,
                                            step_length=step0, knots=coarse, ankle=o.ankle,
@@ -222,10 +239,10 @@ class _Run:
                     break
             else:
                 assert isinstance(result, Result)
-                if not every_start:
-                    return result
                 found.append(result)
-        return best_of(found)
+                if not every_start:
+                    break
+        return found
 
     @property
     def cold_options(self) -> GaitOptions:
@@ -249,6 +266,38 @@ class _Run:
         return self.stage(f"control model {o.control_model}", coarse_knots(o), Relaxation(),
                           result_guess(result), bounds, hold_ankles=ANKLES in held,
                           solver_options=PRIMAL_WARM_OPTIONS)
+
+    def complete(self, coarse: Result | None) -> Result | None:
+        """A coarse solution of the cold stages through the rest: the requested control
+        model, the releases and the requested grid (None for None)."""
+        if coarse is None:
+            return None
+        outcome = self.to_control_model(coarse)
+        if outcome.success:
+            outcome = self.release(outcome)
+            if outcome.success:
+                outcome = self.refine(outcome)
+        return outcome
+
+    def best_completion(self, starts: list[Result]) -> Result | None:
+        """:meth:`complete` each of ``starts`` (their stages named ``start i/n: ...`` when
+        there are several) and keep the converged one of lowest cost; the grid costs the
+        cost error estimate reads are the kept one's. The last outcome if none converged."""
+        if len(starts) <= 1:
+            return self.complete(starts[0] if starts else None)
+        before = list(self.grid_costs)
+        done: list[tuple[Result | None, list[tuple[tuple[int, ...], float]]]] = []
+        for i, start in enumerate(starts):
+            self.prefix = f"start {i + 1}/{len(starts)}: "
+            mark = len(self.grid_costs)
+            outcome = self.complete(start)
+            done.append((outcome, self.grid_costs[mark:]))
+        self.prefix = ""
+        best = best_of([outcome for outcome, _ in done])
+        if best is None:
+            return done[-1][0]
+        self.grid_costs = before + next(grids for outcome, grids in done if outcome is best)
+        return best
 
     def release(self, result: Result) -> Result:
         """Free what the cold stages held, one :data:`RELEASES` stage at a time; each stage
@@ -413,16 +462,18 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         result = outcome if outcome is not None and outcome.success else None
     elif result is None:
         speed = options.speed if options.speed is not None else REFERENCE_SPEED
-        coarse = run.cold(speed, every_start=options.multistart)
         far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9
-        if far and (coarse is None or options.multistart):
-            coarse = best_of([coarse, run.speed_continuation(speed)])
-        if coarse is not None:
-            outcome = run.to_control_model(coarse)
-        if outcome is not None and outcome.success:
-            outcome = run.release(outcome)
-            if outcome.success:
-                outcome = run.refine(outcome)
+        if options.multistart:
+            starts = run.cold_starts(speed, every_start=True)
+            if far:
+                continued = run.speed_continuation(speed)
+                starts += [continued] if continued is not None else []
+            outcome = run.best_completion(distinct(starts))
+        else:
+            coarse = run.cold(speed)
+            if far and coarse is None:
+                coarse = run.speed_continuation(speed)
+            outcome = run.complete(coarse)
     if outcome is not None and outcome.success:
         outcome = run.refine_mesh(outcome)
     if not run.results:  # no stage ran: every naive start was beyond the legs' reach
@@ -432,6 +483,26 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                            stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
                            grid_costs=tuple(run.grid_costs),
                            stage_results=tuple(run.named_results))
+
+
+#: Two coarse optima are the same start for :func:`distinct` when their costs differ by less
+#: than this (relative) and their step lengths by less than :data:`SAME_STEP` (m): IPOPT's
+#: tolerance leaves differences of about 1e-7; the branches differ by 10-25 %.
+SAME_COST = 1e-5
+SAME_STEP = 1e-4
+
+
+def distinct(results: list[Result]) -> list[Result]:
+    """``results`` without those that repeat an earlier one (:data:`SAME_COST`,
+    :data:`SAME_STEP`): starts that found the same optimum are completed once."""
+    kept: list[Result] = []
+    for r in results:
+        if not any(abs(r.objective - k.objective) <= SAME_COST * abs(k.objective)
+                   and abs(r.parameters.get(STEP_LENGTH, 0.0)
+                           - k.parameters.get(STEP_LENGTH, 0.0))
+                   <= SAME_STEP for k in kept):
+            kept.append(r)
+    return kept
 
 
 def unplaced_message(options: GaitOptions, unplaced: list[tuple[float, float, str]]) -> str:
