@@ -269,3 +269,62 @@ def test_heel_toe_with_every_share_free_converges_and_verifies() -> None:
     fixed = solve_gait("seven-link", options.replace(free_phase_fractions=False))
     assert fixed.success
     assert gait.cost_value <= fixed.cost_value * (1 + 1e-6)
+
+
+# -- the command line ---------------------------------------------------------------------------
+
+def _solve_cli(*args: str) -> Any:
+    from click.testing import CliRunner
+
+    from gaitopt.cli import cli
+
+    return CliRunner().invoke(cli, ["solve", *args])
+
+
+@pytest.mark.parametrize(("args", "words"), [
+    (["--free-fractions"], ("free_phase_fractions", "formulation 'full'")),
+    (["--free-fractions", "--formulation", "full", "--single-support-bounds", "0.6,0.9"],
+     ("give one of them",)),
+    (["--free-fractions", "--formulation", "full", "--single-support", "1", "--no-impulse"],
+     ("free_phase_fractions", "has one phase")),
+])
+def test_bad_free_fraction_requests_exit_2_with_one_line(tmp_path: Any, args: list[str],
+                                                         words: tuple[str, ...]) -> None:
+    out = tmp_path / "g.gait.json"
+    result = _solve_cli(*args, "-o", str(out))
+    assert result.exit_code == 2, (result.output, result.exception)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert not out.exists()
+
+
+def test_a_bad_fraction_in_a_sequence_file_exits_2_naming_it(tmp_path: Any) -> None:
+    file = tmp_path / "seq.yaml"
+    file.write_text(
+        "phases:\n"
+        "  - {name: a, held: [tip_1], fraction: {guess: 0.8, min: 0.9, max: 0.95}}\n"
+        "  - {name: b, held: [tip_1, tip_2], fraction: 0.2}\n"
+        "events: [{name: s, touchdown: [tip_2]}, {name: l, release: [tip_1]}]\n"
+        "anchors: {tip_1: 0, tip_2: 1}\n")
+    result = _solve_cli("--contact-sequence", str(file), "-o", str(tmp_path / "g.gait.json"))
+    assert result.exit_code == 2, (result.output, result.exception)
+    assert "phases[0].fraction" in result.stderr and "0 < min <= guess" in result.stderr
+
+
+def test_the_summary_prints_the_solved_fractions(tmp_path: Any, solved: SolveFn) -> None:
+    """``--free-fractions`` on the paper's grid: the same optimum as the API's, and the
+    summary names each phase's solved share and that it was free."""
+    api = solved(FULL.replace(free_phase_fractions=True)).gait
+    out = tmp_path / "free.gait.json"
+    result = _solve_cli("--formulation", "full", "--paper-grid", "--free-fractions", "-o",
+                        str(out))
+    assert result.exit_code == 0, result.output
+    gait = Gait.load(out)
+    assert gait.cost_value == pytest.approx(api.cost_value, rel=1e-6)
+    assert gait.contact_sequence is not None
+    shares = [ph["fraction"] for ph in gait.contact_sequence["phases"]]
+    text = " ".join(result.output.split())
+    assert (f"phase fractions │ single_support {shares[0]:.4f} (free), double_support "
+            f"{shares[1]:.4f} (free)") in text
