@@ -30,6 +30,11 @@ works for any planar tree with contact points and any :class:`ContactSequence`:
   (joints may reach them: a knee may straighten fully), normal forces and impulses ``>= 0``,
   optional friction cones, every point that is not held above the ground, released points
   moving up, points touching down at their anchors, controls continuous and periodic;
+* phase ``i`` lasts ``s_i L / v`` with ``s_i`` its share of the step: its fraction, or for
+  free fractions the parameters ``fraction_<phase>`` after ``L, v, P`` (bounded), the last
+  free phase taking the remainder so that the shares sum to 1
+  (:func:`~gaitopt.gait.contact_sequence.fraction_parameters`; its bounds a boundary row
+  :data:`REMAINDER` when the others' do not imply them);
 * the paper's objective ``(sum of int u'u dt + P^2) / L`` over the actuator controls only.
 
 The rows relaxed by the first continuation stage are named like the reduced problem's
