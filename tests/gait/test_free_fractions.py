@@ -15,22 +15,24 @@ import pytest
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
 from gaitopt.gait.contact_sequence import (
-    FRACTION_PARAMETER,
     ContactSequenceError,
     check_sequence,
-    fraction_parameters,
     heel_toe_sequence,
-    phase_share,
-    remainder_bounds,
     sequence_from_dict,
     walking_sequence,
-    with_first_fraction_bounds,
-    with_free_fractions,
 )
 from gaitopt.gait.formulation import checked_sequence, contact_sequence, problem_for
 from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.phase_fractions import (
+    FRACTION_PARAMETER,
+    fraction_parameters,
+    phase_share,
+    remainder_bounds,
+    with_first_fraction_bounds,
+    with_free_fractions,
+)
 from gaitopt.robot.loader import load_model
 from gaitopt.robot.model import RobotModel
 from tests.gait.conftest import Solved

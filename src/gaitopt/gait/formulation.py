@@ -19,11 +19,10 @@ from gaitopt.gait.contact_sequence import (
     running_sequence,
     sequence_from_dict,
     walking_sequence,
-    with_first_fraction_bounds,
-    with_free_fractions,
 )
 from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.phase_fractions import with_first_fraction_bounds, with_free_fractions
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
 from gaitopt.robot.biped import BipedStructure, BipedStructureError, biped_structure

@@ -33,7 +33,7 @@ works for any planar tree with contact points and any :class:`ContactSequence`:
 * phase ``i`` lasts ``s_i L / v`` with ``s_i`` its share of the step: its fraction, or for
   free fractions the parameters ``fraction_<phase>`` after ``L, v, P`` (bounded), the last
   free phase taking the remainder so that the shares sum to 1
-  (:func:`~gaitopt.gait.contact_sequence.fraction_parameters`; its bounds a boundary row
+  (:func:`~gaitopt.gait.phase_fractions.fraction_parameters`; its bounds a boundary row
   :data:`REMAINDER` when the others' do not imply them);
 * the paper's objective ``(sum of int u'u dt + P^2) / L`` over the actuator controls only.
 
@@ -57,10 +57,7 @@ from gaitopt.gait.contact_sequence import (
     ContactSequence,
     EventSpec,
     check_sequence,
-    fraction_parameters,
     phase_knots,
-    phase_share,
-    remainder_bounds,
 )
 from gaitopt.gait.full_physics import (
     PointValues,
@@ -77,6 +74,7 @@ from gaitopt.gait.full_physics import (
     swap_state,
 )
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.phase_fractions import fraction_parameters, phase_share, remainder_bounds
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
     BoundaryConstraint,

@@ -99,7 +99,7 @@ class GaitOptions:
             given) that is fixed becomes free, a decision parameter within ``[s / 2,
             min(2 s, 0.95)]`` around its share ``s`` (which is its first guess); full
             formulation, two phases or more. Not with ``single_support_fraction_bounds``.
-            See :func:`gaitopt.gait.contact_sequence.fraction_parameters`.
+            See :func:`gaitopt.gait.phase_fractions.fraction_parameters`.
         gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no

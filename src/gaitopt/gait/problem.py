@@ -46,7 +46,7 @@ from gaitopt.robot.model import RobotModel
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 #: What the stage ``phase fractions free`` frees: the free phase fractions of the full
 #: formulation (its parameters ``fraction_<phase>``,
-#: :func:`gaitopt.gait.contact_sequence.fraction_parameters`; bounded there, not here).
+#: :func:`gaitopt.gait.phase_fractions.fraction_parameters`; bounded there, not here).
 FRACTION = "phase fractions"
 PARAMETERS = (STEP_LENGTH, SPEED, IMPULSE)
 _L, _V, _P = range(3)

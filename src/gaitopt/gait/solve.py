@@ -57,7 +57,6 @@ from typing import Any
 import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
-from gaitopt.gait.contact_sequence import fraction_parameters
 from gaitopt.gait.formulation import biped_of, checked_sequence, contact_sequence, stage_bounds
 from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.guess import (
@@ -67,6 +66,7 @@ from gaitopt.gait.guess import (
     naive_running_guess,
 )
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.phase_fractions import fraction_parameters
 from gaitopt.gait.problem import (
     FRACTION,
     IMPULSE,

@@ -103,7 +103,8 @@ def frees_fractions(options: GaitOptions) -> bool:
         return True
     if options.contact_sequence is None:
         return False
-    from gaitopt.gait.contact_sequence import free_phases, sequence_from_dict
+    from gaitopt.gait.contact_sequence import sequence_from_dict
+    from gaitopt.gait.phase_fractions import free_phases
 
     return bool(free_phases(sequence_from_dict(options.contact_sequence)))
 
@@ -113,7 +114,7 @@ def held_bounds(options: GaitOptions, held: set[str], speed: float,
                 fractions: Mapping[str, float] | None = None) -> dict[str, Any]:
     """The parameter bounds with the quantities in ``held`` held: the speed at ``speed``, the
     impulse at 0, the free phase fractions (``fractions``: parameter name -> first guess,
-    :func:`gaitopt.gait.contact_sequence.fraction_parameters`) at ``result``'s values or at
+    :func:`gaitopt.gait.phase_fractions.fraction_parameters`) at ``result``'s values or at
     their guesses; the ankle torques are held by the stage."""
     bounds = dict(parameter_bounds(options))
     if SPEED in held:
