@@ -99,3 +99,14 @@ def test_a_step_the_legs_cannot_reach_is_a_clear_error(tmp_path: Path) -> None:
                        r"a leg beyond its reach \(the legs of model 'compass' cannot hold "
                        r"'tip_1'.*misses it by 0.07"):
         solve_gait(model, GaitOptions(formulation="full", step_length=0.75))
+
+
+def test_the_documented_model_is_this_one(compass: RobotModel) -> None:
+    """docs/formulations.md shows the model file; it is the one these tests solve."""
+    text = (Path(__file__).parents[2] / "docs" / "formulations.md").read_text()
+    block = text.split("```yaml\nformat: gaitopt.model\n", 1)[1].split("```", 1)[0]
+    documented = model_from_dict(yaml.safe_load("format: gaitopt.model\n" + block))
+    mine, theirs = compass.to_dict(), documented.to_dict()
+    for data in (mine, theirs):
+        data.pop("description", None)
+    assert theirs == mine
