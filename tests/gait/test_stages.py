@@ -27,7 +27,9 @@ def _released(options: GaitOptions) -> list[str]:
     (GaitOptions(speed=None, ankle=False, impulse=False), ["speed free"]),
     (GaitOptions(ankle=False, impulse=False), []),
     (GaitOptions(formulation="full", single_support_fraction_bounds=(0.6, 0.95)),
-     ["ankle torques free", "liftoff impulse free", "single-support fraction free"]),
+     ["ankle torques free", "liftoff impulse free", "phase fractions free"]),
+    (GaitOptions(formulation="full", free_phase_fractions=True, speed=None),
+     ["ankle torques free", "liftoff impulse free", "phase fractions free", "speed free"]),
 ])
 def test_the_release_stages_that_run_for_each_variant(options: GaitOptions,
                                                       names: list[str]) -> None:
@@ -44,9 +46,11 @@ def test_held_bounds_hold_exactly_what_is_asked() -> None:
     o = GaitOptions(speed=None, single_support_fraction_bounds=(0.6, 0.95))
     free = parameter_bounds(o)
     assert held_bounds(o, set(), 0.3) == free
-    held = held_bounds(o, {SPEED, IMPULSE, FRACTION}, 0.3)
+    fractions = {"fraction_single_support": o.single_support_fraction}
+    assert held_bounds(o, set(), 0.3, fractions=fractions) == free
+    held = held_bounds(o, {SPEED, IMPULSE, FRACTION}, 0.3, fractions=fractions)
     assert held[SPEED] == (0.3, 0.3) and held[IMPULSE] == (0.0, 0.0)
-    assert held[FRACTION] == (o.single_support_fraction, o.single_support_fraction)
+    assert held["fraction_single_support"] == (o.single_support_fraction,) * 2
     assert held["step_length"] == free["step_length"]
 
 

@@ -28,6 +28,7 @@ from gaitopt.cli.base import (
     parse_pair,
     resting_power_option,
 )
+from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.formulation import biped_of, checked_sequence, default_formulation
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import (
@@ -112,6 +113,9 @@ def _step_time(text: str) -> float | None:
 @click.option("--single-support-bounds", default=None,
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
+@click.option("--free-fractions", is_flag=True,
+              help="Every phase's share of the step free, within half to twice its given "
+                   "share (at most 0.95), starting from it (needs --formulation full).")
 @knots_option
 @paper_grid_option
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)), default=None,
@@ -180,6 +184,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
+                  free_fractions: bool,
                   gait_kind: str, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
                   control_model: str | None, mesh_tol: float | None,
@@ -217,7 +222,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         gait=gait_kind, cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
         mesh_tol=mesh_tol, swing_clearance=clearance,
-        clearance_profile=clearance_profile)  # type: ignore[arg-type]
+        clearance_profile=clearance_profile,  # type: ignore[arg-type]
+        free_phase_fractions=free_fractions)
     if resting_power is not None:
         options = options.replace(resting_power=resting_power)
     if single_support_bounds is not None:
@@ -286,6 +292,8 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     table.add_row("step length", f"{p['step_length']:.4f} m")
     table.add_row("step time", f"{p['step_time']:.4f} s (single support "
                   f"{p['single_support_time']:.4f} s)")
+    if sequence_used is not None and len(sequence_used.phases) > 1:
+        table.add_row("phase fractions", phase_fractions_text(sequence_used, gait))
     table.add_row("liftoff impulse", f"{p['liftoff_impulse']:.4f} N s")
     if gait.options.get("cost", "paper") == "paper":
         table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
@@ -311,6 +319,13 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     console.print(table)
     gait.save(output)
     console.print(f"wrote {output}")
+
+
+def phase_fractions_text(sequence: ContactSequence, gait: Gait) -> str:
+    """Each phase's solved share of the step time, ``(free)`` after those that were."""
+    solved = (gait.contact_sequence or {}).get("phases", [])
+    return ", ".join(f"{ph.name} {float(rec['fraction']):.4f}" + (" (free)" if ph.free else "")
+                     for ph, rec in zip(sequence.phases, solved, strict=True))
 
 
 def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:

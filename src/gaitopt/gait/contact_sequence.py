@@ -15,7 +15,9 @@ and the next step starts again with phase 0.
 
 A held point stands still at its *anchor* on the ground: ``x = anchor * L + offset`` (``L``
 the step length, ``offset`` in metres, 0 unless given), ``y = 0``. Leg 1 stands at ``x = 0``
-and leg 2 lands at ``x = L``. Phase durations are fractions of the step time ``L / v``.
+and leg 2 lands at ``x = L``. Phase durations are fractions of the step time ``L / v``: given
+(fixed), or free within bounds (:attr:`PhaseSpec.bounds`; the fraction is then a first guess and
+the solve chooses it, :mod:`gaitopt.gait.phase_fractions`).
 
 A phase holds each point by a *hold spec* (:func:`gaitopt.dynamics.tree.holds`): ``name``
 pins it (x and y), ``name:y`` holds it along the ground normal only. A flat foot is its heel
@@ -55,11 +57,27 @@ class ContactSequenceError(ValueError):
 
 @dataclass(frozen=True)
 class PhaseSpec:
-    """One phase: its name, the contact points held, and its share of the step time."""
+    """One phase: its name, the contact points held, and its share of the step time.
+
+    ``bounds``: ``None`` (the share is ``fraction``) or ``(lower, upper)``, ``0 < lower <=
+    fraction <= upper <= 1``: the share is free within them and ``fraction`` is its first
+    guess."""
 
     name: str
     held: tuple[str, ...]
     fraction: float
+    bounds: tuple[float, float] | None = None
+
+    @property
+    def free(self) -> bool:
+        """Whether the share is a decision (it has bounds)."""
+        return self.bounds is not None
+
+    def fraction_data(self) -> float | dict[str, float]:
+        """The ``fraction`` field of the plain data: a number, or ``{guess, min, max}``."""
+        if self.bounds is None:
+            return self.fraction
+        return {"guess": self.fraction, "min": self.bounds[0], "max": self.bounds[1]}
 
 
 @dataclass(frozen=True)
@@ -116,7 +134,7 @@ class ContactSequence:
         """Plain data for the gait file."""
         return {
             "name": self.name,
-            "phases": [{"name": p.name, "held": list(p.held), "fraction": p.fraction}
+            "phases": [{"name": p.name, "held": list(p.held), "fraction": p.fraction_data()}
                        for p in self.phases],
             "events": [{"name": e.name, "touchdown": list(e.touchdown),
                         "release": list(e.release), "impulse": e.impulse}
@@ -248,7 +266,8 @@ def heel_toe_sequence(model: RobotModel, contact_swap: Mapping[str, str],
 
 def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSequence:
     """A sequence from plain data (the form :meth:`ContactSequence.to_dict` writes, as in a
-    YAML file): ``name``, ``phases`` (``name``, ``held``, ``fraction``), ``events`` (``name``,
+    YAML file): ``name``, ``phases`` (``name``, ``held``, ``fraction``: a number, or
+    ``{guess, min, max}`` for a free one), ``events`` (``name``,
     optional ``touchdown``, ``release``, ``impulse``), ``anchors`` (contact -> step
     lengths), optional ``offsets`` (contact -> m). Check it against a model with
     :func:`check_sequence`."""
@@ -277,6 +296,15 @@ def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSeq
             raise fail(field, value, "must be a number")
         return float(value)
 
+    def share(field: str, value: Any) -> tuple[float, tuple[float, float] | None]:
+        if not isinstance(value, dict):
+            return number(field, value), None
+        e = mapping(field, value, ("guess", "min", "max"), ("guess", "min", "max"))
+        lo, guess, hi = (number(f"{field}.{k}", e[k]) for k in ("min", "guess", "max"))
+        if not 0.0 < lo <= guess <= hi <= 1.0:
+            raise fail(field, value, "needs 0 < min <= guess <= max <= 1")
+        return guess, (lo, hi)
+
     top = mapping("", data, ("name", "phases", "events", "anchors", "offsets"),
                   ("phases", "events", "anchors"))
     if not isinstance(top["phases"], list) or not top["phases"]:
@@ -287,8 +315,9 @@ def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSeq
     for k, ph in enumerate(top["phases"]):
         e = mapping(f"phases[{k}]", ph, ("name", "held", "fraction"),
                     ("name", "held", "fraction"))
+        fraction, bounds = share(f"phases[{k}].fraction", e["fraction"])
         phases.append(PhaseSpec(str(e["name"]), names(f"phases[{k}].held", e["held"]),
-                                number(f"phases[{k}].fraction", e["fraction"])))
+                                fraction, bounds))
     events = []
     for k, ev in enumerate(top["events"]):
         e = mapping(f"events[{k}]", ev, ("name", "touchdown", "release", "impulse"),
@@ -320,8 +349,9 @@ def _two_contacts(model: RobotModel) -> tuple[str, str]:
 def check_sequence(model: RobotModel, seq: ContactSequence,
                    contact_swap: dict[str, str]) -> None:
     """Raise :class:`ContactSequenceError` unless ``seq`` is consistent: every named point is
-    a contact of ``model`` with an anchor, events match the phases they join, fractions are
-    positive and sum to 1, and the last event leads (after the leg swap) into phase 0."""
+    a contact of ``model`` with an anchor, events match the phases they join, fractions (the
+    first guesses of free ones) are positive, within their bounds and sum to 1, and the last
+    event leads (after the leg swap) into phase 0."""
     names = {c.name for c in model.contacts}
     if not seq.phases or len(seq.events) != len(seq.phases):
         raise ContactSequenceError(f"sequence {seq.name!r}: needs one event per phase")
@@ -352,10 +382,23 @@ def check_sequence(model: RobotModel, seq: ContactSequence,
         if not ph.fraction > 0.0:
             raise ContactSequenceError(f"sequence {seq.name!r}: phase {ph.name!r} fraction "
                                        f"{ph.fraction:g} must be > 0")
+        if ph.bounds is not None and not 0.0 < ph.bounds[0] <= ph.fraction <= ph.bounds[1] \
+                <= 1.0:
+            raise ContactSequenceError(
+                f"sequence {seq.name!r}: phase {ph.name!r} fraction {ph.fraction:g} with "
+                f"bounds [{ph.bounds[0]:g}, {ph.bounds[1]:g}]: needs 0 < min <= guess <= "
+                "max <= 1")
     total = sum(ph.fraction for ph in seq.phases)
+    free = [i for i, ph in enumerate(seq.phases) if ph.free]
     if abs(total - 1.0) > 1e-9:
-        raise ContactSequenceError(f"sequence {seq.name!r}: phase fractions sum to "
+        raise ContactSequenceError(f"sequence {seq.name!r}: phase fractions "
+                                   f"{'(first guesses) ' if free else ''}sum to "
                                    f"{total:g}, not 1")
+    if len(free) == 1:
+        raise ContactSequenceError(
+            f"sequence {seq.name!r}: phase {seq.phases[free[0]].name!r} is the only one with "
+            "free fraction bounds; with every other share fixed its share is fixed too (give "
+            "bounds to at least two phases)")
     for i, ev in enumerate(seq.events):
         held = [hold_name(c) for c in seq.phases[i].held]
         for c in ev.release:

@@ -22,6 +22,7 @@ from gaitopt.gait.contact_sequence import (
 )
 from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.gait.phase_fractions import with_first_fraction_bounds, with_free_fractions
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
 from gaitopt.robot.biped import BipedStructure, BipedStructureError, biped_structure
@@ -55,7 +56,18 @@ def default_formulation(model: RobotModel, gait: str, custom_sequence: bool) -> 
 
 def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
     """The contact sequence of ``options``: the one given as data, or the paper's walk, the
-    single-support walk, a run or a heel-toe walk."""
+    single-support walk, a run or a heel-toe walk; with its fractions freed by
+    ``single_support_fraction_bounds`` (phase 0 of two) or ``free_phase_fractions`` (every
+    phase, default bounds)."""
+    seq = _sequence(model, options)
+    if options.single_support_fraction_bounds is not None:
+        seq = with_first_fraction_bounds(seq, options.single_support_fraction_bounds)
+    if options.free_phase_fractions:
+        seq = with_free_fractions(seq)
+    return seq
+
+
+def _sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
     if options.contact_sequence is not None:
         return sequence_from_dict(options.contact_sequence)
     if options.gait == "heel-toe":
@@ -77,6 +89,9 @@ def checked_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence
         check_sequence(model, seq, dict(model_symmetry(model).contacts))
     except (ContactSequenceError, ValueError) as exc:
         raise GaitOptionsError(f"contact sequence: {exc}") from None
+    if options.free_phase_fractions and len(seq.phases) < 2:
+        raise GaitOptionsError(f"free_phase_fractions: sequence {seq.name!r} has one phase, "
+                               "whose share is the whole step: nothing to free")
     return seq
 
 

@@ -30,6 +30,11 @@ works for any planar tree with contact points and any :class:`ContactSequence`:
   (joints may reach them: a knee may straighten fully), normal forces and impulses ``>= 0``,
   optional friction cones, every point that is not held above the ground, released points
   moving up, points touching down at their anchors, controls continuous and periodic;
+* phase ``i`` lasts ``s_i L / v`` with ``s_i`` its share of the step: its fraction, or for
+  free fractions the parameters ``fraction_<phase>`` after ``L, v, P`` (bounded), the last
+  free phase taking the remainder so that the shares sum to 1
+  (:func:`~gaitopt.gait.phase_fractions.fraction_parameters`; its bounds a boundary row
+  :data:`REMAINDER` when the others' do not imply them);
 * the paper's objective ``(sum of int u'u dt + P^2) / L`` over the actuator controls only.
 
 The rows relaxed by the first continuation stage are named like the reduced problem's
@@ -69,6 +74,7 @@ from gaitopt.gait.full_physics import (
     swap_state,
 )
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.phase_fractions import fraction_parameters, phase_share, remainder_bounds
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
     BoundaryConstraint,
@@ -104,6 +110,9 @@ RISE = "released points rise (impulse)"
 EVENT_FRICTION = "friction cones of the impulses"
 #: The step time ``L / v`` (s) row, present when a step time is given.
 STEP_TIME = "step time L / v"
+#: The bounds of the free phase that takes the remainder of the step time (suffix of
+#: ``<phase>: ...``), when the other free fractions' bounds do not imply them.
+REMAINDER = "share within its bounds (the remainder of the step)"
 #: Bound on the projection controls (m/s and m/s^2 per unit of J^T): generous, they vanish.
 PROJECTION_BOUND = 10.0
 #: Scales of the rate states (rad/s, m/s) and of the projection controls in the NLP. Measured
@@ -141,10 +150,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
     names = state_names(model)
     weight = model.total_mass * 9.81
     rate = options.rate_bound
-    free_fraction = options.single_support_fraction_bounds is not None
-    if free_fraction and len(seq.phases) != 2:
-        raise ValueError(f"a free single-support fraction needs a sequence of two phases; "
-                         f"{seq.name!r} has {len(seq.phases)}")
+    fractions = fraction_parameters(seq)
 
     def state_bounds(held: Sequence[str]) -> dict[str, tuple[float, float]]:
         b: dict[str, tuple[float, float]] = {
@@ -223,8 +229,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
 
             path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf, scale=0.1))
         if options.swing_clearance is not None and not phases and landing:
-            path.append(_clearance_profile(model, options, landing,
-                                           _share(0, ph.fraction, free_fraction)))
+            path.append(_clearance_profile(model, options, landing, _share(seq, 0)))
 
         def dynamics(x: Any, u: Any, p: Any, t: Any, point: Any = point) -> Any:
             return point(x, u).xdot
@@ -244,8 +249,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
                                             for n in model.coordinate_names}
         phases.append(Phase(
             name=ph.name, states=names, controls=controls, dynamics=dynamics,
-            duration=Duration.of_parameters(
-                _step_share(_share(len(phases), ph.fraction, free_fraction))),
+            duration=Duration.of_parameters(_step_share(_share(seq, len(phases)))),
             state_bounds=state_bounds(held), control_bounds=control_bounds,
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
@@ -332,7 +336,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
                                          lower=-ca.inf, upper=ca.inf, scale=1.0))
 
-    from gaitopt.gait.problem import FRACTION, parameter_bounds
+    from gaitopt.gait.problem import parameter_bounds
 
     bounds = parameter_bounds(options)
     if not any(ev.impulse for ev in seq.events):
@@ -340,9 +344,14 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
     parameters = [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH], scale=0.5),
                   Parameter(SPEED, *bounds[SPEED], scale=1.0),
                   Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
-    if FRACTION in bounds:
-        parameters.append(Parameter(FRACTION, *bounds[FRACTION], scale=1.0,
-                                    guess=options.single_support_fraction))
+    parameters += [Parameter(fp.name, fp.lower, fp.upper, scale=1.0, guess=fp.guess)
+                   for fp in fractions]
+    remainder = remainder_bounds(seq)
+    if remainder is not None:
+        rest, lo, hi = remainder
+        events.append(BoundaryConstraint(f"{seq.phases[rest].name}: {REMAINDER}",
+                                         lambda ends, p: _share(seq, rest)(p), lower=lo,
+                                         upper=hi, scale=1.0))
     return Problem(
         phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
         parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
@@ -373,12 +382,11 @@ def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
     return mayer
 
 
-def _share(i: int, fraction: float, free: bool) -> Callable[[Any], Any]:
-    """``p -> `` phase ``i``'s share of the step time: its sequence fraction, or with a free
-    fraction ``f = p[3]`` for phase 0 and ``1 - f`` for phase 1."""
-    if not free:
-        return lambda p: fraction
-    return (lambda p: p[_F]) if i == 0 else (lambda p: 1.0 - p[_F])
+def _share(seq: ContactSequence, i: int) -> Callable[[Any], Any]:
+    """``p -> `` phase ``i``'s share of the step time (:func:`phase_share`): its fraction,
+    or of the free fractions ``p[_F:]`` (in the order of :func:`fraction_parameters`)."""
+    n = len(fraction_parameters(seq))
+    return lambda p: phase_share(seq, i, [p[_F + k] for k in range(n)])
 
 
 def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence[str],

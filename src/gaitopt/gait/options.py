@@ -104,6 +104,11 @@ class GaitOptions:
             or ``(lower, upper)``: the fraction is free within them, a decision parameter
             (``single_support_fraction`` is its first guess); full formulation, with double
             support (a walk) or a flight (a run).
+        free_phase_fractions: every phase fraction of the contact sequence (built in or
+            given) that is fixed becomes free, a decision parameter within ``[s / 2,
+            min(2 s, 0.95)]`` around its share ``s`` (which is its first guess); full
+            formulation, two phases or more. Not with ``single_support_fraction_bounds``.
+            See :func:`gaitopt.gait.phase_fractions.fraction_parameters`.
         gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no
@@ -112,8 +117,8 @@ class GaitOptions:
             :func:`gaitopt.gait.contact_sequence.heel_toe_sequence`).
         contact_sequence: a contact sequence as plain data (the gait file's
             ``contact_sequence``; :func:`gaitopt.gait.contact_sequence.sequence_from_dict`),
-            which replaces ``gait``; full formulation only. Its phase fractions are used as
-            given.
+            which replaces ``gait``; full formulation only. A phase fraction is a number
+            (fixed) or ``{guess, min, max}`` (free within the bounds).
         cost: ``"paper"`` (torque squared per metre), ``"work"`` (mechanical cost of
             transport) or ``"metabolic"`` (with efficiencies and a resting power); formulas in
             :mod:`gaitopt.gait.cost` and docs/costs.md.
@@ -170,6 +175,7 @@ class GaitOptions:
     gait: GaitKind = "walk"
     contact_sequence: dict[str, Any] | None = None
     single_support_fraction_bounds: tuple[float, float] | None = None
+    free_phase_fractions: bool = False
     cost: CostName = "paper"
     efficiency_positive: float = 0.25
     efficiency_negative: float = 1.2
@@ -296,6 +302,13 @@ def validate_options(options: GaitOptions, biped: BipedStructure | None) -> None
             raise GaitOptionsError(f"single_support_fraction = {o.single_support_fraction:g}: "
                                    f"must lie in single_support_fraction_bounds "
                                    f"[{f_lo:g}, {f_hi:g}] (it is the first guess)")
+    if o.free_phase_fractions:
+        if o.formulation != "full":
+            raise GaitOptionsError("free_phase_fractions: free phase fractions need "
+                                   "formulation 'full'")
+        if o.single_support_fraction_bounds is not None:
+            raise GaitOptionsError("free_phase_fractions and single_support_fraction_bounds: "
+                                   "give one of them (free_phase_fractions frees every phase)")
     if o.gait not in GAITS:
         raise GaitOptionsError(f"gait = {o.gait!r}: must be one of {', '.join(GAITS)}")
     if (o.gait == "heel-toe" or o.contact_sequence is not None) and o.formulation != "full":

@@ -44,8 +44,10 @@ from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
-#: The free single-support fraction, a fourth parameter (full formulation only).
-FRACTION = "single_support_fraction"
+#: What the stage ``phase fractions free`` frees: the free phase fractions of the full
+#: formulation (its parameters ``fraction_<phase>``,
+#: :func:`gaitopt.gait.phase_fractions.fraction_parameters`; bounded there, not here).
+FRACTION = "phase fractions"
 PARAMETERS = (STEP_LENGTH, SPEED, IMPULSE)
 _L, _V, _P = range(3)
 
@@ -135,8 +137,8 @@ def with_step_time(bounds: Bounds, options: GaitOptions) -> Bounds:
 
 
 def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
-    """Bounds of ``L, v, P`` (and of the single-support fraction when it is free) for a
-    variant: a given value becomes equal bounds."""
+    """Bounds of ``L, v, P`` for a variant: a given value becomes equal bounds. (Free phase
+    fractions keep the bounds their parameters have in the problem.)"""
     if options.step_length is not None:
         step = (options.step_length, options.step_length)
     elif options.step_time is not None and options.speed is not None:
@@ -148,11 +150,7 @@ def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
     # Without double support the trailing leg leaves at the heel strike with no impulse.
     with_impulse = options.impulse and options.double_support
     impulse = (0.0, options.max_impulse) if with_impulse else (0.0, 0.0)
-    bounds = {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
-    if options.single_support_fraction_bounds is not None:
-        lo, hi = options.single_support_fraction_bounds
-        bounds[FRACTION] = (float(lo), float(hi))
-    return bounds
+    return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
 
 
 def _limits(model: RobotModel, joint: str) -> tuple[float, float]:

@@ -12,8 +12,8 @@ are data (:mod:`gaitopt.gait.stages`: :data:`~gaitopt.gait.stages.CONTACT_STAGES
    (:data:`~gaitopt.gait.stages.COLD_START_OPTIONS`); the ankle torques held at zero;
 2. ``enforced contact``: the same with the contact conditions enforced (the paper's two-stage
    process);
-3. ``ankle torques free``, ``liftoff impulse free`` (impulse variants), ``single-support
-   fraction free`` (when bounded) and ``speed free`` (the optimal walk): what was held so far
+3. ``ankle torques free``, ``liftoff impulse free`` (impulse variants), ``phase fractions
+   free`` (when some are free) and ``speed free`` (the optimal walk): what was held so far
    is released one at a time; starting from the no-impulse gait keeps the impulse variants
    from stopping in worse local minima than the no-impulse gait;
 4. ``target grid``: the requested grid, if finer, from the coarse solution interpolated
@@ -70,6 +70,7 @@ from gaitopt.gait.guess import (
     naive_running_guess,
 )
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.phase_fractions import fraction_parameters
 from gaitopt.gait.problem import (
     FRACTION,
     IMPULSE,
@@ -140,6 +141,10 @@ class _Run:
         self.grid_costs: list[tuple[tuple[int, ...], float]] = []
         #: Naive starts no leg could reach: (step length m, longest leg reach m, why).
         self.unplaced: list[tuple[float, float, str]] = []
+        #: The free phase fractions' parameters -> first guesses (held by the cold stages).
+        self.fractions = ({fp.name: fp.guess for fp in
+                           fraction_parameters(contact_sequence(model, options))}
+                          if options.formulation == "full" else {})
 
     def stage(self, name: str, knots: Grid, relax: Relaxation,
               guess: Guess | Result | WarmStart, bounds: dict[str, Any], *,
@@ -191,7 +196,7 @@ class _Run:
         r_max = (0.0 if biped is None else
                  min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
         held = {spec.frees for spec in RELEASES if spec.frees and spec.runs(o)}
-        bounds = held_bounds(o, held, speed)
+        bounds = held_bounds(o, held, speed, fractions=self.fractions)
         bounds[SPEED] = (speed, speed)  # also when the speed is given: continuation
         if o.step_length is not None:
             steps = [o.step_length]
@@ -226,9 +231,9 @@ class _Run:
                 self.unplaced.append((step0, r_max, str(exc)))
                 continue
             start = guess.to_ocp()
-            if FRACTION in bounds:  # a free fraction starts at its guess
-                start = Guess(phases=start.phases, parameters={
-                    **start.parameters, FRACTION: o.single_support_fraction})
+            if self.fractions:  # free fractions start at their guesses
+                start = Guess(phases=start.phases,
+                              parameters={**start.parameters, **self.fractions})
             result: Guess | Result = start
             for spec in CONTACT_STAGES:
                 result = self.stage(spec.name, coarse, spec.relax, result, bounds,
@@ -261,7 +266,7 @@ class _Run:
             return result
         held = {spec.frees for spec in RELEASES if spec.frees and spec.runs(o)}
         speed = result.parameters[SPEED]
-        bounds = held_bounds(o, held, speed, result)
+        bounds = held_bounds(o, held, speed, result, self.fractions)
         bounds[SPEED] = (speed, speed)
         return self.stage(f"control model {o.control_model}", coarse_knots(o), Relaxation(),
                           result_guess(result), bounds, hold_ankles=ANKLES in held,
@@ -309,7 +314,7 @@ class _Run:
         for i, spec in enumerate(stages):
             held = {later.frees for later in stages[i + 1:] if later.frees}
             result = self.stage(spec.name, coarse, spec.relax, result,
-                                held_bounds(o, held, speed, start),
+                                held_bounds(o, held, speed, start, self.fractions),
                                 hold_ankles=ANKLES in held, solver_options=spec.solver_options)
             if not result.success:
                 return result
@@ -381,7 +386,8 @@ class _Run:
             return None
         speeds = np.linspace(REFERENCE_SPEED, target,
                              int(np.ceil(abs(target - REFERENCE_SPEED) / SPEED_STEP)) + 1)[1:]
-        bounds = held_bounds(o, {IMPULSE, FRACTION}, REFERENCE_SPEED)
+        bounds = held_bounds(o, {IMPULSE, FRACTION}, REFERENCE_SPEED,
+                             fractions=self.fractions)
         for v in speeds:
             b = dict(bounds)
             b["speed"] = (float(v), float(v))
@@ -510,6 +516,9 @@ def unplaced_message(options: GaitOptions, unplaced: list[tuple[float, float, st
     constant height and speed; at the heel strike it is ``L (1 - f/2)`` ahead of the stance
     tip (step length ``L``, single-support fraction ``f``), which the stance leg must reach."""
     step, r_max, why = max(unplaced, key=lambda u: u[0]) if unplaced else (nan, nan, "")
+    if r_max == 0.0:  # the generic guess (no thigh-shank legs): no closed-form reach
+        return (f"step_length = {step:.3g} m: every naive start puts a leg beyond its reach "
+                f"({why}): a shorter step or a lower speed")
     f = options.single_support_fraction
     longest = r_max / (1.0 - f / 2.0)
     return (f"step_length = {step:.3g} m: every naive start puts a leg beyond its reach "

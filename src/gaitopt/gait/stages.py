@@ -9,7 +9,7 @@ options of the stages (and why) are here too.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -91,26 +91,40 @@ RELEASES: tuple[StageSpec, ...] = (
     StageSpec("ankle torques free", runs=lambda o: o.ankle, frees=ANKLES),
     StageSpec("liftoff impulse free", runs=lambda o: o.impulse and o.double_support,
               frees=IMPULSE),
-    StageSpec("single-support fraction free",
-              runs=lambda o: o.single_support_fraction_bounds is not None, frees=FRACTION),
+    StageSpec("phase fractions free", runs=lambda o: frees_fractions(o), frees=FRACTION),
     StageSpec("speed free", runs=lambda o: o.speed is None, frees=SPEED),
 )
 
 
+def frees_fractions(options: GaitOptions) -> bool:
+    """Whether the options free phase fractions (``single_support_fraction_bounds``,
+    ``free_phase_fractions`` or fraction bounds in a given sequence)."""
+    if options.single_support_fraction_bounds is not None or options.free_phase_fractions:
+        return True
+    if options.contact_sequence is None:
+        return False
+    from gaitopt.gait.contact_sequence import sequence_from_dict
+    from gaitopt.gait.phase_fractions import free_phases
+
+    return bool(free_phases(sequence_from_dict(options.contact_sequence)))
+
+
 def held_bounds(options: GaitOptions, held: set[str], speed: float,
-                result: Result | None = None) -> dict[str, Any]:
+                result: Result | None = None,
+                fractions: Mapping[str, float] | None = None) -> dict[str, Any]:
     """The parameter bounds with the quantities in ``held`` held: the speed at ``speed``, the
-    impulse at 0, a free single-support fraction at ``result``'s value (or at its first
-    guess ``options.single_support_fraction``); the ankle torques are held by the stage."""
+    impulse at 0, the free phase fractions (``fractions``: parameter name -> first guess,
+    :func:`gaitopt.gait.phase_fractions.fraction_parameters`) at ``result``'s values or at
+    their guesses; the ankle torques are held by the stage."""
     bounds = dict(parameter_bounds(options))
     if SPEED in held:
         bounds[SPEED] = (speed, speed)
     if IMPULSE in held:
         bounds[IMPULSE] = (0.0, 0.0)
-    if FRACTION in held and FRACTION in bounds:
-        value = (result.parameters[FRACTION] if result is not None
-                 else options.single_support_fraction)
-        bounds[FRACTION] = (value, value)
+    if FRACTION in held:
+        for name, guess in (fractions or {}).items():
+            value = result.parameters.get(name, guess) if result is not None else guess
+            bounds[name] = (value, value)
     return bounds
 
 
