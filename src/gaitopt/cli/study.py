@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -54,7 +54,15 @@ from gaitopt.study.driver import (
     run_sweep,
 )
 from gaitopt.study.executors import Backend, BackendError
-from gaitopt.study.plan import SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.study.grid_error import (
+    CHECK_DIR,
+    REFINE_DIR,
+    WITHIN,
+    GridError,
+    check_knots,
+    grid_error,
+)
+from gaitopt.study.plan import START_SPEED, SweepPoint, SweepSpec, SweepSpecError
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 from gaitopt.study.worker import PointOutcome
 
@@ -201,10 +209,12 @@ def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
 def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
                       workers: int | None, scheduler: str | None,
                       fail_points: Sequence[str] = (),
-                      backend: Backend | None = None) -> SweepReport:
+                      backend: Backend | None = None,
+                      seeds: Mapping[str, Path] | None = None) -> SweepReport:
     """:func:`run_sweep` with a progress bar (done/failed/remaining, ETA) and a line per
     finished point; errors the user can fix become :class:`UserError`. ``backend``: run on
-    it (and leave it open) instead of starting one."""
+    it (and leave it open) instead of starting one; ``seeds``: warm starts of the chains'
+    first points (:func:`run_sweep`)."""
     progress = Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
         TextColumn("failed {task.fields[failed]}  remaining {task.fields[remaining]}"),
@@ -232,7 +242,7 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
     try:
         report = run_sweep(spec, directory, workers=workers, scheduler=scheduler,
                            on_start=on_start, on_point=on_point, fail_points=fail_points,
-                           backend=backend)
+                           backend=backend, seeds=seeds)
     except (SweepSpecError, SweepSettingsError, BackendError, GaitOptionsError,
             BipedStructureError) as exc:
         raise UserError(str(exc)) from None
@@ -369,7 +379,6 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
     optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
-    from gaitopt.study.grid_error import CHECK_DIR, check_knots, grid_error
     from gaitopt.study.summary import read_summary
 
     console = make_console()
@@ -399,11 +408,14 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                       problem={**grid, "knots": finer})
     run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
                       scheduler=scheduler)
+    rows = read_summary(directory / SUMMARY_FILE)
+    refine_points(console, directory, model_name, grid, grid_error(directory, rows),
+                  workers=workers, scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
-    rows = read_summary(directory / SUMMARY_FILE)
     errors = grid_error(directory, rows)
     if errors is not None:
+        rows = errors.reported(rows)
         console.print(errors.statement(), soft_wrap=True)
         for v in VARIANTS:
             p = errors.free(v)
@@ -424,6 +436,38 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
         console.print("no point converged: no animation", soft_wrap=True)
     console.print(f"study done in {time.perf_counter() - start:.0f} s. Open {pages[0]}",
                   soft_wrap=True)
+
+
+def refine_points(console: Console, directory: Path, model_name: str, grid: dict[str, Any],
+                  errors: GridError | None, *, workers: int | None,
+                  scheduler: str | None) -> None:
+    """The refinement sweep of a study (:mod:`gaitopt.study.grid_error`): the points whose
+    change to the check grid exceeds 1 % (every variant at their speeds, and the speed-free
+    optima if one of them is among them), solved on the next finer grid in
+    ``DIR/refine-grid``, each chain warm-started from the check sweep's gait."""
+    if errors is None or errors.check_knots is None:
+        return
+    points = errors.to_refine()
+    if not points and not (directory / REFINE_DIR / SUMMARY_FILE).exists():
+        return
+    # Rerunning a finished study: refine the same points again (they are kept).
+    done = [p.row for p in errors.points if p.refined]
+    rows = [p.row for p in points] + done
+    finer = check_knots(errors.check_knots)
+    speeds = sorted({round(r.speed_m_min, 6) for r in rows if r.speed_mode == "fixed"})
+    console.print(f"refinement grid {finer[0]}+{finer[1]} knots: {len(points)} points "
+                  f"changed by more than {100 * WITHIN:g} % to the check grid",
+                  soft_wrap=True)
+    if not speeds:  # only speed-free optima: solve them from the check grid's start speed
+        speeds = [START_SPEED * 60.0]
+    spec = make_spec(model_name=model_name, speeds=",".join(f"{v:g}" for v in speeds),
+                     variants=",".join(sorted({r.variant for r in rows})),
+                     free=any(r.speed_mode == "free" for r in rows), step_length="free",
+                     single_support="0.85", problem={**grid, "knots": finer})
+    check = directory / CHECK_DIR
+    seeds = {p.key: check / p.key for p in spec.points if (check / p.key).exists()}
+    run_with_progress(console, spec, directory / REFINE_DIR, workers=workers,
+                      scheduler=scheduler, seeds=seeds)
 
 
 def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
