@@ -17,8 +17,8 @@ Run: ``python bench/mesh_convergence.py [--models paper jumps] [--grids 8,5 16,6
 for each ``--variants`` x ``--speeds`` point (m/min, or ``free`` for the speed-free optimum)
 it takes the point's gait from the study's finest grid (its refinement sweep, else its check
 sweep), solves the same problem warm-started from it on each ``--grids`` grid in turn (each
-from the previous), and prints the study's reported value, the values of every grid and the
-reported value's distance to the finest grid (cost relative, speed and step length absolute).
+from the previous; ``--spacing`` uniform or cosine knots, default the study's), and prints
+each grid's values and their distance to the finest grid (cost relative).
 Run: ``python bench/mesh_convergence.py --study out/study --speeds 12 36 60 free
 --grids 40,10 80,20``
 """
@@ -105,8 +105,8 @@ def study_grids(study: Path) -> list[tuple[str, Path]]:
     return out
 
 
-def study_point(study: Path, variant: str, speed: str,
-                grids: list[tuple[int, int]]) -> dict[str, Any]:
+def study_point(study: Path, variant: str, speed: str, grids: list[tuple[int, int]],
+                spacing: str | None = None) -> dict[str, Any]:
     """One point of ``--study``: its values on the study's grids and on ``grids``."""
     robot = load_model("five-link")
     out: dict[str, Any] = {"variant": variant, "speed": speed, "values": {}}
@@ -123,11 +123,13 @@ def study_point(study: Path, variant: str, speed: str,
         return out
     options = GaitOptions.from_dict(dict(start_gait.options)).replace(
         speed=None if speed == "free" else float(speed) / 60.0)
+    if spacing is not None:
+        options = options.replace(knot_spacing=spacing)
     warm: Any = guess_from_gait(start_gait)
     for grid in grids:
         mark = time.perf_counter()
         sol = solve_walking(robot, options.replace(knots=grid), warm_start=warm)
-        label = f"{grid[0]}+{grid[1]}"
+        label = f"{grid[0]}+{grid[1]} {options.knot_spacing}"
         if sol.success:
             r = sol.result
             out["values"][label] = (r.objective, 60.0 * r.parameters["speed"],
@@ -159,7 +161,7 @@ def main_study(args: argparse.Namespace) -> None:
     print("|:--|--:|--:|--:|--:|--:|--:|")
     for variant in args.variants:
         for speed in args.speeds:
-            p = study_point(Path(args.study), variant, speed, grids)
+            p = study_point(Path(args.study), variant, speed, grids, args.spacing)
             print("\n".join(study_lines(p)), flush=True)
             if args.json:
                 with open(args.json, "a") as fh:
@@ -172,6 +174,8 @@ def main() -> None:
     ap.add_argument("--variants", nargs="+", default=["ankle", "plain"], choices=VARIANTS)
     ap.add_argument("--speeds", nargs="+", default=["12", "36", "60", "free"],
                     help="with --study: speeds in m/min, or free")
+    ap.add_argument("--spacing", default=None, choices=["uniform", "cosine"],
+                    help="with --study: the knot spacing of --grids (default: the study's)")
     ap.add_argument("--models", nargs="+", default=list(MODELS), choices=list(MODELS))
     ap.add_argument("--grids", nargs="+", default=[f"{a},{b}" for a, b in GRIDS])
     ap.add_argument("--clearance", type=float, default=None)

@@ -12,6 +12,7 @@ import math
 import sys
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -43,7 +44,7 @@ from gaitopt.cli.base import (
 )
 from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.gait.formulation import default_formulation
-from gaitopt.gait.options import GAITS, GaitOptions, GaitOptionsError
+from gaitopt.gait.options import GAITS, KNOT_SPACINGS, GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import (
     Counts,
@@ -262,6 +263,11 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
     return report
 
 
+def _spacing_option(default: str, help_: str) -> Any:
+    return click.option("--knot-spacing", type=click.Choice(list(KNOT_SPACINGS)),
+                        default=default, show_default=True, help=help_)
+
+
 def _workers_option(f: Any) -> Any:
     f = click.option("--scheduler", default=None, metavar="ADDRESS",
                      help="Run on a Dask cluster (e.g. tcp://host:8786) instead of local "
@@ -300,11 +306,13 @@ def _workers_option(f: Any) -> Any:
 @resting_power_option
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
+@_spacing_option("uniform", "The knots of each phase: uniform, or cosine-spaced (clustered at "
+                            "the events; docs/walking.md section 6).")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
                   paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
-                  resting_power: float | None, control_model: str | None,
+                  resting_power: float | None, control_model: str | None, knot_spacing: str,
                   workers: int | None, scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
 
@@ -321,7 +329,8 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
         except ValueError as exc:
             raise UserError(str(exc)) from None
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "gait": gait_kind, **grid_choice(knots, control_model, paper_grid)}
+                               "gait": gait_kind, "knot_spacing": knot_spacing,
+                               **grid_choice(knots, control_model, paper_grid)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     spec = make_spec(model_name=model_name, speeds=speeds, variants=variants, free=free,
@@ -368,9 +377,13 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
               help="The paper's setting: 8+5 knots and its control model (continuous, "
                    "periodic controls); checked against 16+6 knots.")
 @knots_option
+@_spacing_option("cosine", "The knots of each phase of the paper's study: cosine-spaced "
+                           "(clustered at the events, the default) or uniform (always with "
+                           "--paper-grid).")
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
-                  paper_grid: bool, knots: str | None, cost_study: bool, costs: tuple[str, ...],
+                  paper_grid: bool, knots: str | None, knot_spacing: str, cost_study: bool,
+                  costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, clearance: float | None, gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
@@ -394,7 +407,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                         "--costs)")
     directory = directory or STUDY_DIR
     start = time.perf_counter()
-    grid = grid_choice(knots, None, paper_grid)
+    grid = {**grid_choice(knots, None, paper_grid),
+            "knot_spacing": "uniform" if paper_grid else knot_spacing}
     model_name = model_names[0] if model_names else "five-link"
     spec = make_spec(model_name=model_name, speeds=speeds,
                      variants="all", free=True, step_length="free", single_support="0.85",
@@ -444,7 +458,8 @@ def refine_points(console: Console, directory: Path, model_name: str, grid: dict
     """The refinement sweep of a study (:mod:`gaitopt.study.grid_error`): the points whose
     change to the check grid exceeds 1 % (every variant at their speeds, and the speed-free
     optima if one of them is among them), solved on the next finer grid in
-    ``DIR/refine-grid``, each chain warm-started from the check sweep's gait."""
+    ``DIR/refine-grid``, each warm-started from the check sweep's gait of the same point
+    (no continuation: the points are independent and may be far apart in speed)."""
     if errors is None or errors.check_knots is None:
         return
     points = errors.to_refine()
@@ -460,10 +475,11 @@ def refine_points(console: Console, directory: Path, model_name: str, grid: dict
                   soft_wrap=True)
     if not speeds:  # only speed-free optima: solve them from the check grid's start speed
         speeds = [START_SPEED * 60.0]
-    spec = make_spec(model_name=model_name, speeds=",".join(f"{v:g}" for v in speeds),
-                     variants=",".join(sorted({r.variant for r in rows})),
-                     free=any(r.speed_mode == "free" for r in rows), step_length="free",
-                     single_support="0.85", problem={**grid, "knots": finer})
+    spec = replace(make_spec(model_name=model_name, speeds=",".join(f"{v:g}" for v in speeds),
+                             variants=",".join(sorted({r.variant for r in rows})),
+                             free=any(r.speed_mode == "free" for r in rows),
+                             step_length="free", single_support="0.85",
+                             problem={**grid, "knots": finer}), continuation=False)
     check = directory / CHECK_DIR
     seeds = {p.key: check / p.key for p in spec.points if (check / p.key).exists()}
     run_with_progress(console, spec, directory / REFINE_DIR, workers=workers,

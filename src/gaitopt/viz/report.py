@@ -290,8 +290,10 @@ def _optimum_error(errors: GridError | None, row: SummaryRow) -> str:
         grid = (f"solved on {errors.refine_knots[0]}+{errors.refine_knots[1]}, change from "
                 f"{errors.check_knots[0]}+{errors.check_knots[1]}")
     moved = "" if row.speed_mode == "fixed" else f"speed {p.speed_m_min:+.2f} m/min, "
-    return (f"{grid} knots: cost {100 * p.cost:.2f} %, {moved}"
-            f"step {p.step_length:+.4f} m")
+    estimate = "" if row.speed_mode == "fixed" else f"speed {p.speed_error:.2f} m/min, "
+    return (f"{grid} knots: cost {100 * p.cost:.2f} %, {moved}step {p.step_length:+.4f} m; "
+            f"error estimate ({p.factor:g} x): cost {100 * p.cost_error:.2f} %, {estimate}"
+            f"step {p.step_error:.4f} m")
 
 
 def _solver_table(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None],
