@@ -423,8 +423,9 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
                       scheduler=scheduler)
     rows = read_summary(directory / SUMMARY_FILE)
-    refine_points(console, directory, model_name, grid, grid_error(directory, rows),
-                  workers=workers, scheduler=scheduler)
+    if not paper_grid:  # the paper's setting is reported as it is, with its estimate
+        refine_points(console, directory, model_name, grid, grid_error(directory, rows),
+                      workers=workers, scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
     errors = grid_error(directory, rows)

@@ -246,7 +246,7 @@ class GridError:
 
 def _span(points: Sequence[PointError]) -> str:
     """``33-60 m/min`` (the speeds of ``points``)."""
-    speeds = sorted(p.row.speed_m_min for p in points)
+    speeds = sorted(round(p.row.speed_m_min, 1) for p in points)
     return (f"{speeds[0]:g} m/min" if speeds[0] == speeds[-1] else
             f"{speeds[0]:g}-{speeds[-1]:g} m/min")
 
