@@ -388,9 +388,10 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                   regularization: float, clearance: float | None, gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
-    optimum, the same on a finer grid (DIR/check-grid) for the error estimates, then the
-    report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
-    optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
+    optimum (cosine-spaced 16+6 knots), the same on a finer grid (DIR/check-grid) for the
+    error estimates, the points whose estimate exceeds 1 % finer still (DIR/refine-grid),
+    then the report (Figs. 3-8 with their grid and error estimate, findings) and an animation
+    of the optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
     from gaitopt.study.summary import read_summary
 
