@@ -185,10 +185,15 @@ def test_study_writes_the_report_and_an_animation(runner: CliRunner, tmp_path: P
     check = read_summary(folder / "check-grid" / SUMMARY_FILE)
     assert len(check) == 16 and all(r.success for r in check)
     page = (folder / "report" / "report.html").read_text(encoding="utf-8")
-    assert ("Grid: 16+6 cosine-spaced knots, control model jumps. Error estimate (3 x the "
-            "change to 24+8 knots at "
-            "12 fixed-speed points, 4 speed-free optima)") in page
+    assert "Grid: 16+6 cosine-spaced knots, control model jumps" in page
+    assert "at 12 fixed-speed points, 4 speed-free optima): cost within" in page
     assert "on the check grid speed" in " ".join(result.output.split())
+    # The points whose estimate exceeds 1 % are re-solved on 36+12 and reported from there.
+    # (here the speed-free optima: their speeds move by 0.1 m/min, 3 x that is over 1 %)
+    again = read_summary(folder / "refine-grid" / SUMMARY_FILE)
+    assert again and all(r.success for r in again)
+    assert list(Gait.load(folder / "refine-grid" / again[0].file).options["knots"]) == [36, 12]
+    assert "36+12 knots at the" in page and f"refine-grid/{again[0].file}" in page
 
 
 def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,
