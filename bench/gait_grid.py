@@ -16,7 +16,7 @@ instant, the verify bug recorded in tests/gait/test_verify.py: recomputed with e
 its own phase, no normal force is negative).
 
 Run: ``python bench/gait_grid.py [--speeds 3 6 ...] [--variants plain ankle] [--json FILE]
-[--transcription hermite-simpson-separated]``
+[--transcription hermite-simpson-separated] [--knot-spacing cosine]``
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from gaitopt.analysis.verify import LIMITS, verify_gait
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import TRANSCRIPTIONS, GaitOptions
+from gaitopt.gait.options import KNOT_SPACINGS, TRANSCRIPTIONS, GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 
 VARIANTS = {
@@ -116,8 +116,9 @@ def lowest_force_by_phase(gait: Gait) -> float:
 
 
 def solve_point(variant: str, speed_m_min: float, *, check: bool,
-                transcription: str = "hermite-simpson") -> Point:
+                transcription: str = "hermite-simpson", knot_spacing: str = "uniform") -> Point:
     options = GaitOptions(speed=speed_m_min / 60.0, transcription=transcription,  # type: ignore[arg-type]
+                          knot_spacing=knot_spacing,  # type: ignore[arg-type]
                           **VARIANTS[variant])
     start = time.perf_counter()
     solution = solve_gait_solution("five-link", options)
@@ -178,6 +179,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--transcription", default=GaitOptions().transcription,
                         choices=TRANSCRIPTIONS,
                         help="GaitOptions.transcription of every point (default: the default)")
+    parser.add_argument("--knot-spacing", default="uniform", choices=KNOT_SPACINGS,
+                        help="GaitOptions.knot_spacing of every point (cosine: the study's)")
     args = parser.parse_args(argv)
 
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
@@ -186,7 +189,8 @@ def main(argv: list[str] | None = None) -> None:
         rows = []
         for speed in args.speeds:
             point = solve_point(variant, speed, check=not args.no_verify,
-                                transcription=args.transcription)
+                                transcription=args.transcription,
+                                knot_spacing=args.knot_spacing)
             rows.append(point)
             print(f"  {variant:<14} {speed:5.1f} m/min  {'ok ' if point.success else 'FAIL'}"
                   f" {point.wall_time_s:6.2f} s  verify {point.verify}", flush=True)

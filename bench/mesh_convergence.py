@@ -12,6 +12,15 @@ Models: ``paper`` (controls continuous at the heel strike and periodic), ``state
 
 Run: ``python bench/mesh_convergence.py [--models paper jumps] [--grids 8,5 16,6]
 [--clearance 0.02] [--json FILE]``
+
+``--study DIR`` measures the converged values of a study (``gaitopt study -o DIR``) instead:
+for each ``--variants`` x ``--speeds`` point (m/min, or ``free`` for the speed-free optimum)
+it takes the point's gait from the study's finest grid (its refinement sweep, else its check
+sweep), solves the same problem warm-started from it on each ``--grids`` grid in turn (each
+from the previous; ``--spacing`` uniform or cosine knots, default the study's), and prints
+each grid's values and their distance to the finest grid (cost relative).
+Run: ``python bench/mesh_convergence.py --study out/study --speeds 12 36 60 free
+--grids 40,10 80,20``
 """
 
 from __future__ import annotations
@@ -20,14 +29,19 @@ import argparse
 import json
 import os
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gaitopt.gait.api import guess_from_gait
+from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import solve_walking
 from gaitopt.ocp import Result
 from gaitopt.robot import load_model
+from gaitopt.study.grid_error import CHECK_DIR, REFINE_DIR, sweep_grid
+from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, read_summary
 
 MODELS: dict[str, dict[str, Any]] = {
     "paper": {"control_model": "paper"},
@@ -80,14 +94,99 @@ def line(r: dict[str, Any]) -> str:
             f"{r['wall_s']:.0f} |")
 
 
+def study_grids(study: Path) -> list[tuple[str, Path]]:
+    """The study's sweeps, coarse to fine: (``16+6``, directory) for the main, check and
+    refinement sweeps that exist."""
+    out = []
+    for d in (study, study / CHECK_DIR, study / REFINE_DIR):
+        grid = sweep_grid(d)
+        if grid is not None and (d / SUMMARY_FILE).exists():
+            out.append((f"{grid[0][0]}+{grid[0][1]}", d))
+    return out
+
+
+def study_point(study: Path, variant: str, speed: str, grids: list[tuple[int, int]],
+                spacing: str | None = None) -> dict[str, Any]:
+    """One point of ``--study``: its values on the study's grids and on ``grids``."""
+    robot = load_model("five-link")
+    out: dict[str, Any] = {"variant": variant, "speed": speed, "values": {}}
+    start_gait = None
+    for label, d in study_grids(study):
+        rows = [r for r in read_summary(d / SUMMARY_FILE) if r.variant == variant and r.success
+                and (r.speed_mode == "free" if speed == "free" else
+                     r.speed_mode == "fixed" and abs(r.speed_m_min - float(speed)) < 5e-3)]
+        if rows:
+            r = rows[0]
+            out["values"][label] = (r.cost, r.speed_m_min, r.step_length)
+            start_gait = Gait.load(d / r.file)
+    if start_gait is None:
+        return out
+    options = GaitOptions.from_dict(dict(start_gait.options)).replace(
+        speed=None if speed == "free" else float(speed) / 60.0)
+    if spacing is not None:
+        options = options.replace(knot_spacing=spacing)
+    warm: Any = guess_from_gait(start_gait)
+    for grid in grids:
+        mark = time.perf_counter()
+        sol = solve_walking(robot, options.replace(knots=grid), warm_start=warm)
+        label = f"{grid[0]}+{grid[1]} {options.knot_spacing}"
+        if sol.success:
+            r = sol.result
+            out["values"][label] = (r.objective, 60.0 * r.parameters["speed"],
+                                    r.parameters["step_length"])
+            warm = r
+        else:
+            out["values"][label] = None
+        out.setdefault("wall_s", {})[label] = time.perf_counter() - mark
+    return out
+
+
+def study_lines(p: dict[str, Any]) -> list[str]:
+    """Markdown rows of one ``--study`` point: each grid's values and distance to the finest."""
+    values = [(g, v) for g, v in p["values"].items() if v is not None]
+    if not values:
+        return [f"| {p['variant']} | {p['speed']} | failed | | | | |"]
+    ref = values[-1][1]
+    lines = []
+    for g, (cost, speed, step) in values:
+        lines.append(f"| {p['variant']} | {p['speed']} | {g} | {cost:.2f} | "
+                     f"{100 * (cost - ref[0]) / ref[0]:+.2f} % | {speed:.2f} | {step:.4f} |")
+    return lines
+
+
+def main_study(args: argparse.Namespace) -> None:
+    grids = [(int(a), int(b)) for a, b in (g.split(",") for g in args.grids)]
+    print(f"load average {os.getloadavg()[0]:.2f}; study {args.study}")
+    print("| variant | speed (m/min) | knots | cost | to the finest | speed (m/min) | step (m) |")
+    print("|:--|--:|--:|--:|--:|--:|--:|")
+    for variant in args.variants:
+        for speed in args.speeds:
+            p = study_point(Path(args.study), variant, speed, grids, args.spacing)
+            print("\n".join(study_lines(p)), flush=True)
+            if args.json:
+                with open(args.json, "a") as fh:
+                    fh.write(json.dumps(p) + "\n")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--study", default=None, help="measure this study's converged values")
+    ap.add_argument("--variants", nargs="+", default=["ankle", "plain"], choices=VARIANTS)
+    ap.add_argument("--speeds", nargs="+", default=["12", "36", "60", "free"],
+                    help="with --study: speeds in m/min, or free")
+    ap.add_argument("--spacing", default=None, choices=["uniform", "cosine"],
+                    help="with --study: the knot spacing of --grids (default: the study's)")
     ap.add_argument("--models", nargs="+", default=list(MODELS), choices=list(MODELS))
     ap.add_argument("--grids", nargs="+", default=[f"{a},{b}" for a, b in GRIDS])
     ap.add_argument("--clearance", type=float, default=None)
     ap.add_argument("--profile", default="quartic", choices=["quartic", "parabola"])
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
+    if args.study is not None:
+        if args.grids == ap.get_default("grids"):
+            args.grids = ["40,10", "80,20"]
+        main_study(args)
+        return
     grids = [tuple(int(v) for v in g.split(",")) for g in args.grids]
     print(f"load average {os.getloadavg()[0]:.2f}; clearance {args.clearance} "
           f"({args.profile})")

@@ -185,19 +185,28 @@ def test_study_writes_the_report_and_an_animation(runner: CliRunner, tmp_path: P
     check = read_summary(folder / "check-grid" / SUMMARY_FILE)
     assert len(check) == 16 and all(r.success for r in check)
     page = (folder / "report" / "report.html").read_text(encoding="utf-8")
-    assert ("Grid: 16+6 knots, control model jumps. Error estimate (change to 24+8 knots at "
-            "12 fixed-speed points, 4 speed-free optima)") in page
+    assert "Grid: 16+6 cosine-spaced knots, control model jumps" in page
+    assert "at 12 fixed-speed points, 4 speed-free optima): cost within" in page
     assert "on the check grid speed" in " ".join(result.output.split())
+    # The points whose estimate exceeds 1 % are re-solved on 36+12 and reported from there.
+    # (here the speed-free optima: their speeds move by 0.1 m/min, 3 x that is over 1 %)
+    again = read_summary(folder / "refine-grid" / SUMMARY_FILE)
+    assert again and all(r.success for r in again)
+    assert list(Gait.load(folder / "refine-grid" / again[0].file).options["knots"]) == [36, 12]
+    assert "36+12 knots at the" in page and f"refine-grid/{again[0].file}" in page
 
 
 def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,
                                                          tmp_path: Path) -> None:
-    """--formulation, --cost, --resting-power and --control-model reach every gait."""
+    """--formulation, --cost, --resting-power, --control-model and --knot-spacing reach every
+    gait."""
     for name, args, expected in (
             ("full", ["--formulation", "full", "--control-model", "jumps"],
              {"formulation": "full", "control_model": "jumps", "cost": "paper"}),
-            ("metabolic", ["--cost", "metabolic", "--resting-power", "2.0"],
-             {"formulation": "reduced", "cost": "metabolic", "resting_power": 2.0})):
+            ("metabolic", ["--cost", "metabolic", "--resting-power", "2.0",
+                           "--knot-spacing", "cosine"],
+             {"formulation": "reduced", "cost": "metabolic", "resting_power": 2.0,
+              "knot_spacing": "cosine"})):
         folder = tmp_path / name
         result = runner.invoke(cli, ["sweep", "-o", str(folder), "--speeds", "12,15",
                                      "--variants", "ankle", "--no-free", "--workers", "0",

@@ -190,3 +190,23 @@ def test_files_and_settings_written_before_an_option_existed_are_kept(
                                     if k != "multistart"})
     assert settings_differences(older, settings)  # without the defaults: a difference
     assert settings_differences(with_option_defaults(older), settings) == []
+
+
+def test_points_without_continuation_start_from_their_seed_files(
+        swept: tuple[Path, SweepReport], tmp_path: Path) -> None:
+    """The refinement sweep's way (``continuation=False`` and ``seeds``): every point starts
+    from its own seed file and converges to the same optimum as the chain did."""
+    from dataclasses import replace
+
+    folder, _ = swept
+    spec = replace(plain_spec(9, 15, free=False), continuation=False)
+    assert spec.parents == {K9: None, K15: None}
+    report = run_sweep(spec, tmp_path / "seeded", workers=0,
+                       seeds={K9: folder / K9, K15: folder / K15})
+    assert {o.key: o.warm for o in report.outcomes} == {K9: "file", K15: "file"}
+    assert not any(o.fell_back for o in report.outcomes)
+    for key in (K9, K15):
+        assert Gait.load(tmp_path / "seeded" / key).cost_value == pytest.approx(
+            Gait.load(folder / key).cost_value, rel=1e-6)
+    saved = (tmp_path / "seeded" / SETTINGS_FILE).read_text(encoding="utf-8")
+    assert '"continuation": false' in saved

@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +45,7 @@ from gaitopt.cli.base import (
 )
 from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.gait.formulation import default_formulation
-from gaitopt.gait.options import GAITS, GaitOptions, GaitOptionsError
+from gaitopt.gait.options import GAITS, KNOT_SPACINGS, GaitOptions, GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import (
     Counts,
@@ -55,7 +56,15 @@ from gaitopt.study.driver import (
     run_sweep,
 )
 from gaitopt.study.executors import Backend, BackendError
-from gaitopt.study.plan import SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.study.grid_error import (
+    CHECK_DIR,
+    REFINE_DIR,
+    WITHIN,
+    GridError,
+    check_knots,
+    grid_error,
+)
+from gaitopt.study.plan import START_SPEED, SweepPoint, SweepSpec, SweepSpecError
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 from gaitopt.study.worker import PointOutcome
 
@@ -202,10 +211,12 @@ def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
 def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
                       workers: int | None, scheduler: str | None,
                       fail_points: Sequence[str] = (),
-                      backend: Backend | None = None) -> SweepReport:
+                      backend: Backend | None = None,
+                      seeds: Mapping[str, Path] | None = None) -> SweepReport:
     """:func:`run_sweep` with a progress bar (done/failed/remaining, ETA) and a line per
     finished point; errors the user can fix become :class:`UserError`. ``backend``: run on
-    it (and leave it open) instead of starting one."""
+    it (and leave it open) instead of starting one; ``seeds``: warm starts of the chains'
+    first points (:func:`run_sweep`)."""
     progress = Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
         TextColumn("failed {task.fields[failed]}  remaining {task.fields[remaining]}"),
@@ -233,7 +244,7 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
     try:
         report = run_sweep(spec, directory, workers=workers, scheduler=scheduler,
                            on_start=on_start, on_point=on_point, fail_points=fail_points,
-                           backend=backend)
+                           backend=backend, seeds=seeds)
     except (SweepSpecError, SweepSettingsError, BackendError, GaitOptionsError,
             BipedStructureError) as exc:
         raise UserError(str(exc)) from None
@@ -251,6 +262,11 @@ def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
         console.print("failed points are listed in the summary as failed; rerun the same "
                       "command to try them again", soft_wrap=True)
     return report
+
+
+def _spacing_option(default: str, help_: str) -> Any:
+    return click.option("--knot-spacing", type=click.Choice(list(KNOT_SPACINGS)),
+                        default=default, show_default=True, help=help_)
 
 
 def _workers_option(f: Any) -> Any:
@@ -292,11 +308,13 @@ def _workers_option(f: Any) -> Any:
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
 @min_knee_flexion_option
+@_spacing_option("uniform", "The knots of each phase: uniform, or cosine-spaced (clustered at "
+                            "the events; docs/walking.md section 6).")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
                   paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
-                  resting_power: float | None, control_model: str | None,
+                  resting_power: float | None, control_model: str | None, knot_spacing: str,
                   min_knee_flexion: float | None, workers: int | None,
                   scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
@@ -314,7 +332,8 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
         except ValueError as exc:
             raise UserError(str(exc)) from None
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "gait": gait_kind, **grid_choice(knots, control_model, paper_grid)}
+                               "gait": gait_kind, "knot_spacing": knot_spacing,
+                               **grid_choice(knots, control_model, paper_grid)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     if min_knee_flexion is not None:
@@ -363,18 +382,22 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
               help="The paper's setting: 8+5 knots and its control model (continuous, "
                    "periodic controls); checked against 16+6 knots.")
 @knots_option
+@_spacing_option("cosine", "The knots of each phase of the paper's study: cosine-spaced "
+                           "(clustered at the events, the default) or uniform (always with "
+                           "--paper-grid).")
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
-                  paper_grid: bool, knots: str | None, cost_study: bool, costs: tuple[str, ...],
+                  paper_grid: bool, knots: str | None, knot_spacing: str, cost_study: bool,
+                  costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, clearance: float | None, gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
-    optimum, the same on a finer grid (DIR/check-grid) for the error estimates, then the
-    report (Figs. 3-8 with their grid and error estimate, findings) and an animation of the
-    optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
+    optimum (cosine-spaced 16+6 knots), the same on a finer grid (DIR/check-grid) for the
+    error estimates, the points whose estimate exceeds 1 % finer still (DIR/refine-grid),
+    then the report (Figs. 3-8 with their grid and error estimate, findings) and an animation
+    of the optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
-    from gaitopt.study.grid_error import CHECK_DIR, check_knots, grid_error
     from gaitopt.study.summary import read_summary
 
     console = make_console()
@@ -390,7 +413,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                         "--costs)")
     directory = directory or STUDY_DIR
     start = time.perf_counter()
-    grid = grid_choice(knots, None, paper_grid)
+    grid = {**grid_choice(knots, None, paper_grid),
+            "knot_spacing": "uniform" if paper_grid else knot_spacing}
     model_name = model_names[0] if model_names else "five-link"
     spec = make_spec(model_name=model_name, speeds=speeds,
                      variants="all", free=True, step_length="free", single_support="0.85",
@@ -404,11 +428,15 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                       problem={**grid, "knots": finer})
     run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
                       scheduler=scheduler)
+    rows = read_summary(directory / SUMMARY_FILE)
+    if not paper_grid:  # the paper's setting is reported as it is, with its estimate
+        refine_points(console, directory, model_name, grid, grid_error(directory, rows),
+                      workers=workers, scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
-    rows = read_summary(directory / SUMMARY_FILE)
     errors = grid_error(directory, rows)
     if errors is not None:
+        rows = errors.reported(rows)
         console.print(errors.statement(), soft_wrap=True)
         for v in VARIANTS:
             p = errors.free(v)
@@ -429,6 +457,40 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
         console.print("no point converged: no animation", soft_wrap=True)
     console.print(f"study done in {time.perf_counter() - start:.0f} s. Open {pages[0]}",
                   soft_wrap=True)
+
+
+def refine_points(console: Console, directory: Path, model_name: str, grid: dict[str, Any],
+                  errors: GridError | None, *, workers: int | None,
+                  scheduler: str | None) -> None:
+    """The refinement sweep of a study (:mod:`gaitopt.study.grid_error`): the points whose
+    change to the check grid exceeds 1 % (every variant at their speeds, and the speed-free
+    optima if one of them is among them), solved on the next finer grid in
+    ``DIR/refine-grid``, each warm-started from the check sweep's gait of the same point
+    (no continuation: the points are independent and may be far apart in speed)."""
+    if errors is None or errors.check_knots is None:
+        return
+    points = errors.to_refine()
+    if not points and not (directory / REFINE_DIR / SUMMARY_FILE).exists():
+        return
+    # Rerunning a finished study: refine the same points again (they are kept).
+    done = [p.row for p in errors.points if p.refined]
+    rows = [p.row for p in points] + done
+    finer = check_knots(errors.check_knots)
+    speeds = sorted({round(r.speed_m_min, 6) for r in rows if r.speed_mode == "fixed"})
+    console.print(f"refinement grid {finer[0]}+{finer[1]} knots: {len(points)} points "
+                  f"changed by more than {100 * WITHIN:g} % to the check grid",
+                  soft_wrap=True)
+    if not speeds:  # only speed-free optima: solve them from the check grid's start speed
+        speeds = [START_SPEED * 60.0]
+    spec = replace(make_spec(model_name=model_name, speeds=",".join(f"{v:g}" for v in speeds),
+                             variants=",".join(sorted({r.variant for r in rows})),
+                             free=any(r.speed_mode == "free" for r in rows),
+                             step_length="free", single_support="0.85",
+                             problem={**grid, "knots": finer}), continuation=False)
+    check = directory / CHECK_DIR
+    seeds = {p.key: check / p.key for p in spec.points if (check / p.key).exists()}
+    run_with_progress(console, spec, directory / REFINE_DIR, workers=workers,
+                      scheduler=scheduler, seeds=seeds)
 
 
 def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,

@@ -37,6 +37,9 @@ CONTROL_MODELS = ("paper", "jumps")
 ClearanceProfile = Literal["parabola", "quartic"]
 #: The swing clearance profiles (see ``docs/walking.md``, "Swing clearance").
 CLEARANCE_PROFILES = ("parabola", "quartic")
+KnotSpacing = Literal["uniform", "cosine"]
+#: The knot spacings of the target grid (see ``docs/walking.md``, section 6).
+KNOT_SPACINGS = ("uniform", "cosine")
 #: The paper's grid, control model and NLP (8 + 5 knots, controls continuous at the heel
 #: strike and periodic, DIRCOL's compressed Hermite-Simpson form): :meth:`GaitOptions.paper`
 #: and ``--paper-grid``. Its cost is about 13 % above the fine-grid limit (docs/walking.md,
@@ -148,6 +151,11 @@ class GaitOptions:
             parabola's slope at the ends is a least vertical tip velocity ``4 c / T1`` at the
             liftoff and the heel strike, which makes its cost grow with the grid (measured in
             docs/walking.md); the quartic has zero slope there.
+        knot_spacing: ``"uniform"`` or ``"cosine"``: the knots of the target grid (``knots``,
+            not the coarse stages) at ``tau_k = (1 - cos(pi k / (N - 1))) / 2`` in each phase,
+            clustered at the events, where fast walks have a boundary layer before the heel
+            strike that a uniform grid resolves at first order only (docs/walking.md,
+            section 6).
     """
 
     speed: float | None = 0.2
@@ -186,6 +194,7 @@ class GaitOptions:
     control_model: ControlModel = "jumps"
     swing_clearance: float | None = None
     clearance_profile: ClearanceProfile = "quartic"
+    knot_spacing: KnotSpacing = "uniform"
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -412,3 +421,6 @@ def validate_options(options: GaitOptions, biped: BipedStructure | None) -> None
     if o.clearance_profile not in CLEARANCE_PROFILES:
         raise GaitOptionsError(f"clearance_profile = {o.clearance_profile!r}: must be one of "
                                f"{', '.join(repr(m) for m in CLEARANCE_PROFILES)}")
+    if o.knot_spacing not in KNOT_SPACINGS:
+        raise GaitOptionsError(f"knot_spacing = {o.knot_spacing!r}: must be one of "
+                               f"{', '.join(repr(m) for m in KNOT_SPACINGS)}")

@@ -103,6 +103,7 @@ from gaitopt.gait.transcriptions import (
     Grid,
     evaluation_mode,
     grid_knots,
+    target_grid,
     transcription_for,
     warm_start_grid,
 )
@@ -325,9 +326,9 @@ class _Run:
         speed held at the coarse solution's (a fine grid started from a coarse solution with
         them free can wander to a far worse local optimum), then released."""
         o = self.options
-        if tuple(o.knots) == coarse_knots(o):
+        if tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform":
             return result
-        return self.on_grid("target grid", o.knots, result)
+        return self.on_grid("target grid", target_grid(o), result)
 
     def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
         """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
@@ -419,13 +420,15 @@ class _Run:
         guess: Guess | Result = result_guess(start.result)
         if o.cost != "paper" and o.cost_smoothing < COST_SMOOTHING_START:
             smooth = o.replace(cost_smoothing=COST_SMOOTHING_START)
-            guess = self.stage(f"{o.cost} cost, eps {COST_SMOOTHING_START:g} W", o.knots,
+            guess = self.stage(f"{o.cost} cost, eps {COST_SMOOTHING_START:g} W",
+                               target_grid(o),
                                Relaxation(), guess, parameter_bounds(o),
                                solver_options=PRIMAL_WARM_OPTIONS, problem=smooth)
             if not guess.success:
                 return guess
             guess = result_guess(guess)
-        return self.stage(f"{o.cost} cost", o.knots, Relaxation(), guess, parameter_bounds(o),
+        return self.stage(f"{o.cost} cost", target_grid(o), Relaxation(), guess,
+                          parameter_bounds(o),
                           solver_options=PRIMAL_WARM_OPTIONS)
 
     def final(self) -> Result:

@@ -174,13 +174,29 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
     return _CACHE[key]
 
 
+def cosine_knots(n: int) -> np.ndarray:
+    """``n`` normalised knot times ``(1 - cos(pi k / (n - 1))) / 2``, k = 0..n-1: clustered
+    at both ends of the phase (intervals about ``pi^2 / (4 (n - 1)^2)`` there, ``pi / (2 (n -
+    1))`` in the middle)."""
+    return 0.5 * (1.0 - np.cos(np.pi * np.arange(n) / (n - 1)))
+
+
+def target_grid(options: GaitOptions) -> Grid:
+    """The target grid of a solve: ``options.knots``, uniform, or with ``knot_spacing =
+    "cosine"`` a mesh of :func:`cosine_knots` per phase."""
+    if options.knot_spacing == "uniform":
+        return options.knots
+    phases = 2 if options.double_support else 1
+    return tuple(cosine_knots(int(n)) for n in options.knots[:phases])
+
+
 def warm_start_grid(options: GaitOptions, warm_start: Guess | Result | WarmStart) -> Grid:
-    """The grid of a warm start: ``options.knots``; with ``mesh_tol``, the warm start's own
+    """The grid of a warm start: :func:`target_grid`; with ``mesh_tol``, the warm start's own
     mesh (a refined gait's non-uniform knots), every other knot of it when each phase has an
     odd number >= 5: the mesh before the halving that ended its refinement, so that a chain
     of warm starts (a sweep) does not double the grid at every point."""
     if options.mesh_tol is None or isinstance(warm_start, WarmStart):
-        return options.knots
+        return target_grid(options)
     if isinstance(warm_start, Result):
         taus = [np.asarray(m, dtype=float) for m in warm_start.mesh]
     else:
@@ -188,7 +204,7 @@ def warm_start_grid(options: GaitOptions, warm_start: Guess | Result | WarmStart
                 if g.tau is not None]
     phases = 2 if options.double_support else 1
     if len(taus) != phases or any(t.size < 2 for t in taus):
-        return options.knots
+        return target_grid(options)
     if all(t.size % 2 == 1 and t.size >= 5 for t in taus):
         taus = [t[::2] for t in taus]
     return tuple(taus)

@@ -35,7 +35,7 @@ import json
 import math
 import os
 import time
-from collections.abc import Callable, Collection, Iterator
+from collections.abc import Callable, Collection, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -305,6 +305,7 @@ class _Driver:
     directory: Path
     backend: Backend
     fail_points: frozenset[str]
+    seeds: Mapping[str, str]
     on_point: PointFn | None
     rows: dict[str, SummaryRow]
     state: dict[str, str]  # todo, running, ok, failed, kept
@@ -368,7 +369,7 @@ class _Driver:
 
     def task(self, key: str) -> PointTask:
         p, parent = self.points[key], self.parents[key]
-        offer = self.offers.get(parent) if parent is not None else None
+        offer = self.offers.get(parent) if parent is not None else self.seeds.get(key)
         self.given[key] = offer
         # a kept neighbour's gait file is read here: workers may not see this directory
         warm = SavedGait.read(offer) if isinstance(offer, str) else offer
@@ -478,13 +479,16 @@ def run_sweep(spec: SweepSpec, directory: str | os.PathLike[str], *,
               backend: Backend | None = None, workers: int | None = None,
               scheduler: str | None = None, on_start: StartFn | None = None,
               on_point: PointFn | None = None,
-              fail_points: Collection[str] = ()) -> SweepReport:
+              fail_points: Collection[str] = (),
+              seeds: Mapping[str, str | os.PathLike[str]] | None = None) -> SweepReport:
     """Run (or resume) the sweep ``spec`` in ``directory`` (see the module docstring).
 
     Args:
         backend: where points run; default :func:`make_backend` (``workers``, ``scheduler``).
         on_start: called once with what will be done; on_point: after every finished point.
         fail_points: testing hook: keys of points solved with ``max_iter = 1`` (they fail).
+        seeds: point key -> a gait file (e.g. the same point solved on another grid) that
+            warm-starts the point when it starts a chain (no parent), instead of a cold start.
 
     Raises :class:`SweepSpecError` (a bad grid or point option) and
     :class:`SweepSettingsError` (a directory with other settings) before any solve. On
@@ -515,7 +519,9 @@ def run_sweep(spec: SweepSpec, directory: str | os.PathLike[str], *,
                                wall_time_s=time.perf_counter() - start,
                                summaries=tuple(summaries), notes=tuple(scan.notes))
         driver = _Driver(spec=spec, directory=out, backend=backend,
-                         fail_points=frozenset(fail_points), on_point=on_point, rows=rows,
+                         fail_points=frozenset(fail_points),
+                         seeds={k: str(v) for k, v in (seeds or {}).items()},
+                         on_point=on_point, rows=rows,
                          state=state, counts=counts)
         interrupted = False
         try:

@@ -5,16 +5,28 @@ and then a *check sweep* of the same problem on a finer grid (:func:`check_knots
 the default) at the same speeds and each variant's speed-free optimum, in
 ``<study>/check-grid``. (All speeds: the sweep continues from speed to speed, and steps of
 3 m/min take about 13 IPOPT iterations where steps of 12 m/min took about 200, so a sparse
-check would cost more.) For every point solved on both grids the difference of
-the study's value from the check grid's is the estimate of the study's discretization error
-(the last two refinements):
+check would cost more.) For every point solved on both grids the change between them is
 
 * cost: ``|J(grid) - J(check)| / J(check)`` (relative);
 * step length ``L(check) - L(grid)`` (m) and, for the speed-free optimum, the speed
-  ``v(check) - v(grid)`` (m/min): how far they move from the study's grid to the finer one.
+  ``v(check) - v(grid)`` (m/min): how far they move from the study's grid to the finer one;
 
-It is an estimate, not a bound: with the default control model the cost converges fast
-(docs/walking.md, section 6), so the difference mostly reflects the coarser grid's error.
+and the estimate of the study's discretization error is that change times the first-order
+factor (:func:`first_order_factor`: 3 from 16 to 24 knots): the error if it fell as
+``1 / knots``. On uniform knots fast walks converge at about that order, so the change alone
+understated their error about three times; on the cosine-spaced knots of the study the
+measured order is 1.3 to 2 and the estimate is an overestimate (docs/walking.md, section 6).
+It is an estimate, not a bound.
+
+**Refinement.** Where that estimate exceeds :data:`WITHIN` (1 %) for the cost or
+(speed-free optimum, relative) the speed, ``gaitopt study`` re-solves the point on a third,
+finer grid (:func:`check_knots` of the check grid: 36 + 12 for the default) in a *refinement
+sweep*, ``<study>/refine-grid``, each chain warm-started from the check sweep's gait at the
+same point. A point solved there is reported with its refined value, and its error estimate
+comes from the change between its last two grids, from the check grid to the refinement grid
+(``|J(refine) - J(check)| / J(refine)``; step length and speed ``refine - check``; times 2,
+the first-order factor of the finer grid):
+:meth:`GridError.reported` gives the rows the report shows.
 """
 
 from __future__ import annotations
@@ -23,7 +35,7 @@ import json
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from gaitopt.study.plan import SETTINGS_FILE
@@ -36,6 +48,8 @@ CHECK_KNOTS: dict[tuple[int, int], tuple[int, int]] = {(16, 6): (24, 8), (8, 5):
 WITHIN = 0.01
 #: The folder of the check sweep inside the study directory.
 CHECK_DIR = "check-grid"
+#: The folder of the refinement sweep inside the study directory.
+REFINE_DIR = "refine-grid"
 
 
 def check_knots(knots: tuple[int, int]) -> tuple[int, int]:
@@ -46,25 +60,71 @@ def check_knots(knots: tuple[int, int]) -> tuple[int, int]:
 
 @dataclass(frozen=True)
 class PointError:
-    """One point solved on both grids: the study's row and the check grid's."""
+    """One point solved on two grids: ``row`` the value the study reports, ``check`` the same
+    point on the other grid of its estimate (finer, or with ``refined`` the coarser check
+    grid, ``row`` then coming from the refinement sweep)."""
 
     row: SummaryRow
     check: SummaryRow
+    refined: bool = False
+    #: The first-order factor from the change between the two grids to the error of the
+    #: reported one (:func:`first_order_factor`).
+    factor: float = 1.0
+
+    @property
+    def _finer(self) -> SummaryRow:
+        return self.row if self.refined else self.check
+
+    @property
+    def _coarser(self) -> SummaryRow:
+        return self.check if self.refined else self.row
 
     @property
     def cost(self) -> float:
-        """``|J(grid) - J(check)| / J(check)``."""
-        return abs(self.row.cost - self.check.cost) / abs(self.check.cost)
+        """``|J(grid) - J(finer grid)| / J(finer grid)`` of the point's two grids."""
+        return abs(self.row.cost - self.check.cost) / abs(self._finer.cost)
 
     @property
     def step_length(self) -> float:
-        """``L(check) - L(grid)`` (m): how the step length moves on the finer grid."""
-        return self.check.step_length - self.row.step_length
+        """``L(finer) - L(coarser)`` (m): how the step length moves on the finer grid."""
+        return self._finer.step_length - self._coarser.step_length
 
     @property
     def speed_m_min(self) -> float:
-        """``v(check) - v(grid)`` (m/min; 0 at a fixed speed)."""
-        return self.check.speed_m_min - self.row.speed_m_min
+        """``v(finer) - v(coarser)`` (m/min; 0 at a fixed speed)."""
+        return self._finer.speed_m_min - self._coarser.speed_m_min
+
+    @property
+    def cost_error(self) -> float:
+        """The estimate of the reported cost's relative error: ``factor * cost``."""
+        return self.factor * self.cost
+
+    @property
+    def step_error(self) -> float:
+        """The estimate of the reported step length's error (m): ``factor * |step_length|``."""
+        return self.factor * abs(self.step_length)
+
+    @property
+    def speed_error(self) -> float:
+        """The estimate of the reported speed's error (m/min; 0 at a fixed speed)."""
+        return self.factor * abs(self.speed_m_min)
+
+    @property
+    def relative(self) -> float:
+        """The larger estimated relative error of the cost and (speed-free optimum) the
+        speed: what decides a refinement."""
+        return max(self.cost_error, self.speed_error / abs(self._finer.speed_m_min))
+
+
+def first_order_factor(coarse: int, fine: int, *, of_finer: bool) -> float:
+    """Error of a grid from the change between two grids of ``coarse`` and ``fine`` knots
+    (single support), if the error falls as ``C / knots``: the coarse grid's error is the
+    change times ``fine / (fine - coarse)`` (3 for 16 to 24 knots), the fine grid's times
+    ``coarse / (fine - coarse)`` (2 for 24 to 36). With the measured orders of the default
+    grids (1.3 to 2, docs/walking.md section 6) it overestimates the error."""
+    if fine <= coarse:
+        return 1.0
+    return (coarse if of_finer else fine) / (fine - coarse)
 
 
 def _key(row: SummaryRow) -> tuple[str, str, float]:
@@ -74,35 +134,54 @@ def _key(row: SummaryRow) -> tuple[str, str, float]:
 
 @dataclass(frozen=True)
 class GridError:
-    """The study's grid and the check grid, and every point solved on both."""
+    """The study's grid, the check grid, the refinement grid (None without a refinement
+    sweep), and every point solved on two of them (refined points with their last two)."""
 
     knots: tuple[int, int]
     control_model: str
     check_knots: tuple[int, int] | None
     points: tuple[PointError, ...]
+    refine_knots: tuple[int, int] | None = None
+    spacing: str = "uniform"
 
     @staticmethod
     def compare(rows: Sequence[SummaryRow], check_rows: Sequence[SummaryRow], *,
                 knots: tuple[int, int], control_model: str,
-                check: tuple[int, int] | None) -> GridError:
+                check: tuple[int, int] | None,
+                refine_rows: Sequence[SummaryRow] = (),
+                refine: tuple[int, int] | None = None,
+                refine_prefix: str = REFINE_DIR) -> GridError:
         """Pair the converged rows of the study and of the check sweep by variant, speed mode
-        and speed (0.01 m/min)."""
-        ok = {_key(r): r for r in check_rows if r.success and math.isfinite(r.cost)}
+        and speed (0.01 m/min); a point also converged in the refinement sweep is paired as
+        (refinement row, check row), the refinement row's file made relative to the study
+        (``refine_prefix``: the refinement sweep's folder relative to the study's)."""
+        ok = _converged(check_rows)
+        fine = _converged(refine_rows) if refine is not None else {}
         pairs = []
         for r in rows:
             if not (r.success and math.isfinite(r.cost)):
                 continue
-            key = _key(r)
-            found = (ok.get(key) if r.speed_mode == "fixed" else
-                     next((c for k, c in ok.items() if k[:2] == key[:2]), None))
-            if found is not None:
-                pairs.append(PointError(r, found))
-        return GridError(knots, control_model, check, tuple(pairs))
+            found = _find(ok, r)
+            if found is None:
+                continue
+            better = _find(fine, r)
+            if better is None or refine is None:
+                factor = first_order_factor(knots[0], check[0], of_finer=False) if check else 1.0
+                pairs.append(PointError(r, found, factor=factor))
+            else:
+                factor = first_order_factor(check[0], refine[0], of_finer=True) if check else 1.0
+                pairs.append(PointError(replace(better, file=f"{refine_prefix}/{better.file}"
+                                                if better.file else ""),
+                                        found, refined=True, factor=factor))
+        return GridError(knots, control_model, check, tuple(pairs),
+                         refine if any(p.refined for p in pairs) else None)
 
     @property
     def grid(self) -> str:
-        """``16+6 knots, control model jumps``."""
-        return f"{self.knots[0]}+{self.knots[1]} knots, control model {self.control_model}"
+        """``16+6 knots, control model jumps`` (``16+6 cosine-spaced knots, ...``)."""
+        spaced = "" if self.spacing == "uniform" else f" {self.spacing}-spaced"
+        return (f"{self.knots[0]}+{self.knots[1]}{spaced} knots, control model "
+                f"{self.control_model}")
 
     def of(self, rows: Sequence[SummaryRow | None]) -> list[PointError]:
         """The checked points among ``rows`` (by identity of variant, mode and speed)."""
@@ -113,6 +192,16 @@ class GridError:
         """The speed-free optimum of ``variant`` on both grids, or None."""
         return next((p for p in self.points if p.row.variant == variant
                      and p.row.speed_mode == "free"), None)
+
+    def to_refine(self) -> list[PointError]:
+        """The points not yet refined whose estimate exceeds :data:`WITHIN` (cost, step
+        length or speed, relative)."""
+        return [p for p in self.points if not p.refined and p.relative > WITHIN]
+
+    def reported(self, rows: Sequence[SummaryRow]) -> list[SummaryRow]:
+        """``rows`` (the study's) with each refined point's row in place of its own."""
+        better = {_key(p.row): p.row for p in self.points if p.refined}
+        return [better.get(_key(r), r) for r in rows]
 
     def statement(self, points: Sequence[PointError] | None = None, *,
                   what: str = "cost") -> str:
@@ -128,21 +217,52 @@ class GridError:
             f"{free} speed-free optim{'a' if free != 1 else 'um'}" if free else "") if part)
         check = f"{self.check_knots[0]}+{self.check_knots[1]} knots"
         if what == "step length":
-            worst = max(abs(p.step_length) for p in chosen)
+            worst = max(p.step_error for p in chosen)
             value = f"step length within {worst:.4f} m"
         else:
-            worst = max(p.cost for p in chosen)
+            worst = max(p.cost_error for p in chosen)
             value = f"cost within {100 * worst:.2f} %"
-            above = [p for p in chosen if p.cost > WITHIN]
+            above = [p for p in chosen if p.cost_error > WITHIN]
             if above:
-                speeds = sorted(p.row.speed_m_min for p in above)
-                span = (f"{speeds[0]:g} m/min" if speeds[0] == speeds[-1] else
-                        f"{speeds[0]:g}-{speeds[-1]:g} m/min")
-                below = max((p.cost for p in chosen if p.cost <= WITHIN), default=0.0)
+                below = max((p.cost_error for p in chosen if p.cost_error <= WITHIN),
+                            default=0.0)
                 value += (f"; above {100 * WITHIN:g} % at {len(above)} of {len(chosen)} "
-                          f"points ({span}), within {100 * below:.2f} % at the others")
-        return (f"Grid: {self.grid}. Error estimate (change to {check} at {where}): "
-                f"{value}.")
+                          f"points ({_span(above)}), within {100 * below:.2f} % at the others")
+        refined = [p for p in chosen if p.refined]
+        factor = f"{chosen[0].factor:g} x " if chosen[0].factor != 1.0 else ""
+        if not refined or self.refine_knots is None:
+            return (f"Grid: {self.grid}. Error estimate ({factor}the change to {check} at "
+                    f"{where}): {value}.")
+        fine = f"{self.refine_knots[0]}+{self.refine_knots[1]} knots"
+        count = f"{len(refined)} point{'s' if len(refined) != 1 else ''}"
+        coarse = next((p.factor for p in chosen if not p.refined), None)
+        return (f"Grid: {self.grid}, and {fine} at the {count} ({_span(refined)}) whose "
+                f"estimate exceeded {100 * WITHIN:g} % (re-solved). Error estimate (first "
+                f"order from each point's last two grids: "
+                + (f"{coarse:g} x the change to {check}, " if coarse is not None else "")
+                + f"{refined[0].factor:g} x the change from {check} to {fine} at the re-solved "
+                f"points; at {where}): {value}.")
+
+
+def _span(points: Sequence[PointError]) -> str:
+    """``33-60 m/min`` (the speeds of ``points``)."""
+    speeds = sorted(round(p.row.speed_m_min, 1) for p in points)
+    return (f"{speeds[0]:g} m/min" if speeds[0] == speeds[-1] else
+            f"{speeds[0]:g}-{speeds[-1]:g} m/min")
+
+
+def _converged(rows: Sequence[SummaryRow]) -> dict[tuple[str, str, float], SummaryRow]:
+    return {_key(r): r for r in rows if r.success and math.isfinite(r.cost)}
+
+
+def _find(rows: dict[tuple[str, str, float], SummaryRow], row: SummaryRow
+          ) -> SummaryRow | None:
+    """``row``'s point among ``rows``: the same key, or for a speed-free optimum the same
+    variant's (its speed differs between grids)."""
+    key = _key(row)
+    if row.speed_mode == "fixed":
+        return rows.get(key)
+    return next((c for k, c in rows.items() if k[:2] == key[:2]), None)
 
 
 def sweep_grid(sweep_dir: str | os.PathLike[str]) -> tuple[tuple[int, int], str] | None:
@@ -158,10 +278,13 @@ def sweep_grid(sweep_dir: str | os.PathLike[str]) -> tuple[tuple[int, int], str]
 
 
 def grid_error(sweep_dir: str | os.PathLike[str], rows: Sequence[SummaryRow],
-               check_dir: str | os.PathLike[str] | None = None) -> GridError | None:
+               check_dir: str | os.PathLike[str] | None = None,
+               refine_dir: str | os.PathLike[str] | None = None) -> GridError | None:
     """The grid error of the sweep in ``sweep_dir`` (its ``rows``) against the check sweep in
-    ``check_dir`` (default ``<sweep_dir>/check-grid``); without a check sweep, the grid
-    alone (no points). None when the sweep's grid is unknown (no ``sweep.json``)."""
+    ``check_dir`` (default ``<sweep_dir>/check-grid``) and the refinement sweep in
+    ``refine_dir`` (default ``<sweep_dir>/refine-grid``, when it exists); without a check
+    sweep, the grid alone (no points). None when the sweep's grid is unknown (no
+    ``sweep.json``). Only sweeps of the study's control model count."""
     grid = sweep_grid(sweep_dir)
     if grid is None:
         return None
@@ -169,6 +292,24 @@ def grid_error(sweep_dir: str | os.PathLike[str], rows: Sequence[SummaryRow],
     check_grid = sweep_grid(check)
     summary = check / SUMMARY_FILE
     if check_grid is None or not summary.exists() or check_grid[1] != grid[1]:
-        return GridError(grid[0], grid[1], None, ())
-    return GridError.compare(rows, read_summary(summary), knots=grid[0], control_model=grid[1],
-                             check=check_grid[0])
+        return GridError(grid[0], grid[1], None, (), spacing=knot_spacing(sweep_dir))
+    refine = Path(refine_dir) if refine_dir is not None else Path(sweep_dir) / REFINE_DIR
+    refine_grid = sweep_grid(refine)
+    fine_rows: list[SummaryRow] = []
+    if (refine_grid is not None and refine_grid[1] == grid[1]
+            and (refine / SUMMARY_FILE).exists()):
+        fine_rows = read_summary(refine / SUMMARY_FILE)
+    errors = GridError.compare(rows, read_summary(summary), knots=grid[0],
+                               control_model=grid[1], check=check_grid[0], refine_rows=fine_rows,
+                               refine=refine_grid[0] if fine_rows and refine_grid else None,
+                               refine_prefix=Path(os.path.relpath(refine, sweep_dir)).as_posix())
+    return replace(errors, spacing=knot_spacing(sweep_dir))
+
+
+def knot_spacing(sweep_dir: str | os.PathLike[str]) -> str:
+    """The knot spacing of a sweep's points (``uniform`` when ``sweep.json`` lacks it)."""
+    try:
+        settings = json.loads((Path(sweep_dir) / SETTINGS_FILE).read_text(encoding="utf-8"))
+        return str(settings["settings"]["options"].get("knot_spacing", "uniform"))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return "uniform"

@@ -62,6 +62,9 @@ class SweepSpec:
         single_support: single-support fractions of the step time.
         base: every other problem option (bounds, tolerances, grid ``knots``, ...); its
             per-point fields (:data:`POINT_FIELDS` but ``knots``) are ignored.
+        continuation: points warm-start from their neighbours along the speed axis; with
+            False every point starts alone (cold, or from a seed file: the refinement sweep
+            of :mod:`gaitopt.study.grid_error`).
     """
 
     model: RobotModel
@@ -72,6 +75,7 @@ class SweepSpec:
     step_times: tuple[float | None, ...] = (None,)
     single_support: tuple[float, ...] = (0.85,)
     base: GaitOptions = field(default_factory=GaitOptions)
+    continuation: bool = True
 
     def __post_init__(self) -> None:
         check_spec(self)
@@ -108,6 +112,8 @@ class SweepSpec:
     def parents(self) -> Mapping[str, str | None]:
         """Point key -> the key of the point it is warm-started from (None: cold start)."""
         parents: dict[str, str | None] = {}
+        if not self.continuation:
+            return {p.key: None for p in self.points}
         groups: dict[tuple[Any, ...], list[SweepPoint]] = {}
         for p in self.points:
             groups.setdefault(p.group, []).append(p)
@@ -251,7 +257,8 @@ def sweep_settings(spec: SweepSpec) -> dict[str, Any]:
         "step_lengths": list(spec.step_lengths),
         "single_support_fractions": list(spec.single_support),
         "options": shared,
-    } | ({"step_times": list(spec.step_times)} if spec.step_times != (None,) else {})
+    } | ({"step_times": list(spec.step_times)} if spec.step_times != (None,) else {}) | (
+        {} if spec.continuation else {"continuation": False})
 
 
 def settings_document(spec: SweepSpec) -> dict[str, Any]:

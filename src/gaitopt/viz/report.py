@@ -18,7 +18,9 @@ Every figure's caption and the headline table state the sweep's grid (knots and 
 and, when a check sweep on a finer grid exists (``<sweep>/check-grid``, written by ``gaitopt
 study``; :mod:`gaitopt.study.grid_error`), the error estimate of what it shows: the largest
 change of the cost (or step length) to the finer grid over the points shown, and for each
-speed-free optimum how far its speed and step length move.
+speed-free optimum how far its speed and step length move. Points re-solved in a refinement
+sweep (``<sweep>/refine-grid``) are shown with their refined values and gaits, and the
+captions say on which grid and with which estimate (the change from the check grid).
 """
 
 from __future__ import annotations
@@ -136,6 +138,9 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
                 cache[row.file] = None
         return cache[row.file]
 
+    errors = grid_error(sweep, rows, check_dir)
+    if errors is not None:  # refined points show their refined values
+        rows = errors.reported(rows)
     optimal = {v: optimal_row(rows, v) for v in VARIANTS}
     fast = {v: row_near_speed(rows, v, FAST_SPEED_M_MIN) for v in VARIANTS}
     for v in VARIANTS:
@@ -143,7 +148,6 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         load(fast[v])
     gaits = {f: g for f, g in cache.items() if g is not None}
     findings = assess_findings(rows, gaits)
-    errors = grid_error(sweep, rows, check_dir)
 
     def grid_note(shown: Sequence[SummaryRow | None] | None = None, what: str = "cost") -> str:
         """The grid and error-estimate sentence of a figure showing ``shown`` (all rows)."""
@@ -307,10 +311,15 @@ def _optimum_error(errors: GridError | None, row: SummaryRow) -> str:
     if not found:
         return "not checked"
     p = found[0]
-    grid = f"{errors.check_knots[0]}+{errors.check_knots[1]}"
+    grid = f"to {errors.check_knots[0]}+{errors.check_knots[1]}"
+    if p.refined and errors.refine_knots is not None:
+        grid = (f"solved on {errors.refine_knots[0]}+{errors.refine_knots[1]}, change from "
+                f"{errors.check_knots[0]}+{errors.check_knots[1]}")
     moved = "" if row.speed_mode == "fixed" else f"speed {p.speed_m_min:+.2f} m/min, "
-    return (f"to {grid} knots: cost {100 * p.cost:.2f} %, {moved}"
-            f"step {p.step_length:+.4f} m")
+    estimate = "" if row.speed_mode == "fixed" else f"speed {p.speed_error:.2f} m/min, "
+    return (f"{grid} knots: cost {100 * p.cost:.2f} %, {moved}step {p.step_length:+.4f} m; "
+            f"error estimate ({p.factor:g} x): cost {100 * p.cost_error:.2f} %, {estimate}"
+            f"step {p.step_error:.4f} m")
 
 
 def _solver_table(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None],
