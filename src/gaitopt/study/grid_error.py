@@ -18,8 +18,8 @@ understated their error about three times; on the cosine-spaced knots of the stu
 measured order is 1.3 to 2 and the estimate is an overestimate (docs/walking.md, section 6).
 It is an estimate, not a bound.
 
-**Refinement.** Where that estimate exceeds :data:`WITHIN` (1 %) for the cost or
-(speed-free optimum, relative) the speed, ``gaitopt study`` re-solves the point on a third,
+**Refinement.** Where that estimate exceeds :data:`WITHIN` (1 %) for the cost, the step
+length (relative) or (speed-free optimum, relative) the speed, ``gaitopt study`` re-solves the point on a third,
 finer grid (:func:`check_knots` of the check grid: 36 + 12 for the default) in a *refinement
 sweep*, ``<study>/refine-grid``, each chain warm-started from the check sweep's gait at the
 same point. A point solved there is reported with its refined value, and its error estimate
@@ -111,9 +111,10 @@ class PointError:
 
     @property
     def relative(self) -> float:
-        """The larger estimated relative error of the cost and (speed-free optimum) the
-        speed: what decides a refinement."""
-        return max(self.cost_error, self.speed_error / abs(self._finer.speed_m_min))
+        """The largest estimated relative error of the cost, the step length and (speed-free
+        optimum) the speed: what decides a refinement."""
+        return max(self.cost_error, self.step_error / abs(self._finer.step_length),
+                   self.speed_error / abs(self._finer.speed_m_min))
 
 
 def first_order_factor(coarse: int, fine: int, *, of_finer: bool) -> float:
