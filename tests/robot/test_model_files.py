@@ -327,7 +327,7 @@ def test_unusable_files(tmp_path: Path, content: bytes, problem: str) -> None:
 def test_missing_file_and_folder(tmp_path: Path) -> None:
     with pytest.raises(ModelError, match=r"nope\.yaml: no such file or built-in model; allowed:"
                                          r" a model file \(YAML\) or a built-in model name "
-                                         r"\(five-link, seven-link\)"):
+                                         r"\(adult-point-feet, five-link, seven-link\)"):
         load_model(tmp_path / "nope.yaml")
     with pytest.raises(ModelError, match="not a file"):
         load_model(tmp_path)
