@@ -21,6 +21,7 @@ import argparse
 import json
 import math
 import os
+import sys
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -30,6 +31,9 @@ from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from gait_grid import load_average  # noqa: E402  (the five-link grid's helpers)
 
 VARIANTS = {"impulse": True, "no impulse": False}
 SPEEDS_M_MIN = (12.0, 30.0, 45.0, 60.0, 80.0)
@@ -48,13 +52,6 @@ class Point:
     impulse: float
     cost: float
     verify: str
-
-
-def load_average() -> str:
-    try:
-        return ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    except OSError:
-        return "n/a"
 
 
 def solve_point(model: str, base: GaitOptions, variant: str, speed_m_min: float | None) -> Point:
