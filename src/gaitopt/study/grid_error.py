@@ -18,13 +18,14 @@ understated their error about three times; on the cosine-spaced knots of the stu
 measured order is 1.3 to 2 and the estimate is an overestimate (docs/walking.md, section 6).
 It is an estimate, not a bound.
 
-**Refinement.** Where that estimate exceeds :data:`WITHIN` (1 %) for the cost, the step
-length (relative) or (speed-free optimum, relative) the speed, ``gaitopt study`` re-solves the point on a third,
-finer grid (:func:`check_knots` of the check grid: 36 + 12 for the default) in a *refinement
-sweep*, ``<study>/refine-grid``, each chain warm-started from the check sweep's gait at the
-same point. A point solved there is reported with its refined value, and its error estimate
-comes from the change between its last two grids, from the check grid to the refinement grid
-(``|J(refine) - J(check)| / J(refine)``; step length and speed ``refine - check``; times 2,
+**Refinement.** Where that estimate exceeds :data:`WITHIN` (1 %) for the cost, the step length
+(relative) or (speed-free optimum, relative) the speed, ``gaitopt study`` re-solves the point
+on a third, finer grid (:func:`check_knots` of the check grid: 36 + 12 for the default) in a
+*refinement sweep*, ``<study>/refine-grid``, each chain warm-started from the check sweep's
+gait at the same point. A point solved there is reported with its refined value, and its error
+estimate comes from the change between its last two grids, from the check grid to the
+refinement grid (``|J(refine) - J(check)| / J(refine)``; step length and speed ``refine -
+check``; times 2,
 the first-order factor of the finer grid):
 :meth:`GridError.reported` gives the rows the report shows.
 """
