@@ -24,9 +24,8 @@ on a third, finer grid (:func:`check_knots` of the check grid: 36 + 12 for the d
 *refinement sweep*, ``<study>/refine-grid``, each chain warm-started from the check sweep's
 gait at the same point. A point solved there is reported with its refined value, and its error
 estimate comes from the change between its last two grids, from the check grid to the
-refinement grid (``|J(refine) - J(check)| / J(refine)``; step length and speed ``refine -
-check``; times 2,
-the first-order factor of the finer grid):
+refinement grid (``|J(refine) - J(check)| / J(refine)``; step length and speed
+``refine - check``; times 2, the first-order factor of the finer grid):
 :meth:`GridError.reported` gives the rows the report shows.
 """
 
