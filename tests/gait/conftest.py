@@ -24,11 +24,12 @@ import pytest
 from numpy.typing import NDArray
 
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.gait_file import Gait, GaitPhase, leg_swap_permutations
+from gaitopt.gait.gait_file import Gait, GaitPhase
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import gait_from_solution
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.robot import RobotModel, load_model
+from gaitopt.robot.symmetry import swap_permutations
 from tests.dynamics.pinocchio_model import PinModel, build
 
 Array = NDArray[np.float64]
@@ -229,7 +230,7 @@ def periodicity_errors(gait: Gait, *, controls: tuple[str, ...]) -> tuple[float,
 
     ``controls``: the actuator names compared (those acting at the start of the step)."""
     model = gait.model
-    perm_q, perm_u = leg_swap_permutations(model)
+    perm_q, perm_u = swap_permutations(model)
     first, last = gait.phases[0], gait.phases[-1]
     liftoff = next(e for e in gait.events if e.name == "liftoff")
     q_next = last.q[-1][perm_q].copy()

@@ -14,11 +14,10 @@ from gaitopt.gait.gait_file import (
     Gait,
     GaitFileError,
     GaitPhase,
-    leg_swap_permutations,
-    phase_controls_at,
-    phase_states_at,
 )
+from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
 from gaitopt.robot import load_model
+from gaitopt.robot.symmetry import swap_names, swap_permutations
 from tests.viz.synthetic import forward_kinematics, synthetic_gait
 
 
@@ -177,8 +176,8 @@ def test_constructor_checks_shapes_against_the_model(gait: Gait) -> None:
 
 # -- legs ----------------------------------------------------------------------------------------
 
-def test_leg_swap_permutations_of_the_five_link_model() -> None:
-    perm_q, perm_u = leg_swap_permutations(load_model("five-link"))
+def test_swap_permutations_of_the_five_link_model() -> None:
+    perm_q, perm_u = swap_permutations(load_model("five-link"))
     # q = [x, y, torso, hip_1, knee_1, hip_2, knee_2]; u = [hip, knee, ankle] x 2
     assert perm_q.tolist() == [0, 1, 2, 5, 6, 3, 4]
     assert perm_u.tolist() == [3, 4, 5, 0, 1, 2]
@@ -261,3 +260,13 @@ def test_non_json_options_are_refused_at_construction(gait: Gait) -> None:
         dataclasses.replace(gait, options={"tol": float("nan")})
     with pytest.raises(GaitFileError, match=r"solver: must be plain JSON data"):
         dataclasses.replace(gait, solver={**gait.solver, "stages": [object()]})
+
+
+def test_swap_names_follow_the_models_symmetry() -> None:
+    """Joint, link and contact names swap by the model's symmetry (declared for the seven-link
+    model: heels and toes with their feet), not by a naming rule; unpaired names stay."""
+    names = swap_names(load_model("seven-link"))
+    assert names["heel_1"] == "heel_2" and names["toe_2"] == "toe_1"
+    assert names["ankle_1"] == "ankle_2" and names["knee_2"] == "knee_1"
+    assert names["foot_1"] == "foot_2" and names["torso"] == "torso"
+    assert all(names[names[n]] == n for n in names)  # an involution

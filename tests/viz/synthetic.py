@@ -24,9 +24,9 @@ from gaitopt.gait.gait_file import (
     GaitEvent,
     GaitPhase,
     GaitSamples,
-    leg_swap_permutations,
 )
 from gaitopt.robot import RobotModel, load_model, model_to_dict
+from gaitopt.robot.symmetry import swap_permutations
 from gaitopt.study.summary import (
     SUMMARY_FILE,
     SpeedMode,
@@ -163,7 +163,7 @@ def synthetic_gait(*, speed: float = 0.5, step_length: float = 0.4,
             x=np.hstack([q[:, indep], qd[:, indep]]), xdot=np.hstack([qd[:, indep],
                                                                       qdd[:, indep]])))
 
-    perm_q, _ = leg_swap_permutations(model)
+    perm_q, _ = swap_permutations(model)
     q_end = q_of(np.array([T]), 1)[0]
     hip_to_tip = q_end[[X, Y]]  # the hip relative to tip 1 at (0, 0)
     p_mag = 25.0 * v if impulse else 0.0

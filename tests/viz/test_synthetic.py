@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gaitopt.gait.gait_file import leg_swap_permutations
+from gaitopt.robot.symmetry import swap_permutations
 from tests.viz.synthetic import forward_kinematics, synthetic_gait
 
 
@@ -21,7 +21,7 @@ def test_stance_tips_stay_on_the_ground_and_swing_tip_above() -> None:
 
 def test_state_is_periodic_with_legs_swapped_and_shifted() -> None:
     gait = synthetic_gait(speed=0.5, step_length=0.4)
-    perm_q, _ = leg_swap_permutations(gait.model)
+    perm_q, _ = swap_permutations(gait.model)
     q_end = gait.phases[-1].q[-1][perm_q]
     q_end[0] -= gait.step_length
     np.testing.assert_allclose(q_end, gait.phases[0].q[0], atol=1e-12)

@@ -17,7 +17,7 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
    contacts held in double support (or the striking tip alone when the gait has none);
 3. **double support** for a fixed duration (time-triggered);
 4. the **liftoff impulse** of the gait's magnitude (:func:`gaitopt.dynamics.liftoff_impulse`);
-5. the **leg swap** (:func:`gaitopt.gait.gait_file.leg_swap_permutations`) and the shift of the
+5. the **leg swap** (:func:`gaitopt.robot.symmetry.swap_permutations`) and the shift of the
    base position by the new stance tip's position, so that it is at the origin:
    ``q+ = P q - E c(P q)``, ``qd+ = P qd`` (``E`` puts the 2-vector on ``x, y``).
 
@@ -64,9 +64,9 @@ from gaitopt.dynamics.functions import (
     liftoff_function,
 )
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
-from gaitopt.gait.gait_file import leg_swap_permutations
 from gaitopt.ocp.hermite_simpson import HermiteSimpson
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import swap_permutations
 
 Array = NDArray[np.float64]
 
@@ -253,7 +253,7 @@ def _swap_jump(spec: StepSpec) -> ca.Function:
     """``swap(y) -> (y+, d y+ / d y)``: legs exchanged, base shifted so that the new stance
     tip (the stance contact after relabelling) is at the origin."""
     nq = spec.nq
-    perm_q, _ = leg_swap_permutations(spec.model)
+    perm_q, _ = swap_permutations(spec.model)
 
     def build() -> ca.Function:
         y = ca.SX.sym("y", 2 * nq)

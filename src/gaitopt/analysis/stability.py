@@ -49,7 +49,8 @@ from gaitopt.dynamics.actuation import actuation_rows
 from gaitopt.dynamics.crba import crba
 from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.rnea import gravity_forces
-from gaitopt.gait.gait_file import Gait, leg_swap_permutations
+from gaitopt.gait.gait_file import Gait
+from gaitopt.robot.symmetry import swap_permutations
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -234,7 +235,7 @@ def free_rotations(spec: StepSpec, states: list[Array]) -> list[tuple[str, Array
         for c in range(len(model.links)):
             if model.parent_index(c) == k:
                 t[model.coordinate_of_link(c), 2 + k] = -1.0
-    perm_q, _ = leg_swap_permutations(model)
+    perm_q, _ = swap_permutations(model)
     b = np.array(actuation_rows(model, [c.name for c in model.contacts]), dtype=float)
     names = [c.name for c in model.contacts]
     out = []

@@ -158,7 +158,7 @@ def recompute_cost(gait: Any) -> float:
 
     from gaitopt.dynamics.kinematics import contact_velocity
     from gaitopt.gait import walking
-    from gaitopt.gait.gait_file import phase_states_at
+    from gaitopt.gait.interpolation import phase_states_at
 
     model = gait.model
     options = GaitOptions.from_dict(dict(gait.options))

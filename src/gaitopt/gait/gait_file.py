@@ -62,7 +62,7 @@ SOLVER_KEYS: tuple[str, ...] = ("status", "success", "iterations", "wall_time_s"
 #: Events of the built-in contact sequences: a walk's heel strike (touchdown) and liftoff
 #: (release, with the liftoff impulse); a run's toe-off (release) and touchdown.
 EVENT_NAMES: tuple[str, ...] = ("heel_strike", "liftoff", "toe_off", "touchdown")
-#: Interpolation rules this module can evaluate (see :func:`phase_states_at`).
+#: Interpolation rules gaitopt can evaluate (:mod:`gaitopt.gait.interpolation`).
 STATE_INTERPOLATIONS: tuple[str, ...] = ("cubic_hermite",)
 CONTROL_INTERPOLATIONS: tuple[str, ...] = ("piecewise_linear",)
 DEFAULT_INTERPOLATION: Mapping[str, str] = MappingProxyType({
@@ -377,7 +377,10 @@ class Gait:
         if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
             raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
         s = self.samples
-        q_swap, u_swap = leg_swap_permutations(self.model)
+        from gaitopt.robot.symmetry import swap_names, swap_permutations
+
+        q_swap, u_swap = swap_permutations(self.model)
+        names = swap_names(self.model)
         period, shift = self.step_time, self.step_length
         x_index = self.model.coordinate_names.index("x")
         duplicate = abs((s.t[-1] - s.t[0]) - period) <= 1e-9 * max(1.0, period)
@@ -393,7 +396,7 @@ class Gait:
             parts["qd"].append((s.qd[:, q_swap] if swap else s.qd)[sl])
             parts["u"].append((s.u[:, u_swap] if swap else s.u)[sl])
             for name in s.points:
-                source = swap_leg_label(name) if swap else name
+                source = names.get(name, name) if swap else name
                 if source not in s.points:
                     source = name
                 p = s.points[source][sl].copy()
@@ -671,59 +674,3 @@ def _dumps(value: Any, indent: int = 0) -> str:
         rows = [f"{inner}{_dumps(v, indent + 2)}" for v in value]
         return "[\n" + ",\n".join(rows) + "\n" + pad + "]"
     return json.dumps(value, allow_nan=False)
-
-
-# -- legs --------------------------------------------------------------------------------------
-
-def swap_leg_label(name: str) -> str:
-    """``knee_1`` <-> ``knee_2`` (a name ending in ``_1``/``_2``); other names unchanged."""
-    if name.endswith("_1"):
-        return name[:-2] + "_2"
-    if name.endswith("_2"):
-        return name[:-2] + "_1"
-    return name
-
-
-def leg_swap_permutations(model: RobotModel) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """Index permutations of ``q`` and ``u`` that exchange the two legs
-    (:func:`gaitopt.robot.symmetry.swap_permutations`: the declared symmetry or the one
-    inferred from the chains to the first two contacts). ``q_swapped = q[..., perm_q]``."""
-    from gaitopt.robot.symmetry import swap_permutations
-
-    return swap_permutations(model)
-
-
-# -- interpolation between knots ---------------------------------------------------------------
-
-def phase_states_at(phase: GaitPhase, t: Array) -> Array:
-    """Phase states (M, n) at times ``t`` (M,) by cubic Hermite interpolation of the knots:
-    the transcription's own interpolant (:meth:`gaitopt.ocp.hermite_simpson.HermiteSimpson.
-    state_at`, with s = (t - t_k)/h on the segment [t_k, t_k+1] of length h)."""
-    if phase.interpolation["states"] != "cubic_hermite":
-        raise ValueError(f"unsupported state interpolation {phase.interpolation['states']!r}")
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    k = np.clip(np.searchsorted(phase.t, t, side="right") - 1, 0, phase.t.size - 2)
-    h = (phase.t[k + 1] - phase.t[k])[:, None]
-    s = ((t - phase.t[k]) / h[:, 0])[:, None]
-    # Imported here: gaitopt.ocp loads CasADi, which reading a gait file does not need.
-    from gaitopt.ocp.hermite_simpson import HermiteSimpson
-
-    return np.asarray(HermiteSimpson().state_at(s, phase.x[k], phase.x[k + 1], phase.xdot[k],
-                                                phase.xdot[k + 1], h), dtype=float)
-
-
-def phase_controls_at(phase: GaitPhase, t: Array) -> Array:
-    """Controls (M, nu) at times ``t`` (M,), piecewise linear between knots."""
-    if phase.interpolation["controls"] != "piecewise_linear":
-        raise ValueError(f"unsupported control interpolation "
-                         f"{phase.interpolation['controls']!r}")
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    return np.stack([np.interp(t, phase.t, phase.u[:, j]) for j in range(phase.u.shape[1])],
-                    axis=1)
-
-
-def phase_forces_at(phase: GaitPhase, t: Array) -> dict[str, Array]:
-    """Contact forces (M, 2) N at times ``t`` (M,), piecewise linear between knots."""
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    return {c: np.stack([np.interp(t, phase.t, f[:, 0]), np.interp(t, phase.t, f[:, 1])],
-                        axis=1) for c, f in phase.contact_forces.items()}

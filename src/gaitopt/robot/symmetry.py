@@ -84,6 +84,19 @@ def swap_maps(model: RobotModel) -> tuple[dict[str, str], dict[str, str]]:
     return links, contacts
 
 
+def swap_names(model: RobotModel) -> dict[str, str]:
+    """Every link, joint and contact name of ``model`` -> its counterpart after the swap
+    (itself unless paired): the relabelling of named points (e.g. a gait's ``knee_1``,
+    ``heel_1``) when the legs exchange roles."""
+    links, contacts = swap_maps(model)
+    out = dict(links) | dict(contacts)
+    for link in model.links:
+        other = model.link(links[link.name]).joint
+        if link.joint is not None and other is not None:
+            out[link.joint.name] = other.name
+    return out
+
+
 def swap_permutations(model: RobotModel) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Index permutations of ``q`` (nq,) and ``u`` (nu,) that exchange the legs.
 

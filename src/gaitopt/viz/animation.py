@@ -24,7 +24,9 @@ from matplotlib.patches import FancyArrow
 from numpy.typing import NDArray
 from PIL import Image
 
-from gaitopt.gait.gait_file import Gait, phase_forces_at, swap_leg_label
+from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.interpolation import phase_forces_at
+from gaitopt.robot.symmetry import swap_names
 from gaitopt.viz.stick import draw_pose, pose_at, pose_segments
 from gaitopt.viz.style import LEG_COLORS, new_figure
 
@@ -113,6 +115,7 @@ def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
                                  length_includes_head=True, color=color, alpha=0.8, zorder=5)
         ax.add_patch(arrows[leg])
     label = ax.text(0.01, 0.98, "", transform=ax.transAxes, va="top", fontsize=9)
+    names = swap_names(gait.model)
 
     def draw(t: float) -> None:
         pose = pose_at(stride, t)
@@ -120,7 +123,7 @@ def animate_gait(gait: Gait, path: str | os.PathLike[str], *, steps: int = 4,
             lines[part].set_data(xy[:, 0], xy[:, 1])
         k = min(int(t // period), steps - 1)
         local = contact_forces_at(gait, t - k * period) if forces else {}
-        on_ground = {(swap_leg_label(c) if k % 2 else c): f for c, f in local.items()}
+        on_ground = {(names.get(c, c) if k % 2 else c): f for c, f in local.items()}
         for leg, arrow in arrows.items():
             f = on_ground.get(leg)
             arrow.set_visible(f is not None)

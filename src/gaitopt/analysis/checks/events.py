@@ -11,7 +11,7 @@ For each event at the end of phase i (its time equals that phase's last knot):
   applies the liftoff impulse (``parameters.liftoff_impulse``) on the lifting tip while the
   other contacts held before it stay;
 * ``events.periodicity``: the state after the last event, legs relabelled
-  (:func:`~gaitopt.gait.gait_file.leg_swap_permutations`) and shifted back one step length,
+  (:func:`~gaitopt.robot.symmetry.swap_permutations`) and shifted back one step length,
   equals the first knot; ``events.periodic_controls`` the same for the controls of the
   actuators acting at both ends, if the gait was solved with periodic controls (and the
   paper's control model: with ``control_model = "jumps"`` the torques may jump at the events).
@@ -27,7 +27,8 @@ from gaitopt.dynamics.functions import impact_function, liftoff_function
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, sequence_from_dict
 from gaitopt.gait.full_physics import model_symmetry, per_point
-from gaitopt.gait.gait_file import Gait, GaitEvent, leg_swap_permutations, swap_leg_label
+from gaitopt.gait.gait_file import Gait, GaitEvent
+from gaitopt.robot.symmetry import swap_names, swap_permutations
 
 Array = NDArray[np.float64]
 
@@ -46,7 +47,8 @@ def _phase_ending_at(gait: Gait, t: float) -> int | None:
 def _held_after_strike(gait: Gait, i: int, leg: str) -> tuple[str, ...]:
     if i + 1 < len(gait.phases):
         return tuple(gait.phases[i + 1].contacts)
-    relabelled = tuple(swap_leg_label(c) for c in gait.phases[0].contacts)
+    names = swap_names(gait.model)
+    relabelled = tuple(names.get(c, c) for c in gait.phases[0].contacts)
     return relabelled if leg in relabelled else (leg,)
 
 
@@ -140,7 +142,7 @@ def event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
 def _periodicity_checks(gait: Gait, q_end: Array, qd_end: Array, lim: dict[str, float]
                         ) -> list[Check]:
     model = gait.model
-    perm_q, perm_u = leg_swap_permutations(model)
+    perm_q, perm_u = swap_permutations(model)
     first, last = gait.phases[0], gait.phases[-1]
     q_next = q_end[perm_q].copy()
     q_next[model.coordinate_names.index("x")] -= gait.parameters["step_length"]
