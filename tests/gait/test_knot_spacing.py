@@ -27,11 +27,13 @@ def test_cosine_knots_cluster_at_both_ends() -> None:
 
 
 def test_target_grid() -> None:
-    assert target_grid(GaitOptions()) == (16, 6)
-    ss, ds = target_grid(GaitOptions(knot_spacing="cosine", knots=(24, 8)))
+    model = load_model("five-link")
+    assert target_grid(model, GaitOptions()) == (16, 6)
+    ss, ds = target_grid(model, GaitOptions(knot_spacing="cosine", knots=(24, 8)))
     np.testing.assert_array_equal(ss, cosine_knots(24))
     np.testing.assert_array_equal(ds, cosine_knots(8))
-    alone = target_grid(GaitOptions(knot_spacing="cosine", single_support_fraction=1.0))
+    alone = target_grid(model, GaitOptions(knot_spacing="cosine",
+                                           single_support_fraction=1.0))
     assert len(alone) == 1
 
 
@@ -63,3 +65,23 @@ def test_cosine_knots_converge_where_uniform_ones_do_not() -> None:
     assert abs(cost["cosine", 48] / cost["cosine", 16] - 1) < 0.01
     finest = max(cost["uniform", 48], cost["cosine", 48])
     assert abs(cost["cosine", 16] - finest) < abs(cost["uniform", 16] - finest)
+
+
+def test_cosine_grid_of_a_four_phase_sequence() -> None:
+    """Cosine spacing follows the problem's phases: the heel-toe walk's four phases get their
+    own knot counts (the density rule), and the transcription builds on that mesh."""
+    from gaitopt.gait.contact_sequence import phase_knots
+    from gaitopt.gait.formulation import contact_sequence
+    from gaitopt.gait.transcriptions import transcription_for
+
+    model = load_model("seven-link")
+    options = GaitOptions(formulation="full", gait="heel-toe", knots=(8, 5),
+                          knot_spacing="cosine")
+    grid = target_grid(model, options)
+    counts = phase_knots(contact_sequence(model, options), options.knots)
+    assert [len(m) for m in grid] == list(counts) and len(grid) == 4
+    for mesh, n in zip(grid, counts, strict=True):
+        np.testing.assert_array_equal(mesh, cosine_knots(n))
+    tr = transcription_for(model, options, grid)
+    for mesh, n in zip(tr.mesh, counts, strict=True):
+        np.testing.assert_allclose(np.asarray(mesh, dtype=float), cosine_knots(n))

@@ -328,7 +328,7 @@ class _Run:
         o = self.options
         if tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform":
             return result
-        return self.on_grid("target grid", target_grid(o), result)
+        return self.on_grid("target grid", target_grid(self.model, o), result)
 
     def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
         """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
@@ -421,13 +421,13 @@ class _Run:
         if o.cost != "paper" and o.cost_smoothing < COST_SMOOTHING_START:
             smooth = o.replace(cost_smoothing=COST_SMOOTHING_START)
             guess = self.stage(f"{o.cost} cost, eps {COST_SMOOTHING_START:g} W",
-                               target_grid(o),
+                               target_grid(self.model, o),
                                Relaxation(), guess, parameter_bounds(o),
                                solver_options=PRIMAL_WARM_OPTIONS, problem=smooth)
             if not guess.success:
                 return guess
             guess = result_guess(guess)
-        return self.stage(f"{o.cost} cost", target_grid(o), Relaxation(), guess,
+        return self.stage(f"{o.cost} cost", target_grid(self.model, o), Relaxation(), guess,
                           parameter_bounds(o),
                           solver_options=PRIMAL_WARM_OPTIONS)
 
@@ -460,7 +460,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     run = _Run(model, options, progress, compiled)
     result: Result | None = None
     if warm_start is not None:
-        result = run.stage("warm start", warm_start_grid(options, warm_start), Relaxation(),
+        result = run.stage("warm start", warm_start_grid(model, options, warm_start), Relaxation(),
                            warm_start, parameter_bounds(options),
                            solver_options=PRIMAL_WARM_OPTIONS)
         if not result.success:

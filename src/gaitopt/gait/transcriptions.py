@@ -181,30 +181,32 @@ def cosine_knots(n: int) -> np.ndarray:
     return 0.5 * (1.0 - np.cos(np.pi * np.arange(n) / (n - 1)))
 
 
-def target_grid(options: GaitOptions) -> Grid:
+def target_grid(model: RobotModel, options: GaitOptions) -> Grid:
     """The target grid of a solve: ``options.knots``, uniform, or with ``knot_spacing =
-    "cosine"`` a mesh of :func:`cosine_knots` per phase."""
+    "cosine"`` a mesh of :func:`cosine_knots` for each phase of the problem, with the knot
+    count the problem gives that phase (two-phase walks: ``options.knots``; longer contact
+    sequences: :func:`gaitopt.gait.contact_sequence.phase_knots`)."""
     if options.knot_spacing == "uniform":
         return options.knots
-    phases = 2 if options.double_support else 1
-    return tuple(cosine_knots(int(n)) for n in options.knots[:phases])
+    return tuple(cosine_knots(ph.intervals + 1) for ph in problem_for(model, options).phases)
 
 
-def warm_start_grid(options: GaitOptions, warm_start: Guess | Result | WarmStart) -> Grid:
+def warm_start_grid(model: RobotModel, options: GaitOptions,
+                    warm_start: Guess | Result | WarmStart) -> Grid:
     """The grid of a warm start: :func:`target_grid`; with ``mesh_tol``, the warm start's own
     mesh (a refined gait's non-uniform knots), every other knot of it when each phase has an
     odd number >= 5: the mesh before the halving that ended its refinement, so that a chain
     of warm starts (a sweep) does not double the grid at every point."""
     if options.mesh_tol is None or isinstance(warm_start, WarmStart):
-        return target_grid(options)
+        return target_grid(model, options)
     if isinstance(warm_start, Result):
         taus = [np.asarray(m, dtype=float) for m in warm_start.mesh]
     else:
         taus = [np.asarray(g.tau, dtype=float) for g in warm_start.phases.values()
                 if g.tau is not None]
-    phases = 2 if options.double_support else 1
-    if len(taus) != phases or any(t.size < 2 for t in taus):
-        return target_grid(options)
+    if (len(taus) != len(problem_for(model, options).phases)
+            or any(t.size < 2 for t in taus)):
+        return target_grid(model, options)
     if all(t.size % 2 == 1 and t.size >= 5 for t in taus):
         taus = [t[::2] for t in taus]
     return tuple(taus)
