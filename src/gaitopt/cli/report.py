@@ -33,7 +33,7 @@ def write_reports(console: Console, directory: Path, out: Path,
     sweep folders drawn beside each (printed: their optima against people's walk)."""
     from gaitopt.study.findings import findings_text
     from gaitopt.viz.report import write_report
-    from gaitopt.viz.sweep_comparison import comparison_text, load_compared_sweep
+    from gaitopt.viz.sweep_comparison import comparison_text
 
     for other in compare:
         if not (other / SUMMARY_FILE).exists():
@@ -43,12 +43,11 @@ def write_reports(console: Console, directory: Path, out: Path,
         target = out if sweep == directory else out / sweep.name
         try:
             info = write_report(sweep, target, compare=compare)
-            if compare:
-                compared = [load_compared_sweep(d) for d in (sweep, *compare)]
         except SummaryError as exc:
             raise UserError(str(exc)) from None
-        if compare:
-            console.print("\n".join(["compared:", *comparison_text(compared)]), soft_wrap=True)
+        if info.compared:
+            console.print("\n".join(["compared:", *comparison_text(info.compared)]),
+                          soft_wrap=True)
         console.print(f"report: {info.html} ({len(info.figures)} figure files beside it)",
                       soft_wrap=True)
         for problem in info.problems:

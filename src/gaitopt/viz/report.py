@@ -91,12 +91,14 @@ PAPER_EVALUATION_KINDS: dict[str, str] = {
 
 @dataclass(frozen=True)
 class ReportInfo:
-    """What :func:`write_report` wrote: the HTML file, the figure files, and any problems."""
+    """What :func:`write_report` wrote: the HTML file, the figure files, any problems, the
+    findings and the sweeps compared (this one first; empty without ``compare``)."""
 
     html: Path
     figures: tuple[Path, ...]
     problems: tuple[str, ...]
     findings: Findings
+    compared: tuple[ComparedSweep, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -175,6 +177,7 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     add(step_length_figure(rows), "fig4_step_length", "Fig. 4: optimal step length against "
         "speed." + grid_note(what="step length"))
 
+    compared: list[ComparedSweep] = []
     if compare:
         compared = [ComparedSweep(sweep_label(sweep), tuple(rows), sweep)]
         compared += [load_compared_sweep(d) for d in compare]
@@ -247,7 +250,7 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     path = out / "report.html"
     write_text_atomic(path, page)
     return ReportInfo(html=path, figures=tuple(figures), problems=tuple(problems),
-                      findings=findings)
+                      findings=findings, compared=tuple(compared))
 
 
 def write_gait_figures(curves: Sequence[tuple[str, Gait]], out_dir: str | os.PathLike[str],

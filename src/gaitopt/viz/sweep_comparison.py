@@ -58,7 +58,8 @@ def sweep_label(folder: Path) -> str:
         settings = json.loads((folder / SETTINGS_FILE).read_text())["settings"]
         options = settings.get("options", {})
         knots = "+".join(str(k) for k in options.get("knots", ()))
-        gait = options.get("contact_sequence") and "custom sequence" or options.get("gait", "walk")
+        gait = ("custom sequence" if options.get("contact_sequence")
+                else options.get("gait", "walk"))
         return f"{settings['model']['name']} ({gait}, {knots} knots)"
     except (OSError, ValueError, KeyError, TypeError):
         return folder.resolve().name
