@@ -51,9 +51,12 @@ class StabilityRow:
     tracked: StabilityCell
 
 
-def _cell(gait: Gait, **kwargs: object) -> StabilityCell:
+def _cell(gait: Gait, pd: tuple[float, float] | None) -> StabilityCell:
+    """Open loop about the gait's knots (``pd`` None), or PD-tracked from its start."""
     try:
-        return StabilityCell(gait_stability(gait, check=False, **kwargs))  # type: ignore[arg-type]
+        report = (gait_stability(gait, about="gait", check=False) if pd is None
+                  else gait_stability(gait, pd=pd, check=False))
+        return StabilityCell(report)
     except StabilityError as exc:
         return StabilityCell(None, str(exc))
 
@@ -61,8 +64,7 @@ def _cell(gait: Gait, **kwargs: object) -> StabilityCell:
 def stability_rows(gaits: Sequence[tuple[str, Gait]],
                    pd: tuple[float, float] = REPORT_PD) -> list[StabilityRow]:
     """The two analyses of each ``(label, gait)``."""
-    return [StabilityRow(label, _cell(gait, about="gait"), _cell(gait, pd=pd))
-            for label, gait in gaits]
+    return [StabilityRow(label, _cell(gait, None), _cell(gait, pd)) for label, gait in gaits]
 
 
 def stability_table_html(rows: Sequence[StabilityRow],
