@@ -21,12 +21,16 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
    base position by the new stance tip's position, so that it is at the origin:
    ``q+ = P q - E c(P q)``, ``qd+ = P qd`` (``E`` puts the 2-vector on ``x, y``).
 
-That is the paper's walk; in general (:class:`StepSpec`) the phases run in order, the one that
-ends at the guard is state-triggered and the others last their durations, and after each
-phase its :class:`StepEvent` jumps (impacts, liftoffs) are applied in order, then the swap.
-A run is stance (time-triggered), the toe-off (a liftoff without impulse, no contact held
-after it), flight (no contact held) until the swing tip strikes (the guard), the touchdown
-impact, the swap.
+That is the paper's walk; in general (:class:`StepSpec`) the phases run in order, those
+that end when a point strikes the ground are state-triggered (each with its own guard: the
+height of the point that strikes, :attr:`PhaseProfile.guard`) and the others last their
+durations, and after each phase its :class:`StepEvent` jumps (impacts, liftoffs) are
+applied in order, then the swap. A run is stance (time-triggered), the toe-off (a liftoff
+without impulse, no contact held after it), flight (no contact held) until the swing tip
+strikes (the guard), the touchdown impact, the swap. A walk with feet (heel-toe) has two
+guards: the heel strike, and the toe of the same foot landing at the end of the heel
+rocker (foot flat); its section is the start of foot flat, with the stance heel pinned at
+the origin and the stance toe held on the ground (:attr:`StepSpec.section_holds`).
 
 Optional joint-space PD tracking adds ``u = kp B^T (q_ref(tau) - q) + kd B^T (qd_ref(tau) -
 qd)`` to the replayed torques (``B`` the actuation matrix of the phase, so a joint actuator
@@ -64,6 +68,7 @@ from gaitopt.dynamics.functions import (
     liftoff_function,
 )
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
+from gaitopt.dynamics.tree import holds
 from gaitopt.ocp.hermite_simpson import HermiteSimpson
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import swap_permutations
@@ -79,7 +84,9 @@ class StepSimulationError(ValueError):
 class PhaseProfile:
     """One phase replayed on its own clock (``tau = 0`` at the phase start).
 
-    ``contacts`` held; ``duration`` (s), or None when the phase ends at the guard; knot times
+    ``contacts`` held (hold specs, as :func:`gaitopt.dynamics.tree.holds` reads them);
+    ``duration`` (s), or None when the phase ends at a guard: the point ``guard`` (default:
+    the step's swing tip) reaching the ground moving down; knot times
     ``t`` (K,) on the phase clock; torques ``u`` (K, nu) N m; for PD tracking the reference
     ``q``, ``qd``, ``qdd`` (K, nq) at the knots (``q_ref`` is the cubic Hermite interpolant of
     ``q`` and ``qd``, ``qd_ref`` that of ``qd`` and ``qdd``; last values held past the end).
@@ -93,6 +100,7 @@ class PhaseProfile:
     qd: Array | None = None
     qdd: Array | None = None
     nominal_duration: float = 0.0
+    guard: str | None = None
 
     def inputs(self, tau: float) -> tuple[Array, Array | None, Array | None]:
         """``(u, q_ref, qd_ref)`` at ``tau`` (the references None without PD knots)."""
@@ -127,11 +135,13 @@ class StepEvent:
 @dataclass(frozen=True, eq=False)
 class StepSpec:
     """Everything the return map needs: the model, the stance and swing contacts, the phases
-    in order (exactly one ends at the guard: ``duration`` None; the others last their
+    in order (at least one ends at a guard: ``duration`` None; the others last their
     ``duration``), the events after each phase (``events[i]``, applied in order), the
-    distance (m) the swing tip must be ahead of the origin (the stance tip at the start of
-    the step) before the guard is armed, optional PD gains ``(kp, kd)`` (N m/rad,
-    N m s/rad) and the integrator tolerances."""
+    distance (m) a guard's point must be ahead of the origin (the stance tip at the start of
+    the step) before its guard is armed, optional PD gains ``(kp, kd)`` (N m/rad,
+    N m s/rad), the integrator tolerances, and the holds that define the Poincare section
+    (``section_holds``: the points held at rest at the step's start, as hold specs; default
+    the stance tip pinned)."""
 
     model: RobotModel
     stance: str
@@ -142,6 +152,7 @@ class StepSpec:
     pd: tuple[float, float] | None = None
     rtol: float = 1e-11
     atol: float = 1e-11
+    section_holds: tuple[str, ...] = ()
     _functions: dict[str, ca.Function] = field(default_factory=dict, repr=False)
 
     @cached_property
@@ -149,13 +160,27 @@ class StepSpec:
         return self.model.nq
 
     @cached_property
-    def guard_phase(self) -> int:
-        """Index of the phase that ends at the heel-strike guard."""
-        guards = [i for i, ph in enumerate(self.phases) if ph.duration is None]
-        if len(guards) != 1 or len(self.events) != len(self.phases):
-            raise StepSimulationError("a step needs exactly one guard-terminated phase and a "
+    def guard_phases(self) -> tuple[int, ...]:
+        """Indices of the phases that end at a guard (state-triggered), in order."""
+        guards = tuple(i for i, ph in enumerate(self.phases) if ph.duration is None)
+        if not guards or len(self.events) != len(self.phases):
+            raise StepSimulationError("a step needs at least one guard-terminated phase and a "
                                       "list of events after each phase")
-        return guards[0]
+        return guards
+
+    @cached_property
+    def guard_phase(self) -> int:
+        """Index of the first phase that ends at a guard (the heel strike of a walk)."""
+        return self.guard_phases[0]
+
+    @cached_property
+    def holds(self) -> tuple[str, ...]:
+        """The section's holds (:attr:`section_holds`, or the stance tip pinned)."""
+        return self.section_holds or (self.stance,)
+
+    def guard_point(self, phase: int) -> str:
+        """The point whose touchdown ends phase ``phase`` (the swing tip by default)."""
+        return self.phases[phase].guard or self.swing
 
     def function(self, key: str, build: Callable[[], ca.Function]) -> ca.Function:
         if key not in self._functions:
@@ -213,7 +238,8 @@ def _rhs(spec: StepSpec, contacts: tuple[str, ...], jacobian: bool = True) -> ca
         qdd = contact_dynamics_function(model, contacts, inputs="u")(q, qd, u)[0]
         ydot = ca.vertcat(qd, qdd)
         outputs = [ydot, ca.jacobian(ydot, y)] if jacobian else [ydot]
-        return _compiled(spec, ca.Function(f"rhs_{tag}", [y, uff, q_ref, qd_ref], outputs))
+        name = re.sub(r"_+", "_", re.sub(r"\W", "_", f"rhs_{tag}"))
+        return _compiled(spec, ca.Function(name, [y, uff, q_ref, qd_ref], outputs))
 
     return spec.function("rhs:" + tag, build)
 
@@ -297,7 +323,8 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     ``guard`` is not True), at ``phase.duration`` (time-triggered), or at the guard
     (``duration`` None, or ``guard=True``). Returns ``(tau_end, y, Phi)``."""
     n = 2 * spec.nq
-    swing = _tip(spec, spec.swing)
+    point = phase.guard or spec.swing
+    swing = _tip(spec, point)
 
     def rhs(tau: float, z: Array) -> Array:
         if not variational:
@@ -339,14 +366,28 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
                 continue
             tau, z = stop, np.asarray(sol.y[:, -1], float)
     if guard:
-        raise StepSimulationError(f"the swing tip {spec.swing} did not strike the ground ahead "
+        raise StepSimulationError(f"the point {point} did not strike the ground ahead "
                                   f"of the stance tip within {end:.3g} s of single support")
     return tau, z[:n], (z[n:].reshape(n, n) if variational else None)
 
 
-def guard_row(spec: StepSpec, y: Array) -> Array:
-    """``Dg`` (2 nq,): the gradient of the guard (swing tip height) with respect to ``y``."""
-    return _eval(_tip(spec, spec.swing), y)[2][1]
+def guard_row(spec: StepSpec, y: Array, point: str | None = None) -> Array:
+    """``Dg`` (2 nq,): the gradient of a guard (the height of ``point``, by default the swing
+    tip) with respect to ``y``."""
+    return _eval(_tip(spec, point or spec.swing), y)[2][1]
+
+
+def guard_factor(spec: StepSpec, phase: int, tau: float, y_minus: Array) -> Array:
+    """``I - f- Dg / (Dg f-)`` (2 nq, 2 nq) at the guard ending phase ``phase`` (module
+    docstring), ``f-`` the phase's field at the crossing (clock ``tau``, state ``y_minus``)."""
+    f_minus = phase_field(spec, spec.phases[phase], tau, y_minus)
+    dg = guard_row(spec, y_minus, spec.guard_point(phase))
+    rate = float(dg @ f_minus)
+    if abs(rate) < 1e-12:
+        raise StepSimulationError(f"the point {spec.guard_point(phase)} grazes the ground at "
+                                  "its touchdown (zero vertical velocity): the saltation "
+                                  "matrix is undefined")
+    return np.eye(2 * spec.nq) - np.outer(f_minus, dg) / rate
 
 
 def saltation_matrix(spec: StepSpec, y_minus: Array, f_minus: Array, f_plus: Array) -> Array:
@@ -388,7 +429,7 @@ def simulate_step(spec: StepSpec, y0: Array, *, variational: bool = False) -> St
     """One step of the return map from ``y0`` (2 nq,) (see the module docstring)."""
     y = np.asarray(y0, dtype=float)
     n = 2 * spec.nq
-    guard = spec.guard_phase
+    guard, guards = spec.guard_phase, spec.guard_phases
     monodromy = np.eye(n)
     factors: dict[str, Array] = {}
     t_total, t_strike, y_strike, y_imp = 0.0, 0.0, y, y
@@ -400,14 +441,8 @@ def simulate_step(spec: StepSpec, y0: Array, *, variational: bool = False) -> St
             t_strike, y_strike, y_imp = tau, y_end, y
         if variational:
             assert phi is not None
-            if i == guard:
-                f_minus = phase_field(spec, phase, tau, y_end)
-                dg = guard_row(spec, y_end)
-                rate = float(dg @ f_minus)
-                if abs(rate) < 1e-12:
-                    raise StepSimulationError("the swing tip grazes the ground at the heel "
-                                              "strike")
-                jump = jump @ (np.eye(n) - np.outer(f_minus, dg) / rate)
+            if i in guards:
+                jump = jump @ guard_factor(spec, i, tau, y_end)
             factors[f"phi_{i}"], factors[f"jump_{i}"] = phi, jump
             monodromy = jump @ phi @ monodromy
     y_next, d_swap = _eval(_swap_jump(spec), y)
@@ -433,10 +468,20 @@ def step_map(spec: StepSpec, y0: Array) -> Array:
 
 
 def section_constraints(spec: StepSpec, y: Array) -> tuple[Array, Array]:
-    """The stance tip's position and velocity (4,) and their Jacobian ``C`` (4, 2 nq):
-    ``C = [[J, 0], [d(J qd)/dq, J]]``; the section is ``{position = 0, velocity = 0}``."""
-    p, v, c = _eval(_tip(spec, spec.stance), np.asarray(y, float))
-    return np.concatenate([p.ravel(), v.ravel()]), c
+    """The held coordinates of the section's points (:attr:`StepSpec.holds`): positions then
+    velocities, ``(2 m,)`` for ``m`` held axes (4 for the stance tip pinned: x, y, vx, vy),
+    and their Jacobian ``C`` (2 m, 2 nq): ``C = [[J, 0], [d(J qd)/dq, J]]``, rows of the held
+    axes. The section is ``{position = position at the start, velocity = 0}`` (the stance tip
+    at the origin; a point held along the normal only at height 0)."""
+    rows_p, rows_v, jac_p, jac_v = [], [], [], []
+    for hold in holds(spec.model, spec.holds, "section_holds"):
+        p, v, c = _eval(_tip(spec, hold.name), np.asarray(y, float))
+        axes = list(hold.axes)
+        rows_p.append(p.ravel()[axes])
+        rows_v.append(v.ravel()[axes])
+        jac_p.append(c[axes])
+        jac_v.append(c[[2 + a for a in axes]])
+    return (np.concatenate(rows_p + rows_v), np.vstack(jac_p + jac_v))
 
 
 def reference_step(spec: StepSpec) -> StepResult:
@@ -468,7 +513,7 @@ def reference_step(spec: StepSpec) -> StepResult:
             z, tau = np.asarray(sol.y[:, -1], float), float(stop)
         return z.reshape(n, n)
 
-    guard = spec.guard_phase
+    guard, guards = spec.guard_phase, spec.guard_phases
     monodromy = np.eye(n)
     factors: dict[str, Array] = {}
     t_total, t_strike = 0.0, 0.0
@@ -478,10 +523,9 @@ def reference_step(spec: StepSpec) -> StepResult:
         y_end = reference(phase, tau)
         t_total += tau
         y, jump = events_jump(spec, events, y_end)
+        if i in guards:
+            jump = jump @ guard_factor(spec, i, tau, y_end)
         if i == guard:
-            f_minus = phase_field(spec, phase, tau, y_end)
-            dg = guard_row(spec, y_end)
-            jump = jump @ (np.eye(n) - np.outer(f_minus, dg) / float(dg @ f_minus))
             t_strike, y_strike, y_imp = tau, y_end, y
         factors[f"phi_{i}"], factors[f"jump_{i}"] = along(phase), jump
         monodromy = jump @ factors[f"phi_{i}"] @ monodromy

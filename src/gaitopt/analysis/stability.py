@@ -47,10 +47,12 @@ from gaitopt.analysis.return_map import (
 )
 from gaitopt.dynamics.actuation import actuation_rows
 from gaitopt.dynamics.crba import crba
-from gaitopt.dynamics.kinematics import contact_jacobian
+from gaitopt.dynamics.kinematics import contact_jacobian, contact_position
 from gaitopt.dynamics.rnea import gravity_forces
+from gaitopt.dynamics.tree import holds
+from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
 from gaitopt.gait.gait_file import Gait
-from gaitopt.robot.symmetry import swap_permutations
+from gaitopt.robot.symmetry import swap_maps, swap_permutations
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -148,6 +150,8 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
                              "its trajectories are not a gait; solve it again")
     if pd is not None and (len(pd) != 2 or not all(np.isfinite(pd)) or min(pd) < 0):
         raise StabilityError(f"pd: got {pd!r}; allowed: two finite gains kp, kd >= 0")
+    if gait.contact_sequence is not None:
+        return _step_from_sequence(gait, pd, rtol)
     phases = gait.phases
     if len(phases[0].contacts) != 1:
         raise StabilityError(f"phases[0].contacts: the step must start in single support on "
@@ -194,6 +198,65 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
                     arm_distance=ARM_FRACTION * gait.step_length, pd=pd, rtol=rtol, atol=rtol)
 
 
+def _step_from_sequence(gait: Gait, pd: tuple[float, float] | None, rtol: float) -> StepSpec:
+    """The return map of a gait that carries its contact sequence (any sequence of the
+    transcription, e.g. heel-toe): each phase holds the sequence's hold specs; a phase
+    followed by a touchdown is state-triggered, its guard the height of the point that
+    touches down (the first, if several); after it the impact of the points held next
+    (as the transcription's event map does); a release is a liftoff with the gait's
+    impulse (0 without one, or after a touchdown at the same instant: then it only projects
+    the velocity onto the held points' constraints, which the state already meets); the
+    section holds
+    the first phase's points at rest, the stance point the first of them held on both axes.
+    """
+    try:
+        seq = sequence_from_dict(dict(gait.contact_sequence or {}))
+    except ContactSequenceError as exc:
+        raise StabilityError(f"contact_sequence: {exc}") from None
+    model = gait.model
+    swap = swap_maps(model)[1]
+    phases = gait.phases
+    if len(phases) != len(seq.phases):
+        raise StabilityError(f"contact_sequence: {len(seq.phases)} phases, but the gait has "
+                             f"{len(phases)}")
+    pinned = [h.name for h in holds(model, seq.phases[0].held) if len(h.axes) == 2]
+    if not pinned:
+        raise StabilityError(f"contact_sequence.phases[0].held = {list(seq.phases[0].held)}: "
+                             "the step must start with a point pinned on the ground (the "
+                             "Poincare section holds it at the origin)")
+    touchdowns = [ev.touchdown[0] for ev in seq.events if ev.touchdown]
+    if not touchdowns:
+        raise StabilityError("contact_sequence.events: no touchdown, so no guard ends a phase")
+    events: list[tuple[StepEvent, ...]] = []
+    guards: dict[int, str] = {}
+    released = {e.leg: e for e in gait.events}  # the recorded events, by the point they move
+    for i, ev in enumerate(seq.events):
+        after = seq.holds_after(i, swap)
+        jumps = []
+        if ev.touchdown:
+            guards[i] = ev.touchdown[0]
+            jumps.append(StepEvent("strike", ev.touchdown[0], after))
+        for point in ev.release:
+            recorded = released.get(point)
+            impulse = None if recorded is None else recorded.impulses.get(point)
+            magnitude = 0.0 if impulse is None or ev.touchdown else float(np.hypot(*impulse))
+            jumps.append(StepEvent("liftoff", point, after, magnitude))
+        events.append(tuple(jumps))
+
+    def profile(i: int) -> PhaseProfile:
+        ph = phases[i]
+        return PhaseProfile(contacts=seq.phases[i].held,
+                            duration=None if i in guards else ph.duration,
+                            t=ph.t - ph.t[0], u=np.array(ph.u), q=np.array(ph.q),
+                            qd=np.array(ph.qd), qdd=np.array(ph.qdd),
+                            nominal_duration=ph.duration, guard=guards.get(i))
+
+    return StepSpec(model=model, stance=pinned[0], swing=touchdowns[0],
+                    phases=tuple(profile(i) for i in range(len(phases))),
+                    events=tuple(events), arm_distance=ARM_FRACTION * gait.step_length,
+                    pd=pd, rtol=rtol, atol=rtol, section_holds=seq.phases[0].held)
+
+
 def gait_start(gait: Gait) -> Array:
     """The gait's state at the start of single support, ``[q; qd]`` (2 nq,)."""
     return np.concatenate([gait.phases[0].q[0], gait.phases[0].qd[0]])
@@ -202,23 +265,25 @@ def gait_start(gait: Gait) -> Array:
 # -- the section -------------------------------------------------------------------------------
 
 def tangent_basis(spec: StepSpec, y: Array) -> tuple[Array, Array]:
-    """``(V (2nq, 2nq - 4), C (4, 2nq))``: an orthonormal basis of the section's tangent
-    space at ``y`` and the constraint Jacobian whose null space it is."""
+    """``(V (2nq, 2nq - r), C (r, 2nq))``: an orthonormal basis of the section's tangent
+    space at ``y`` and the constraint Jacobian whose null space it is (``r`` = 4 for the
+    stance tip pinned: its position and velocity)."""
     _, c = section_constraints(spec, y)
     _, s, vt = np.linalg.svd(c)
     if s[-1] < 1e-9 * s[0]:
-        raise StabilityError("the stance tip's constraints are singular at the section state")
+        raise StabilityError(f"the section's constraints ({', '.join(spec.holds)} held) are "
+                             "singular at the section state")
     return vt[c.shape[0]:].T, c
 
 
 def project_to_section(spec: StepSpec, y: Array) -> Array:
     """The nearest state on the section: the base shifted so the stance tip is at the origin,
-    the stance tip's velocity removed by least squares (``qd - J^+ J qd``)."""
+    the held points' velocities removed by least squares (``qd - J^+ J qd``; a point held
+    along the normal only keeps its height: the shift is along the base's x, y)."""
     nq = spec.nq
     y = np.array(y, dtype=float)
-    pv, _ = section_constraints(spec, y)
-    y[:2] -= pv[:2]
-    jac = np.asarray(contact_jacobian(spec.model, y[:nq], [spec.stance]), dtype=float)
+    y[:2] -= np.asarray(contact_position(spec.model, y[:nq], spec.stance), float).ravel()
+    jac = np.asarray(contact_jacobian(spec.model, y[:nq], list(spec.holds)), dtype=float)
     y[nq:] -= np.linalg.pinv(jac) @ (jac @ y[nq:])
     return y
 
@@ -272,9 +337,12 @@ def floquet(spec: StepSpec, y: Array, *, check: bool = True, fd_step: float = FD
     phi = result.monodromy
     basis, c = tangent_basis(spec, y)
     names = list(spec.model.coordinate_names)
+    held = ", ".join(spec.holds)
     removed = [RemovedDirections(
-        "stance tip position and velocity (x, y)",
-        "the section's constraints: the map holds the stance tip at the origin at rest", 4)]
+        "stance tip position and velocity (x, y)" if spec.holds == (spec.stance,) else
+        f"held points' positions and velocities ({held})",
+        f"the section's constraints: the map holds {held} at rest on the ground "
+        "(the stance point at the origin)", c.shape[0])]
     # Free rotations: an invariant subspace [v; 0], [0; v] removed by a quotient.
     s_cols = []
     for link, v in free_rotations(spec, [y, result.y_strike]):
