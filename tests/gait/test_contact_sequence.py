@@ -14,11 +14,12 @@ from gaitopt.gait.contact_sequence import (
     walking_sequence,
 )
 from gaitopt.gait.formulation import checked_sequence, default_formulation
-from gaitopt.gait.full_physics import model_symmetry, per_point, projection_names
+from gaitopt.gait.full_physics import per_point, projection_names
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.robot.loader import load_model
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 
 PAPER = {
     "name": "my-walk",
@@ -41,7 +42,7 @@ def five() -> RobotModel:
 
 
 def swap(model: RobotModel) -> dict[str, str]:
-    return dict(model_symmetry(model).contacts)
+    return dict(leg_swap(model).contacts)
 
 
 def test_data_round_trip_equals_the_built_in_walk(five: RobotModel) -> None:

@@ -61,13 +61,11 @@ from gaitopt.gait.contact_sequence import (
 )
 from gaitopt.gait.full_physics import (
     PointValues,
-    Symmetry,
     actuator_names,
     event_impulses,
     event_map,
     full_controls,
     hold_axes,
-    model_symmetry,
     phase_point,
     projection_names,
     state_names,
@@ -88,6 +86,7 @@ from gaitopt.ocp.problem import (
 )
 from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import LegSwap, leg_swap
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 _L, _V, _P, _F = range(4)
@@ -129,10 +128,10 @@ def _limits(model: RobotModel) -> dict[str, tuple[float, float]]:
 
 def stance_knees(model: RobotModel) -> dict[str, str]:
     """Contact name -> the knee joint of its leg, for five-link-like models (else empty)."""
-    from gaitopt.robot.biped import BipedStructureError, biped_structure
+    from gaitopt.robot.biped import BipedStructureError, biped_of
 
     try:
-        legs = biped_structure(model).legs
+        legs = biped_of(model).legs
     except BipedStructureError:
         return {}
     return {leg.contact: leg.knee for leg in legs}
@@ -140,7 +139,7 @@ def stance_knees(model: RobotModel) -> dict[str, str]:
 
 def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) -> Problem:
     """The OCP of one periodic step of ``seq`` in full coordinates (module docstring)."""
-    symmetry = model_symmetry(model)
+    symmetry = leg_swap(model)
     check_sequence(model, seq, dict(symmetry.contacts))
     nq = model.nq
     mu = options.friction
@@ -414,7 +413,7 @@ def _step_share(share: Callable[[Any], Any]) -> Callable[[Any], Any]:
     return lambda p: share(p) * p[_L] / p[_V]
 
 
-def _periodic_controls(model: RobotModel, symmetry: Symmetry, seq: ContactSequence,
+def _periodic_controls(model: RobotModel, symmetry: LegSwap, seq: ContactSequence,
                        actuators_of: Mapping[str, Sequence[str]]) -> ControlLinkage:
     """``u_first(0)[a] = u_last(T)[swap(a)]`` for every actuator ``a`` of the first phase
     whose swapped counterpart acts at the end of the last phase."""

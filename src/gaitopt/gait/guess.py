@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from gaitopt.dynamics.actuation import actuation_matrix
 from gaitopt.dynamics.crba import crba
 from gaitopt.dynamics.kinematics import contact_jacobian
-from gaitopt.dynamics.reduced import checked_biped, leg_inverse_kinematics
+from gaitopt.dynamics.reduced import leg_inverse_kinematics
 from gaitopt.dynamics.rnea import bias_forces
 from gaitopt.gait import walking
 from gaitopt.gait.full_physics import actuator_names
@@ -31,7 +31,7 @@ from gaitopt.gait.full_physics import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp import Guess as OcpGuess
 from gaitopt.ocp import PhaseGuess as OcpPhaseGuess
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of, reduced_biped
 from gaitopt.robot.model import BASE_POSITION, RobotModel
 
 Array = NDArray[np.float64]
@@ -111,7 +111,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
     (the full-coordinate formulation; joints other than the legs' stay at 0), else the reduced
     states of :mod:`gaitopt.gait.walking`."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
-    legs = (biped_structure(model) if full else checked_biped(model)).legs
+    legs = (biped_of(model) if full else reduced_biped(model)).legs
     v, step, f = speed, step_length, single_support_fraction
     total = step / v
     t1, t2 = f * total, (1.0 - f) * total
@@ -172,7 +172,7 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
     (``xb = -0.6 L``, ``yb = 0.1 m``: the swap of legs maps tip 1's end onto tip 2's start),
     both on smooth arcs; torques by least squares as for the walk."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
-    legs = biped_structure(model).legs
+    legs = biped_of(model).legs
     v, step, f = speed, step_length, stance_fraction
     total = step / v
     t1 = f * total

@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from gaitopt.robot.biped import BipedStructure
+from gaitopt.robot.biped import Biped
 from gaitopt.units import format_speed
 
 Transcription = Literal["hermite-simpson", "hermite-simpson-separated", "trapezoidal"]
@@ -272,7 +272,7 @@ def _bounds(name: str, value: Any, *, positive: bool = False) -> tuple[float, fl
     return lo, hi
 
 
-def validate_options(options: GaitOptions, biped: BipedStructure | None) -> None:
+def validate_options(options: GaitOptions, biped: Biped | None) -> None:
     """Check every option before any solve; raise :class:`GaitOptionsError` naming the field,
     the bad value and the allowed range. ``biped``: the legs, for the reach checks (None for a
     model without thigh-shank legs in the full formulation: no reach check)."""

@@ -25,7 +25,6 @@ import casadi as ca
 import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
-from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import cost, walking
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE
@@ -41,6 +40,7 @@ from gaitopt.ocp.problem import (
     Problem,
 )
 from gaitopt.ocp.transcription import Transcription
+from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
@@ -165,7 +165,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
 
     Call :func:`gaitopt.gait.options.validate_options` first.
     """
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     stance, swing = legs
     f = options.single_support_fraction
     two_phases = options.double_support
@@ -384,7 +384,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
 def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition,
                  magnitude: Any) -> Any:
     """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
-    lifting = checked_biped(model).legs[0].contact
+    lifting = reduced_biped(model).stance.contact
     from gaitopt.dynamics.kinematics import contact_velocity
 
     v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
@@ -393,7 +393,7 @@ def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition
 
 def relabel_actuator(model: RobotModel, name: str) -> str | None:
     """The actuator of the other leg in the same role (hip_1 <-> hip_2, ...), or None."""
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     for i, leg in enumerate(legs):
         other = legs[1 - i]
         for mine, theirs in ((leg.hip_actuator, other.hip_actuator),

@@ -61,8 +61,7 @@ from typing import Any
 import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
-from gaitopt.gait.formulation import biped_of, checked_sequence, contact_sequence, stage_bounds
-from gaitopt.gait.full_physics import model_symmetry
+from gaitopt.gait.formulation import biped_for, checked_sequence, contact_sequence, stage_bounds
 from gaitopt.gait.guess import (
     default_running_step,
     default_step_length,
@@ -110,6 +109,7 @@ from gaitopt.gait.transcriptions import (
 from gaitopt.ocp import Guess, Result, WarmStart, refined_mesh
 from gaitopt.ocp.mesh import split_intervals
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 
 #: The control model of the cold stages (from the naive guess) and of the continuation in
 #: speed: the paper's, whatever the requested one (see the module docstring).
@@ -192,7 +192,7 @@ class _Run:
         """The converged results of :meth:`cold`'s naive guesses: the first one, or with
         ``every_start`` all of them."""
         o, coarse = self.options, coarse_knots(self.options)
-        biped = biped_of(self.model, o)
+        biped = biped_for(self.model, o)
         generic = biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
         r_max = (0.0 if biped is None else
                  min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
@@ -215,7 +215,7 @@ class _Run:
                     from gaitopt.gait.sequence_guess import sequence_guess
 
                     guess = sequence_guess(self.model, contact_sequence(self.model, o),
-                                           model_symmetry(self.model).contacts, speed=speed,
+                                           leg_swap(self.model).contacts, speed=speed,
                                            step_length=step0, knots=coarse, ankle=o.ankle,
                                            ankle_torques=False)
                 elif o.gait == "run":
@@ -453,7 +453,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         GaitOptionsError: invalid options, or a step so long that no naive start can place
             the legs (nothing was solved; the message says what to change).
     """
-    validate_options(options, biped_of(model, options))
+    validate_options(options, biped_for(model, options))
     checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()

@@ -51,7 +51,7 @@ from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import Formulation, GaitOptions
-from gaitopt.robot.biped import BipedStructureError
+from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.executors import Backend
 from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH
@@ -215,13 +215,7 @@ class CostStudySpec:
         """``reduced`` or ``full`` for ``model`` (see the module docstring)."""
         if self.formulation != "auto":
             return self.formulation
-        from gaitopt.dynamics.reduced import checked_biped
-
-        try:
-            checked_biped(model)
-        except BipedStructureError:
-            return "full"
-        return "reduced"
+        return "reduced" if has_reduced_shape(model) else "full"
 
     def gait_of(self, model: RobotModel) -> str:
         """``walk`` or ``heel-toe`` for ``model``: with ``gait="auto"``, ``heel-toe`` when the

@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.formulation import biped_of
+from gaitopt.gait.formulation import biped_for
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptionsError, validate_options
 from gaitopt.ocp import Result
@@ -273,7 +273,7 @@ def check_points(spec: SweepSpec) -> None:
     for point in spec.points:
         options = spec.options(point)  # the legs as the point's formulation sees them
         try:
-            validate_options(options, biped_of(spec.model, options))
+            validate_options(options, biped_for(spec.model, options))
         except GaitOptionsError as exc:
             raise SweepSpecError(f"{point.label().strip()}: {exc}") from None
 
