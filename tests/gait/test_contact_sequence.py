@@ -6,12 +6,11 @@ import numpy as np
 import pytest
 
 from gaitopt.dynamics.kinematics import contact_position
+from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequenceError,
     check_sequence,
-    heel_toe_sequence,
     sequence_from_dict,
-    walking_sequence,
 )
 from gaitopt.gait.formulation import checked_sequence, default_formulation
 from gaitopt.gait.full_physics import per_point, projection_names

@@ -14,12 +14,11 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
+from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequenceError,
     check_sequence,
-    heel_toe_sequence,
     sequence_from_dict,
-    walking_sequence,
 )
 from gaitopt.gait.formulation import checked_sequence, contact_sequence, problem_for
 from gaitopt.gait.gait_file import Gait

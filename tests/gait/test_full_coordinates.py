@@ -11,13 +11,12 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
+from gaitopt.gait.builtin_sequences import running_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequence,
     ContactSequenceError,
     PhaseSpec,
     check_sequence,
-    running_sequence,
-    walking_sequence,
 )
 from gaitopt.gait.full_physics import state_names
 from gaitopt.gait.gait_file import Gait

@@ -10,14 +10,12 @@ asks this module for the legs, the problem and the bounds of a stage; everything
 from __future__ import annotations
 
 from gaitopt.gait import full_coordinates as full
+from gaitopt.gait.builtin_sequences import heel_toe_sequence, running_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequence,
     ContactSequenceError,
     check_sequence,
-    heel_toe_sequence,
-    running_sequence,
     sequence_from_dict,
-    walking_sequence,
 )
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.phase_fractions import with_first_fraction_bounds, with_free_fractions

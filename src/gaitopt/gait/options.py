@@ -117,7 +117,7 @@ class GaitOptions:
             ``single_support_fraction`` of the step, then flight; full formulation only, no
             liftoff impulse) or ``"heel-toe"`` (feet with heel and toe points: foot flat,
             heel off, double support, heel rocker; full formulation; see
-            :func:`gaitopt.gait.contact_sequence.heel_toe_sequence`).
+            :func:`gaitopt.gait.builtin_sequences.heel_toe_sequence`).
         contact_sequence: a contact sequence as plain data (the gait file's
             ``contact_sequence``; :func:`gaitopt.gait.contact_sequence.sequence_from_dict`),
             which replaces ``gait``; full formulation only. A phase fraction is a number
