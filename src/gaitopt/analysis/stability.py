@@ -1,5 +1,9 @@
 """Orbital stability of a gait: the Floquet multipliers of its step-to-step return map.
 
+(One concept, kept whole at about 410 lines: from a gait to its step, the section, the
+multipliers and the report are one analysis; the simulation itself is in
+:mod:`.return_map`.)
+
 ``gait_stability(gait)`` builds the return map of one step (:mod:`.return_map`: the gait's
 own torques replayed open loop, optionally with joint-space PD tracking), takes its Jacobian
 (the monodromy, ``(2 nq, 2 nq)`` in full coordinates ``y = [q; qd]``) at the gait's start state

@@ -1,5 +1,8 @@
 """The walking problem in full coordinates: the whole tree's ``q, qd`` on a contact sequence.
 
+(One concept, kept whole at about 470 lines: :func:`full_problem` states the whole OCP, every
+constraint block beside the others it must agree with; most helpers serve it alone.)
+
 Beside the paper's reduced formulation (:mod:`gaitopt.gait.problem`: polar hip coordinates and
 leg inverse kinematics, singular at a straight knee, five-link bipeds only), this formulation
 works for any planar tree with contact points and any :class:`ContactSequence`:

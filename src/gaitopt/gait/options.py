@@ -1,5 +1,8 @@
 """Options of the walking problem: the variant, the targets and every bound, validated.
 
+(One concept, kept whole at about 430 lines: the options and the check of each; a third of
+the length is the documentation of the fields.)
+
 Defaults follow the paper's problem (ankle torques and the liftoff impulse on, single support
 85 % of the step, the speed given at 12 m/min, the paper's globally optimal speed, and the step
 length free) on a grid whose cost is converged to well within 1 %: 16 + 6 knots with the

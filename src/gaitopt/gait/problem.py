@@ -1,5 +1,8 @@
 """The paper's minimum-energy walking problem stated on the generic OCP engine.
 
+(One concept, kept whole at about 450 lines: :func:`walking_problem` states the whole OCP of
+the reduced formulation with its stage bounds; the helpers serve it alone.)
+
 Decision parameters ``p = [step_length L, speed v, impulse P]``; phase durations are
 expressions of them: ``T1 = f L / v`` (single support) and ``T2 = (1 - f) L / v`` (double
 support), ``f`` the single-support fraction. The objective is the paper's eq. 5::
