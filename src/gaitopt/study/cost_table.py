@@ -22,7 +22,7 @@ from pathlib import Path
 
 from gaitopt.fileio import write_text_atomic
 from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH
-from gaitopt.study.summary import csv_text
+from gaitopt.study.summary import csv_cells, csv_text
 
 COST_TABLE_FILE = "costs.csv"
 COST_COLUMNS: tuple[str, ...] = (
@@ -70,16 +70,7 @@ class CostRow:
                            if self.success else math.nan)
 
     def as_csv_dict(self) -> dict[str, str]:
-        out = {}
-        for col in COST_COLUMNS:
-            value = getattr(self, col)
-            if isinstance(value, bool):
-                out[col] = "true" if value else "false"
-            elif isinstance(value, float):
-                out[col] = "" if math.isnan(value) else repr(value)
-            else:
-                out[col] = str(value)
-        return out
+        return csv_cells(self, COST_COLUMNS)
 
 
 def cost_table_csv(rows: Sequence[CostRow]) -> str:
