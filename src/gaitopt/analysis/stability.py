@@ -54,6 +54,7 @@ from gaitopt.dynamics.crba import crba
 from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.rnea import gravity_forces
 from gaitopt.gait.gait_file import Gait
+from gaitopt.robot.model import BASE_POSITION
 from gaitopt.robot.symmetry import swap_permutations
 
 Array = NDArray[np.float64]
@@ -221,7 +222,7 @@ def project_to_section(spec: StepSpec, y: Array) -> Array:
     nq = spec.nq
     y = np.array(y, dtype=float)
     pv, _ = section_constraints(spec, y)
-    y[:2] -= pv[:2]
+    y[BASE_POSITION] -= pv[:2]  # the base moves by the stance tip's (x, y)
     jac = np.asarray(contact_jacobian(spec.model, y[:nq], [spec.stance]), dtype=float)
     y[nq:] -= np.linalg.pinv(jac) @ (jac @ y[nq:])
     return y
