@@ -14,9 +14,9 @@ from gaitopt.cli.report import sweep_dirs
 from gaitopt.cli.study import parse_speeds, parse_variants
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
-from gaitopt.study.driver import prepare_directory
 from gaitopt.study.plan import SweepSpec
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, read_summary
+from gaitopt.study.sweep_directory import prepare_directory
 from tests.viz.synthetic import synthetic_gait, synthetic_sweep
 
 

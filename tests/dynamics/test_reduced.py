@@ -13,7 +13,6 @@ from gaitopt.dynamics.contact import contact_dynamics
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.dynamics.reduced import (
     ReachError,
-    checked_biped,
     double_support_coordinates,
     double_support_dynamics,
     double_support_state,
@@ -23,10 +22,10 @@ from gaitopt.dynamics.reduced import (
     single_support_state,
 )
 from gaitopt.robot import load_model, model_from_dict
-from gaitopt.robot.biped import BipedStructureError, biped_structure
+from gaitopt.robot.biped import BipedStructureError, biped_of, reduced_biped
 
 MODEL = load_model("five-link")
-LEGS = biped_structure(MODEL).legs
+LEGS = biped_of(MODEL).legs
 FRONT = (0.25, 0.0)
 
 
@@ -173,22 +172,22 @@ def test_a_model_without_two_legs_is_rejected_by_name() -> None:
     data["contacts"] = data["contacts"][:1]
     data["actuators"] = [a for a in data["actuators"] if a.get("contact") != "tip_2"]
     with pytest.raises(BipedStructureError, match="exactly two contact points"):
-        biped_structure(model_from_dict(data))
+        biped_of(model_from_dict(data))
 
 
-def test_the_biped_structure_is_built_once_per_model() -> None:
+def test_the_biped_is_built_once_per_model() -> None:
     """Equal (immutable) models share one structure; a model that is no biped is refused at
     every request, not cached as a success."""
     five = load_model("five-link")
-    assert biped_structure(five) is biped_structure(load_model("five-link"))
-    assert checked_biped(five) is checked_biped(model_from_dict(five.to_dict()))
+    assert biped_of(five) is biped_of(load_model("five-link"))
+    assert reduced_biped(five) is reduced_biped(model_from_dict(five.to_dict()))
     data = five.to_dict()
     data["contacts"] = data["contacts"][:1]
     data["actuators"] = [a for a in data["actuators"] if a.get("contact") != "tip_2"]
     one_leg = model_from_dict(data)
     for _ in range(2):
         with pytest.raises(BipedStructureError, match="exactly two contact points"):
-            biped_structure(one_leg)
+            biped_of(one_leg)
 
 
 def test_the_base_coordinates_are_named_and_indexed_once() -> None:

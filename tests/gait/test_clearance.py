@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from gaitopt.gait import walking
 from gaitopt.gait.options import GaitOptions
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of
 from tests.gait.conftest import Reference, Solved, SolveFn
 
 C = 0.02
@@ -35,7 +35,7 @@ def cleared(solved: SolveFn) -> Solved:
 
 
 def swing_heights(ref: Reference, qs: NDArray[np.float64]) -> NDArray[np.float64]:
-    swing = biped_structure(ref.model).legs[1].contact
+    swing = biped_of(ref.model).legs[1].contact
     zero = np.zeros(ref.model.nq)
     return np.array([ref.tip_kinematics(q, zero, zero, swing)[0][1] for q in qs])
 

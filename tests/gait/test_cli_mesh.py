@@ -13,7 +13,7 @@ from gaitopt.cli import cli
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import load_model
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of
 
 
 @pytest.mark.parametrize(("args", "field", "allowed"), [
@@ -37,11 +37,11 @@ def test_an_unknown_control_model_is_refused() -> None:
     assert result.exit_code == 2 and "smooth" in result.output
     with pytest.raises(GaitOptionsError, match=r"control_model = 'smooth': must be one of"):
         validate_options(GaitOptions.paper(control_model="smooth"),  # type: ignore[arg-type]
-                         biped_structure(load_model("five-link")))
+                         biped_of(load_model("five-link")))
     with pytest.raises(GaitOptionsError, match=r"clearance_profile = 'sine'"):
         validate_options(GaitOptions.paper(swing_clearance=0.01,
                                      clearance_profile="sine"),  # type: ignore[arg-type]
-                         biped_structure(load_model("five-link")))
+                         biped_of(load_model("five-link")))
 
 
 def test_the_options_reach_the_gait_file_and_the_summary(tmp_path: Path) -> None:

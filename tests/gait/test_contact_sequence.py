@@ -6,19 +6,19 @@ import numpy as np
 import pytest
 
 from gaitopt.dynamics.kinematics import contact_position
+from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequenceError,
     check_sequence,
-    heel_toe_sequence,
     sequence_from_dict,
-    walking_sequence,
 )
 from gaitopt.gait.formulation import checked_sequence, default_formulation
-from gaitopt.gait.full_physics import model_symmetry, per_point, projection_names
+from gaitopt.gait.full_physics import per_point, projection_names
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.robot.loader import load_model
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 
 PAPER = {
     "name": "my-walk",
@@ -41,7 +41,7 @@ def five() -> RobotModel:
 
 
 def swap(model: RobotModel) -> dict[str, str]:
-    return dict(model_symmetry(model).contacts)
+    return dict(leg_swap(model).contacts)
 
 
 def test_data_round_trip_equals_the_built_in_walk(five: RobotModel) -> None:

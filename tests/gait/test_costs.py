@@ -14,7 +14,7 @@ from gaitopt.gait import cost
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import load_model
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of
 from tests.gait.conftest import Solved
 
 SolveFn = Callable[..., Solved]
@@ -88,6 +88,6 @@ def test_metabolic_cost_changes_by_the_resting_energy(solved: SolveFn) -> None:
     ({"cost_regularization": -0.1}, "cost_regularization = -0.1: must be >= 0"),
 ])
 def test_bad_cost_options_name_the_field(changes: dict[str, object], message: str) -> None:
-    legs = biped_structure(load_model("five-link"))
+    legs = biped_of(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match=message):
         validate_options(GaitOptions.paper().replace(**changes), legs)

@@ -14,15 +14,13 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
+from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequenceError,
     check_sequence,
-    heel_toe_sequence,
     sequence_from_dict,
-    walking_sequence,
 )
 from gaitopt.gait.formulation import checked_sequence, contact_sequence, problem_for
-from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.phase_fractions import (
@@ -35,6 +33,7 @@ from gaitopt.gait.phase_fractions import (
 )
 from gaitopt.robot.loader import load_model
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 from tests.gait.conftest import Solved
 
 SolveFn = Callable[..., Solved]
@@ -66,7 +65,7 @@ def seven() -> RobotModel:
 
 
 def _swap(model: RobotModel) -> dict[str, str]:
-    return dict(model_symmetry(model).contacts)
+    return dict(leg_swap(model).contacts)
 
 
 # -- the data form ------------------------------------------------------------------------------

@@ -11,20 +11,20 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
+from gaitopt.gait.builtin_sequences import running_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequence,
     ContactSequenceError,
     PhaseSpec,
     check_sequence,
-    running_sequence,
-    walking_sequence,
 )
-from gaitopt.gait.full_physics import model_symmetry, state_names
+from gaitopt.gait.full_physics import state_names
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import load_model, model_from_dict
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 from tests.gait.conftest import (
     Reference,
     Solved,
@@ -167,7 +167,7 @@ def test_warm_start_from_a_full_gait_file(solved: SolveFn, tmp_path) -> None:  #
 
 def test_contact_sequences_are_one_mechanism() -> None:
     model = load_model("five-link")
-    swap = dict(model_symmetry(model).contacts)
+    swap = dict(leg_swap(model).contacts)
     for seq in (walking_sequence(model, 0.85, impulse=True),
                 walking_sequence(model, 1.0, impulse=False), running_sequence(model, 0.4)):
         check_sequence(model, seq, swap)  # consistent: each event leads into the next phase
@@ -186,7 +186,7 @@ def test_contact_sequences_are_one_mechanism() -> None:
 
 
 def test_option_errors_name_the_formulation() -> None:
-    legs = biped_structure(load_model("five-link"))
+    legs = biped_of(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match="formulation 'full' allows 0"):
         validate_options(GaitOptions.paper(min_stance_knee_flexion=0.0), legs)
     with pytest.raises(GaitOptionsError, match="formulation = 'polar': must be one of"):
@@ -245,6 +245,6 @@ def test_a_free_single_support_fraction(solved: SolveFn) -> None:
      "single_support_fraction = 0.85: must lie in single_support_fraction_bounds"),
 ])
 def test_free_fraction_errors(changes: dict[str, object], message: str) -> None:
-    legs = biped_structure(load_model("five-link"))
+    legs = biped_of(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match=message):
         validate_options(GaitOptions.paper().replace(**changes), legs)

@@ -15,12 +15,12 @@ import yaml
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.formulation import biped_of, contact_sequence
-from gaitopt.gait.full_physics import model_symmetry
+from gaitopt.gait.formulation import biped_for, contact_sequence
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.robot import load_model, model_from_dict
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 from tests.gait.conftest import (
     Reference,
     Solved,
@@ -45,11 +45,11 @@ def test_the_model_has_no_knees_and_takes_the_generic_guess(compass: RobotModel)
     and puts tip 2 one step ahead at the heel strike."""
     assert compass.nq == 5 and [a.name for a in compass.actuators] == ["hip_1", "hip_2"]
     options = GaitOptions(formulation="full")
-    assert biped_of(compass, options) is None
-    assert dict(model_symmetry(compass).contacts) == {"tip_1": "tip_2", "tip_2": "tip_1"}
+    assert biped_for(compass, options) is None
+    assert dict(leg_swap(compass).contacts) == {"tip_1": "tip_2", "tip_2": "tip_1"}
     step = 0.25
     guess = sequence_guess(compass, contact_sequence(compass, options),
-                           model_symmetry(compass).contacts, speed=0.2, step_length=step,
+                           leg_swap(compass).contacts, speed=0.2, step_length=step,
                            knots=(8, 5), ankle=True)
     single = guess.phases[0]
     for x in single.x:

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.solve import solve_walking
 from gaitopt.gait.transcriptions import cosine_knots, target_grid
 from gaitopt.robot import load_model
+from gaitopt.robot.biped import reduced_biped
 
 
 def test_cosine_knots_cluster_at_both_ends() -> None:
@@ -42,7 +42,7 @@ def test_a_bad_spacing_names_the_field() -> None:
     with pytest.raises(GaitOptionsError, match="knot_spacing = 'chebyshev': must be one of "
                                                "'uniform', 'cosine'"):
         validate_options(GaitOptions(knot_spacing="chebyshev"),  # type: ignore[arg-type]
-                         checked_biped(model))
+                         reduced_biped(model))
 
 
 @pytest.mark.slow

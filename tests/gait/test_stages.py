@@ -10,7 +10,14 @@ import pytest
 
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, parameter_bounds
-from gaitopt.gait.stages import ANKLES, RELEASES, held_bounds
+from gaitopt.gait.stages import (
+    ANKLES,
+    COARSE_COMPLETION,
+    COLD_CONTROL_MODEL,
+    CONTROL_MODEL_STAGE,
+    RELEASES,
+    held_bounds,
+)
 from gaitopt.gait.transcriptions import BOUNDS_ONLY_OPTIONS, NlpStructure
 from gaitopt.robot import load_model
 
@@ -75,3 +82,21 @@ def test_the_structure_key_changes_with_every_field_but_the_bounds_only_ones() -
             assert changed != key, name
     assert NlpStructure.of(model, base, (16, 6), None) != key
     assert NlpStructure.of(model, base, (8, 5), "codegen") != key
+
+
+@pytest.mark.parametrize(("options", "names"), [
+    (GaitOptions(), ["control model jumps", "ankle torques free", "liftoff impulse free"]),
+    (GaitOptions.paper(), ["ankle torques free", "liftoff impulse free"]),
+    (GaitOptions(speed=None, ankle=False, impulse=False), ["control model jumps", "speed free"]),
+])
+def test_the_coarse_completion_switches_control_model_first(options: GaitOptions,
+                                                            names: list[str]) -> None:
+    """After the contact stages (always the paper's control model) the coarse solution is
+    solved again in the requested control model, from its values only, before anything is
+    freed; that stage frees nothing, so it holds what every release frees."""
+    stages = [spec for spec in COARSE_COMPLETION if spec.runs(options)]
+    assert [spec.title(options) for spec in stages] == names
+    assert (CONTROL_MODEL_STAGE, *RELEASES) == COARSE_COMPLETION
+    assert CONTROL_MODEL_STAGE.frees is None and CONTROL_MODEL_STAGE.values_only
+    assert not any(spec.values_only for spec in RELEASES)
+    assert CONTROL_MODEL_STAGE.runs(options) == (options.control_model != COLD_CONTROL_MODEL)

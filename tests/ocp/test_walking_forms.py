@@ -30,7 +30,7 @@ from gaitopt.gait.solve import (
 )
 from gaitopt.ocp import transcribe
 from gaitopt.robot import load_model
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of
 
 SEPARATED = "hermite-simpson-separated"
 MODEL = load_model("five-link")
@@ -46,7 +46,7 @@ def walk(knots: tuple[int, int], form: str, **changes: object) -> WalkingSolutio
 
 
 def test_options_and_cli_accept_the_separated_form_and_name_the_choices() -> None:
-    biped = biped_structure(MODEL)
+    biped = biped_of(MODEL)
     validate_options(GaitOptions.paper(transcription=SEPARATED), biped)
     with pytest.raises(GaitOptionsError, match="transcription = 'simpson'.*"
                                                "'hermite-simpson-separated'"):

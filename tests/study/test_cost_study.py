@@ -21,17 +21,19 @@ from gaitopt.robot.loader import model_from_dict
 from gaitopt.study.cost_findings import COST_FINDING_IDS, assess_cost_findings, ranked
 from gaitopt.study.cost_study import (
     COST_STUDY_FILE,
-    COST_TABLE_FILE,
     DIRECT_FILE,
     CostCase,
-    CostRow,
     CostStudyError,
     CostStudySpec,
     collect_rows,
+    write_settings,
+)
+from gaitopt.study.cost_table import (
+    COST_TABLE_FILE,
+    CostRow,
     human_distance,
     read_cost_table,
     write_cost_table,
-    write_settings,
 )
 from gaitopt.study.plan import START_SPEED
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, write_summary

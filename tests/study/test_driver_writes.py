@@ -9,10 +9,11 @@ from typing import Any
 
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
-from gaitopt.study.driver import prepare_directory, run_sweep
+from gaitopt.study.driver import run_sweep
 from gaitopt.study.executors import Backend, InlineExecutor
 from gaitopt.study.plan import SweepPoint, SweepSpec
 from gaitopt.study.summary import SUMMARY_FILE, read_summary, summary_row, variant_flags
+from gaitopt.study.sweep_directory import prepare_directory
 from gaitopt.study.worker import PointOutcome, PointTask
 from tests.viz.synthetic import synthetic_gait
 

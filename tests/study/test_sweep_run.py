@@ -14,15 +14,10 @@ import pytest
 
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
-from gaitopt.study.driver import (
-    SweepReport,
-    SweepSettingsError,
-    directory_lock,
-    run_sweep,
-    scan_directory,
-)
+from gaitopt.study.driver import SweepReport, run_sweep
 from gaitopt.study.plan import SETTINGS_FILE, SweepSpec
 from gaitopt.study.summary import SUMMARY_FILE, read_summary
+from gaitopt.study.sweep_directory import SweepSettingsError, directory_lock, scan_directory
 
 MODEL = load_model("five-link")
 K9, K12, K15 = (f"gaits/plain/speed-{v:06.2f}m_min.gait.json" for v in (9, 12, 15))

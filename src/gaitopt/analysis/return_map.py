@@ -1,5 +1,9 @@
 """The return map of one step, simulated open loop in full coordinates, and its Jacobian.
 
+(One concept, kept whole at about 540 lines: the step's description, its compiled CasADi
+functions and the integration across events with the variational equations are one
+simulation; the parts are not used apart.)
+
 The Poincare section is the start of single support (just after the liftoff): the stance tip
 is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it, one step is
 

@@ -1,5 +1,9 @@
 """Orbital stability of a gait: the Floquet multipliers of its step-to-step return map.
 
+(One concept, kept whole at about 490 lines: from a gait (or its contact sequence) to its
+step, the section, the multipliers and the report are one analysis; the simulation itself is
+in :mod:`.return_map`.)
+
 ``gait_stability(gait)`` builds the return map of one step (:mod:`.return_map`: the gait's
 own torques replayed open loop, optionally with joint-space PD tracking), takes its Jacobian
 (the monodromy, ``(2 nq, 2 nq)`` in full coordinates ``y = [q; qd]``) at the gait's start state
@@ -52,7 +56,8 @@ from gaitopt.dynamics.rnea import gravity_forces
 from gaitopt.dynamics.tree import holds
 from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
 from gaitopt.gait.gait_file import Gait
-from gaitopt.robot.symmetry import swap_maps, swap_permutations
+from gaitopt.robot.model import BASE_POSITION
+from gaitopt.robot.symmetry import leg_swap, swap_permutations
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -214,7 +219,7 @@ def _step_from_sequence(gait: Gait, pd: tuple[float, float] | None, rtol: float)
     except ContactSequenceError as exc:
         raise StabilityError(f"contact_sequence: {exc}") from None
     model = gait.model
-    swap = swap_maps(model)[1]
+    swap = leg_swap(model).contacts
     phases = gait.phases
     if len(phases) != len(seq.phases):
         raise StabilityError(f"contact_sequence: {len(seq.phases)} phases, but the gait has "
@@ -282,7 +287,9 @@ def project_to_section(spec: StepSpec, y: Array) -> Array:
     along the normal only keeps its height: the shift is along the base's x, y)."""
     nq = spec.nq
     y = np.array(y, dtype=float)
-    y[:2] -= np.asarray(contact_position(spec.model, y[:nq], spec.stance), float).ravel()
+    # the base moves by the stance point's (x, y)
+    y[BASE_POSITION] -= np.asarray(contact_position(spec.model, y[:nq], spec.stance),
+                                   float).ravel()
     jac = np.asarray(contact_jacobian(spec.model, y[:nq], list(spec.holds)), dtype=float)
     y[nq:] -= np.linalg.pinv(jac) @ (jac @ y[nq:])
     return y

@@ -29,7 +29,7 @@ from gaitopt.cli.base import (
     resting_power_option,
 )
 from gaitopt.gait.contact_sequence import ContactSequence
-from gaitopt.gait.formulation import biped_of, checked_sequence, default_formulation
+from gaitopt.gait.formulation import biped_for, checked_sequence, default_formulation
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import (
     GAITS,
@@ -233,7 +233,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     try:
-        validate_options(options, biped_of(model, options))
+        validate_options(options, biped_for(model, options))
         sequence_used = checked_sequence(model, options)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None

@@ -83,7 +83,7 @@ def report_command(directory: Path, output: Path | None, compare: tuple[Path, ..
 def write_cost_reports(console: Console, directory: Path, out: Path) -> Path:
     """Write a cost study's report from its ``costs.csv``; print the answer and findings."""
     from gaitopt.study.cost_findings import cost_findings_text
-    from gaitopt.study.cost_study import COST_TABLE_FILE, CostStudyError, read_cost_table
+    from gaitopt.study.cost_table import COST_TABLE_FILE, CostStudyError, read_cost_table
     from gaitopt.viz.cost_report import answer_text, write_cost_report
 
     try:

@@ -8,24 +8,15 @@ See docs/studies.md.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import click
 from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
 
 from gaitopt.cli.base import (
     UserError,
@@ -39,23 +30,17 @@ from gaitopt.cli.base import (
     min_knee_flexion_option,
     model_option,
     paper_grid_option,
-    parse_free_or_value,
     parse_knots,
     resting_power_option,
 )
 from gaitopt.cli.report import animate_file, write_reports
+from gaitopt.cli.sweep_grid import make_spec, parse_speeds, parse_variants
+from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.gait.formulation import default_formulation
-from gaitopt.gait.options import GAITS, KNOT_SPACINGS, GaitOptions, GaitOptionsError
+from gaitopt.gait.options import GAITS, KNOT_SPACINGS
 from gaitopt.robot.biped import BipedStructureError
-from gaitopt.study.driver import (
-    Counts,
-    SweepReport,
-    SweepSettingsError,
-    SweepStart,
-    default_workers,
-    run_sweep,
-)
-from gaitopt.study.executors import Backend, BackendError
+from gaitopt.study.driver import default_workers
+from gaitopt.study.executors import BackendError
 from gaitopt.study.grid_error import (
     CHECK_DIR,
     REFINE_DIR,
@@ -64,7 +49,7 @@ from gaitopt.study.grid_error import (
     check_knots,
     grid_error,
 )
-from gaitopt.study.plan import START_SPEED, SweepPoint, SweepSpec, SweepSpecError
+from gaitopt.study.plan import START_SPEED, SweepSpecError
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 from gaitopt.study.worker import PointOutcome
 
@@ -76,192 +61,6 @@ STUDY_DIR = Path("out/study")
 #: Default directory and resting powers (W/kg) of ``gaitopt study --costs``.
 COSTS_DIR = Path("out/costs")
 DEFAULT_RESTING_POWERS_TEXT = "0,0.6,1.2,2.4,4.8"
-MAX_SPEEDS = 2000
-
-
-# -- parsing the grid -----------------------------------------------------------------------------
-
-def parse_speeds(text: str) -> tuple[float, ...]:
-    """Speeds in m/s from m/min text: ``3:60:3`` (start:stop:step, stop included), a list
-    ``3,6,12.5`` or both (``3:30:3,45,60``); sorted, duplicates removed."""
-    values: list[float] = []
-    for item in text.replace("m/min", "").split(","):
-        item = item.strip()
-        if not item:
-            continue
-        parts = item.split(":")
-        try:
-            numbers = [float(p) for p in parts]
-        except ValueError:
-            raise UserError(f"--speeds: {item!r} is not a speed in m/min or a range "
-                            "start:stop:step (m/min), e.g. 3:60:3 or 3,12,60") from None
-        if not all(math.isfinite(x) for x in numbers):
-            raise UserError(f"--speeds: {item!r}: speeds must be finite")
-        if len(numbers) == 1:
-            values.append(numbers[0])
-        elif len(numbers) == 3:
-            start, stop, step = numbers
-            if step <= 0 or stop < start:
-                raise UserError(f"--speeds: range {item!r} needs start <= stop and step > 0 "
-                                "(start:stop:step in m/min, stop included)")
-            n = math.floor((stop - start) / step + 1e-9) + 1
-            if n > MAX_SPEEDS:
-                raise UserError(f"--speeds: range {item!r} has {n} speeds; at most "
-                                f"{MAX_SPEEDS}")
-            values.extend(round(start + i * step, 9) for i in range(n))
-        else:
-            raise UserError(f"--speeds: {item!r} must be a speed or start:stop:step (m/min)")
-    if not values:
-        raise UserError("--speeds: no speed given (e.g. 3:60:3)")
-    bad = [v for v in values if v <= 0]
-    if bad:
-        raise UserError(f"--speeds: speeds must be > 0 m/min, got {bad[0]:g}")
-    unique = sorted(set(values))
-    if len(unique) > MAX_SPEEDS:
-        raise UserError(f"--speeds: {len(unique)} speeds; at most {MAX_SPEEDS}")
-    return tuple(v / 60.0 for v in unique)
-
-
-def parse_variants(text: str) -> tuple[str, ...]:
-    """``all`` or a comma list of variant names, returned in the canonical order."""
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    if names == ["all"]:
-        return VARIANTS
-    unknown = [n for n in names if n not in VARIANTS]
-    if unknown or not names:
-        raise UserError(f"--variants: unknown variant {unknown[0] if unknown else text!r}; use "
-                        f"'all' or a comma list of {', '.join(VARIANTS)}")
-    return tuple(v for v in VARIANTS if v in names)
-
-
-def parse_step_lengths(text: str, *, option: str = "--step-length", unit: str = "m",
-                       quantity: str = "length") -> tuple[float | None, ...]:
-    """``free`` or a comma list of step lengths in m (``free`` may be one of them); with
-    ``option="--step-time", unit="s", quantity="time"``, of step times in s."""
-    out: list[float | None] = []
-    for item in (i.strip() for i in text.split(",")):
-        value = parse_free_or_value(item, option, unit, quantity)
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise UserError(f"{option}: {item!r} must be > 0 {unit} (or 'free')")
-        out.append(value)
-    return tuple(dict.fromkeys(out))
-
-
-def parse_fractions(text: str) -> tuple[float, ...]:
-    """A comma list of single-support fractions in (0, 1]."""
-    out = []
-    for item in (i.strip() for i in text.split(",")):
-        try:
-            value = float(item)
-        except ValueError:
-            raise UserError(f"--single-support: {item!r} is not a number in (0, 1]") from None
-        if not 0.0 < value <= 1.0:
-            raise UserError(f"--single-support: {item!r} must lie in (0, 1]")
-        out.append(value)
-    return tuple(dict.fromkeys(out))
-
-
-def make_spec(*, model_name: str, speeds: str, variants: str, free: bool, step_length: str,
-              single_support: str, knots: str | None = None, step_time: str = "free",
-              problem: dict[str, Any] | None = None) -> SweepSpec:
-    """The sweep of the CLI's options; ``problem`` holds further :class:`GaitOptions` fields
-    shared by every point (formulation, cost, control model, ...); ``knots`` None keeps
-    the default grid (or ``problem``'s)."""
-    from gaitopt.gait.api import as_model
-
-    model = as_model(model_name)
-    try:
-        return SweepSpec(model=model, speeds=parse_speeds(speeds),
-                         variants=parse_variants(variants), free_speed=free,
-                         step_lengths=parse_step_lengths(step_length),
-                         step_times=parse_step_lengths(step_time, option="--step-time",
-                                                       unit="s", quantity="time"),
-                         single_support=parse_fractions(single_support),
-                         base=GaitOptions(**{**(problem or {}), **(
-                             {} if knots is None else {"knots": parse_knots(knots)})}))
-    except SweepSpecError as exc:
-        raise UserError(str(exc)) from None
-
-
-# -- running a sweep with a progress bar ------------------------------------------------------
-
-def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
-    """One line per finished point: variant, speed, cost, step length, status, iterations,
-    time, how it started."""
-    row = outcome.row
-    if point.speed is None:
-        speed = (f"free ({row.speed_m_min:5.2f})" if math.isfinite(row.speed_m_min)
-                 else "free")
-    else:
-        speed = f"{point.speed * 60:6.2f}"
-    extra = f" [{point.subdir}]" if point.subdir else ""
-    start = {"result": "warm", "file": "warm (file)", "none": "cold"}.get(outcome.warm,
-                                                                           outcome.warm)
-    if outcome.fell_back:
-        start += " -> cold"
-    head = f"{'ok  ' if row.success else 'FAIL'} {point.variant:<13}{extra} {speed:>13} m/min"
-    if row.success:
-        body = (f"cost {row.cost:9.3f}  step {row.step_length:.4f} m  {row.status}")
-    else:
-        body = row.status
-    return (f"{head}  {body}  it {outcome.iterations:4d}  {outcome.wall_time_s:5.2f} s  "
-            f"{start}")
-
-
-def run_with_progress(console: Console, spec: SweepSpec, directory: Path, *,
-                      workers: int | None, scheduler: str | None,
-                      fail_points: Sequence[str] = (),
-                      backend: Backend | None = None,
-                      seeds: Mapping[str, Path] | None = None) -> SweepReport:
-    """:func:`run_sweep` with a progress bar (done/failed/remaining, ETA) and a line per
-    finished point; errors the user can fix become :class:`UserError`. ``backend``: run on
-    it (and leave it open) instead of starting one; ``seeds``: warm starts of the chains'
-    first points (:func:`run_sweep`)."""
-    progress = Progress(
-        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-        TextColumn("failed {task.fields[failed]}  remaining {task.fields[remaining]}"),
-        TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
-        console=console, transient=False)
-    task_id: Any = None
-
-    def on_start(start: SweepStart) -> None:
-        nonlocal task_id
-        c = start.counts
-        console.print(f"sweep {start.directory}: {c.total} points, {c.kept} kept from an "
-                      f"earlier run, {c.to_solve} to solve on {start.backend}", soft_wrap=True)
-        for note in start.notes:
-            console.print(f"  note: {note}", soft_wrap=True)
-        if c.to_solve:
-            progress.start()
-            task_id = progress.add_task("solving", total=c.to_solve, failed=0,
-                                        remaining=c.to_solve)
-
-    def on_point(point: SweepPoint, outcome: PointOutcome, counts: Counts) -> None:
-        progress.console.print(point_line(point, outcome), soft_wrap=True)
-        progress.update(task_id, completed=counts.finished, failed=counts.failed,
-                        remaining=counts.remaining)
-
-    try:
-        report = run_sweep(spec, directory, workers=workers, scheduler=scheduler,
-                           on_start=on_start, on_point=on_point, fail_points=fail_points,
-                           backend=backend, seeds=seeds)
-    except (SweepSpecError, SweepSettingsError, BackendError, GaitOptionsError,
-            BipedStructureError) as exc:
-        raise UserError(str(exc)) from None
-    finally:
-        progress.stop()
-    c = report.counts
-    if report.interrupted:
-        console.print(f"interrupted after {c.finished} of {c.to_solve} points; every finished "
-                      "point is saved: rerun the same command to resume", soft_wrap=True)
-        sys.exit(130)
-    console.print(f"done in {report.wall_time_s:.1f} s: {c.succeeded} solved, {c.failed} "
-                  f"failed, {c.kept} kept ({c.total} points); summary: "
-                  + ", ".join(str(p) for p in report.summaries), soft_wrap=True)
-    if c.failed:
-        console.print("failed points are listed in the summary as failed; rerun the same "
-                      "command to try them again", soft_wrap=True)
-    return report
 
 
 def _spacing_option(default: str, help_: str) -> Any:
@@ -507,9 +306,9 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
         CostSweep,
         collect_rows,
         run_direct_solves,
-        write_cost_table,
         write_settings,
     )
+    from gaitopt.study.cost_table import write_cost_table
     from gaitopt.study.driver import make_backend
 
     start = time.perf_counter()

@@ -34,7 +34,6 @@ a leg's reach raises :class:`ReachError` instead of returning NaN.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -51,7 +50,7 @@ from gaitopt.dynamics.backend import (
     vector,
 )
 from gaitopt.dynamics.contact import contact_dynamics
-from gaitopt.robot.biped import BipedStructure, BipedStructureError, Leg, biped_structure
+from gaitopt.robot.biped import Leg, reduced_biped
 from gaitopt.robot.model import BASE_ANGLE, BASE_POSITION, BASE_X, BASE_Y, RobotModel
 
 #: Names of the independent coordinates, with ``{w}`` the swing leg's number.
@@ -92,18 +91,6 @@ class ReducedSolution:
     qd: Any
     qdd: Any
     forces: Any
-
-
-@functools.lru_cache(maxsize=64)
-def checked_biped(model: RobotModel) -> BipedStructure:
-    """The biped structure of ``model``; also requires no links beyond torso and legs.
-    Built once per model (:func:`~gaitopt.robot.biped.biped_structure`)."""
-    structure = biped_structure(model)
-    if model.nq != 7:
-        raise BipedStructureError(
-            f"model {model.name!r} has {len(model.links)} links; the reduced biped dynamics "
-            "need exactly a torso and two thigh-shank legs (5 links, 7 coordinates)")
-    return structure
 
 
 def hip_from_polar(p_tip: Sequence[Scalar], r: Scalar, alpha: Scalar, rd: Scalar,
@@ -179,7 +166,7 @@ def single_support_state(model: RobotModel, stance: int, z: Any, zd: Any,
                          p_stance: Sequence[float] = (0.0, 0.0)) -> tuple[Any, Any]:
     """Full ``(q, qd)`` from single-support coordinates ``z, zd`` (5,) on leg ``stance`` (0/1)
     whose tip is at ``p_stance`` (world, m)."""
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     r, alpha, torso, hip_w, knee_w = as_scalars(z, N_SINGLE, "z")
     rd, alphad, torso_rate, hip_w_rate, knee_w_rate = as_scalars(zd, N_SINGLE, "zd")
     p_hip, v_hip = hip_from_polar(p_stance, r, alpha, rd, alphad)
@@ -195,7 +182,7 @@ def double_support_state(model: RobotModel, stance: int, z: Any, zd: Any,
                          ) -> tuple[Any, Any]:
     """Full ``(q, qd)`` from double-support coordinates ``z, zd`` (3,): hip polar about the
     tip of leg ``stance`` at ``p_stance``, the other tip held at ``p_front`` (world, m)."""
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     r, alpha, torso = as_scalars(z, N_DOUBLE, "z")
     rd, alphad, torso_rate = as_scalars(zd, N_DOUBLE, "zd")
     p_hip, v_hip = hip_from_polar(p_stance, r, alpha, rd, alphad)
@@ -210,7 +197,7 @@ def double_support_state(model: RobotModel, stance: int, z: Any, zd: Any,
 def single_support_coordinates(model: RobotModel, stance: int, q: Any, qd: Any,
                                p_stance: Sequence[Scalar] = (0.0, 0.0)) -> tuple[Any, Any]:
     """Single-support coordinates ``(z, zd)`` of a full state (the inverse map)."""
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     qs = as_scalars(q, model.nq, "q")
     qds = as_scalars(qd, model.nq, "qd")
     r, alpha, rd, alphad = polar_from_hip(p_stance, qs[BASE_POSITION], qds[BASE_POSITION])
@@ -223,7 +210,7 @@ def single_support_coordinates(model: RobotModel, stance: int, q: Any, qd: Any,
 def double_support_coordinates(model: RobotModel, stance: int, q: Any, qd: Any,
                                p_stance: Sequence[Scalar] = (0.0, 0.0)) -> tuple[Any, Any]:
     """Double-support coordinates ``(z, zd)`` of a full state (the inverse map)."""
-    checked_biped(model)
+    reduced_biped(model)
     qs = as_scalars(q, model.nq, "q")
     qds = as_scalars(qd, model.nq, "qd")
     r, alpha, rd, alphad = polar_from_hip(p_stance, qs[BASE_POSITION], qds[BASE_POSITION])
@@ -247,7 +234,7 @@ def single_support_dynamics(model: RobotModel, stance: int, z: Any, zd: Any, tau
     ``gaitopt.dynamics.actuation``), with the stance tip held: step 2 of the algorithm solves
     the Contact Algorithm for ``qdd`` and the contact force, step 3 reads ``zdd`` off ``qdd``.
     """
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     q, qd = single_support_state(model, stance, z, zd, p_stance)
     sol = contact_dynamics(model, q, qd, tau, [legs[stance].contact])
     zs, zds = as_scalars(z, N_SINGLE, "z"), as_scalars(zd, N_SINGLE, "zd")
@@ -263,7 +250,7 @@ def double_support_dynamics(model: RobotModel, stance: int, z: Any, zd: Any, tau
                             ) -> ReducedSolution:
     """Reduced forward dynamics in double support (both tips held); forces are ordered
     ``[stance tip, front tip]``."""
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     q, qd = double_support_state(model, stance, z, zd, p_stance, p_front)
     sol = contact_dynamics(model, q, qd, tau, [legs[stance].contact, legs[1 - stance].contact])
     zs, zds = as_scalars(z, N_DOUBLE, "z"), as_scalars(zd, N_DOUBLE, "zd")

@@ -9,34 +9,37 @@ asks this module for the legs, the problem and the bounds of a stage; everything
 
 from __future__ import annotations
 
-from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import full_coordinates as full
+from gaitopt.gait.builtin_sequences import heel_toe_sequence, running_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     ContactSequence,
     ContactSequenceError,
     check_sequence,
-    heel_toe_sequence,
-    running_sequence,
     sequence_from_dict,
-    walking_sequence,
 )
-from gaitopt.gait.full_physics import model_symmetry
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.phase_fractions import with_first_fraction_bounds, with_free_fractions
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
-from gaitopt.robot.biped import BipedStructure, BipedStructureError, biped_structure
+from gaitopt.robot.biped import (
+    Biped,
+    BipedStructureError,
+    biped_of,
+    has_reduced_shape,
+    reduced_biped,
+)
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 
 
-def biped_of(model: RobotModel, options: GaitOptions) -> BipedStructure | None:
+def biped_for(model: RobotModel, options: GaitOptions) -> Biped | None:
     """The legs of ``model``: the reduced formulation needs exactly the five-link shape; in the
     full one, a torso with two thigh-shank legs (other links allowed), or None for any other
     tree (feet, knee-less legs: the guess is then :mod:`gaitopt.gait.sequence_guess`)."""
     if options.formulation == "reduced":
-        return checked_biped(model)
+        return reduced_biped(model)
     try:
-        return biped_structure(model)
+        return biped_of(model)
     except BipedStructureError:
         return None
 
@@ -45,11 +48,7 @@ def default_formulation(model: RobotModel, gait: str, custom_sequence: bool) -> 
     """The formulation a user gets without asking: the paper's reduced coordinates for the
     walk of a five-link-shaped biped, else full coordinates (the only one for other models,
     runs, heel-toe walks and given sequences)."""
-    if gait != "walk" or custom_sequence:
-        return "full"
-    try:
-        checked_biped(model)
-    except BipedStructureError:
+    if gait != "walk" or custom_sequence or not has_reduced_shape(model):
         return "full"
     return "reduced"
 
@@ -71,7 +70,7 @@ def _sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
     if options.contact_sequence is not None:
         return sequence_from_dict(options.contact_sequence)
     if options.gait == "heel-toe":
-        return heel_toe_sequence(model, model_symmetry(model).contacts,
+        return heel_toe_sequence(model, leg_swap(model).contacts,
                                  options.single_support_fraction, impulse=options.impulse)
     if options.gait == "run":
         return running_sequence(model, options.single_support_fraction)
@@ -86,7 +85,7 @@ def checked_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence
         return None
     try:
         seq = contact_sequence(model, options)
-        check_sequence(model, seq, dict(model_symmetry(model).contacts))
+        check_sequence(model, seq, dict(leg_swap(model).contacts))
     except (ContactSequenceError, ValueError) as exc:
         raise GaitOptionsError(f"contact sequence: {exc}") from None
     if options.free_phase_fractions and len(seq.phases) < 2:

@@ -1,5 +1,8 @@
 """The walking problem in full coordinates: the whole tree's ``q, qd`` on a contact sequence.
 
+(One concept, kept whole at about 470 lines: :func:`full_problem` states the whole OCP, every
+constraint block beside the others it must agree with; most helpers serve it alone.)
+
 Beside the paper's reduced formulation (:mod:`gaitopt.gait.problem`: polar hip coordinates and
 leg inverse kinematics, singular at a straight knee, five-link bipeds only), this formulation
 works for any planar tree with contact points and any :class:`ContactSequence`:
@@ -61,13 +64,11 @@ from gaitopt.gait.contact_sequence import (
 )
 from gaitopt.gait.full_physics import (
     PointValues,
-    Symmetry,
     actuator_names,
     event_impulses,
     event_map,
     full_controls,
     hold_axes,
-    model_symmetry,
     phase_point,
     projection_names,
     state_names,
@@ -88,6 +89,7 @@ from gaitopt.ocp.problem import (
 )
 from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import LegSwap, leg_swap
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 _L, _V, _P, _F = range(4)
@@ -129,10 +131,10 @@ def _limits(model: RobotModel) -> dict[str, tuple[float, float]]:
 
 def stance_knees(model: RobotModel) -> dict[str, str]:
     """Contact name -> the knee joint of its leg, for five-link-like models (else empty)."""
-    from gaitopt.robot.biped import BipedStructureError, biped_structure
+    from gaitopt.robot.biped import BipedStructureError, biped_of
 
     try:
-        legs = biped_structure(model).legs
+        legs = biped_of(model).legs
     except BipedStructureError:
         return {}
     return {leg.contact: leg.knee for leg in legs}
@@ -140,7 +142,7 @@ def stance_knees(model: RobotModel) -> dict[str, str]:
 
 def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) -> Problem:
     """The OCP of one periodic step of ``seq`` in full coordinates (module docstring)."""
-    symmetry = model_symmetry(model)
+    symmetry = leg_swap(model)
     check_sequence(model, seq, dict(symmetry.contacts))
     nq = model.nq
     mu = options.friction
@@ -414,7 +416,7 @@ def _step_share(share: Callable[[Any], Any]) -> Callable[[Any], Any]:
     return lambda p: share(p) * p[_L] / p[_V]
 
 
-def _periodic_controls(model: RobotModel, symmetry: Symmetry, seq: ContactSequence,
+def _periodic_controls(model: RobotModel, symmetry: LegSwap, seq: ContactSequence,
                        actuators_of: Mapping[str, Sequence[str]]) -> ControlLinkage:
     """``u_first(0)[a] = u_last(T)[swap(a)]`` for every actuator ``a`` of the first phase
     whose swapped counterpart acts at the end of the last phase."""

@@ -9,8 +9,7 @@ the projection controls ``gamma, nu`` of its held points (docs/formulations.md Â
 
 from __future__ import annotations
 
-import functools
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,26 +21,7 @@ from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.tree import HOLD_AXES, hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import swap_maps, swap_permutations
-
-
-@dataclass(frozen=True)
-class Symmetry:
-    """How the legs swap after a step: permutations of ``q`` (nq,) and ``u`` (nu,), and the
-    contact names."""
-
-    perm_q: tuple[int, ...]
-    perm_u: tuple[int, ...]
-    contacts: Mapping[str, str]
-
-
-@functools.lru_cache(maxsize=16)
-def model_symmetry(model: RobotModel) -> Symmetry:
-    """The leg swap of a model (declared in its file or inferred:
-    :mod:`gaitopt.robot.symmetry`)."""
-    perm_q, perm_u = swap_permutations(model)
-    _, contacts = swap_maps(model)
-    return Symmetry(tuple(int(i) for i in perm_q), tuple(int(i) for i in perm_u), contacts)
+from gaitopt.robot.symmetry import LegSwap, leg_swap
 
 
 def state_names(model: RobotModel) -> tuple[str, ...]:
@@ -144,7 +124,7 @@ def event_map(model: RobotModel, seq: ContactSequence, i: int, q: Any, qd: Any,
     any touch down; else the liftoff impulse of magnitude ``impulse`` (N s) on the released
     point; else nothing. Impulses ``(2,)`` per point as in :func:`per_point`."""
     ev: EventSpec = seq.events[i]
-    after = seq.holds_after(i, model_symmetry(model).contacts)
+    after = seq.holds_after(i, leg_swap(model).contacts)
     if ev.touchdown:
         sol = impact(model, q, qd, after)
         return EventValues(sol.qd_plus, per_point(after, sol.impulses))
@@ -173,7 +153,7 @@ def event_impulses(model: RobotModel, seq: ContactSequence, i: int, x: Any, impu
     return event_map(model, seq, i, q, qd, impulse).impulses
 
 
-def swap_state(model: RobotModel, symmetry: Symmetry, q: Any, qd: Any, step: Any
+def swap_state(model: RobotModel, symmetry: LegSwap, q: Any, qd: Any, step: Any
                ) -> tuple[list[Any], list[Any]]:
     """The next step's ``(q, qd)``: legs swapped, moved back by one step length."""
     qs, qds = as_scalars(q, model.nq, "q"), as_scalars(qd, model.nq, "qd")

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from gaitopt.dynamics.actuation import actuation_matrix
 from gaitopt.dynamics.crba import crba
 from gaitopt.dynamics.kinematics import contact_jacobian
-from gaitopt.dynamics.reduced import checked_biped, leg_inverse_kinematics
+from gaitopt.dynamics.reduced import leg_inverse_kinematics
 from gaitopt.dynamics.rnea import bias_forces
 from gaitopt.gait import walking
 from gaitopt.gait.full_physics import actuator_names
@@ -31,7 +31,7 @@ from gaitopt.gait.full_physics import state_names as full_state_names
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp import Guess as OcpGuess
 from gaitopt.ocp import PhaseGuess as OcpPhaseGuess
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of, reduced_biped
 from gaitopt.robot.model import BASE_POSITION, RobotModel
 
 Array = NDArray[np.float64]
@@ -111,7 +111,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
     (the full-coordinate formulation; joints other than the legs' stay at 0), else the reduced
     states of :mod:`gaitopt.gait.walking`."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
-    legs = (biped_structure(model) if full else checked_biped(model)).legs
+    stance, swing = (biped_of(model) if full else reduced_biped(model)).legs
     v, step, f = speed, step_length, single_support_fraction
     total = step / v
     t1, t2 = f * total, (1.0 - f) * total
@@ -131,27 +131,27 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
     q_fine = np.zeros((_FINE, model.nq))
     q_fine[:, BASE_POSITION] = p_hip
     for k in range(_FINE):
-        for leg, tip in ((legs[0], (0.0, 0.0)), (legs[1], tuple(tip2[k]))):
+        for leg, tip in ((stance, (0.0, 0.0)), (swing, tuple(tip2[k]))):
             joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip), 0.0,
                                             0.0)
             q_fine[k, leg.hip_index] = float(joints.hip)
             q_fine[k, leg.knee_index] = float(joints.knee)
     phases.append(_phase_guess(model, SINGLE, t_fine, q_fine, _knots(0.0, t1, knots[0]),
-                               ankle, use_ankles, [legs[0].contact], full))
+                               ankle, use_ankles, [stance.contact], full))
     if f < 1.0:
         t_fine = np.linspace(t1, t1 + t2, _FINE)
         p_hip = hip(t_fine)
         q_fine = np.zeros((_FINE, model.nq))
         q_fine[:, BASE_POSITION] = p_hip
         for k in range(_FINE):
-            for leg, tip in ((legs[0], (0.0, 0.0)), (legs[1], (step, 0.0))):
+            for leg, tip in ((stance, (0.0, 0.0)), (swing, (step, 0.0))):
                 joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),
                                                 0.0, 0.0)
                 q_fine[k, leg.hip_index] = float(joints.hip)
                 q_fine[k, leg.knee_index] = float(joints.knee)
         phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
                                    _knots(t1, t2, knots[1]), ankle, use_ankles,
-                                   [legs[0].contact, legs[1].contact], full))
+                                   [stance.contact, swing.contact], full))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
@@ -172,7 +172,7 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
     (``xb = -0.6 L``, ``yb = 0.1 m``: the swap of legs maps tip 1's end onto tip 2's start),
     both on smooth arcs; torques by least squares as for the walk."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
-    legs = biped_structure(model).legs
+    stance, swing = biped_of(model).legs
     v, step, f = speed, step_length, stance_fraction
     total = step / v
     t1 = f * total
@@ -180,7 +180,7 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
     height = 0.97 * float(np.sqrt(max(r_max**2 - (s_hip / 2.0) ** 2, 1e-4)))
     xb, yb, bump = -0.6 * step, 0.1, 0.05
     phases = []
-    for name, (ta, tb), held in (("stance", (0.0, t1), [legs[0].contact]),
+    for name, (ta, tb), held in (("stance", (0.0, t1), [stance.contact]),
                                  ("flight", (t1, total), [])):
         t = np.linspace(ta, tb, _FINE)
         p_hip = np.stack([-s_hip / 2.0 + v * t, np.full_like(t, height)], axis=1)
@@ -197,7 +197,7 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
         q_fine = np.zeros((_FINE, model.nq))
         q_fine[:, BASE_POSITION] = p_hip
         for k in range(_FINE):
-            for leg, tip in ((legs[0], tip1[k]), (legs[1], tip2[k])):
+            for leg, tip in ((stance, tip1[k]), (swing, tip2[k])):
                 joints = leg_inverse_kinematics(leg, list(p_hip[k]), [0.0, 0.0], list(tip),
                                                 0.0, 0.0)
                 q_fine[k, leg.hip_index] = float(joints.hip)

@@ -1,5 +1,8 @@
 """Options of the walking problem: the variant, the targets and every bound, validated.
 
+(One concept, kept whole at about 430 lines: the options and the check of each; a third of
+the length is the documentation of the fields.)
+
 Defaults follow the paper's problem (ankle torques and the liftoff impulse on, single support
 85 % of the step, the speed given at 12 m/min, the paper's globally optimal speed, and the step
 length free) on a grid whose cost is converged to well within 1 %: 16 + 6 knots with the
@@ -18,7 +21,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from gaitopt.robot.biped import BipedStructure
+from gaitopt.robot.biped import Biped
 from gaitopt.units import format_speed
 
 Transcription = Literal["hermite-simpson", "hermite-simpson-separated", "trapezoidal"]
@@ -117,7 +120,7 @@ class GaitOptions:
             ``single_support_fraction`` of the step, then flight; full formulation only, no
             liftoff impulse) or ``"heel-toe"`` (feet with heel and toe points: foot flat,
             heel off, double support, heel rocker; full formulation; see
-            :func:`gaitopt.gait.contact_sequence.heel_toe_sequence`).
+            :func:`gaitopt.gait.builtin_sequences.heel_toe_sequence`).
         contact_sequence: a contact sequence as plain data (the gait file's
             ``contact_sequence``; :func:`gaitopt.gait.contact_sequence.sequence_from_dict`),
             which replaces ``gait``; full formulation only. A phase fraction is a number
@@ -272,7 +275,7 @@ def _bounds(name: str, value: Any, *, positive: bool = False) -> tuple[float, fl
     return lo, hi
 
 
-def validate_options(options: GaitOptions, biped: BipedStructure | None) -> None:
+def validate_options(options: GaitOptions, biped: Biped | None) -> None:
     """Check every option before any solve; raise :class:`GaitOptionsError` naming the field,
     the bad value and the allowed range. ``biped``: the legs, for the reach checks (None for a
     model without thigh-shank legs in the full formulation: no reach check)."""

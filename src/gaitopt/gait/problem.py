@@ -1,5 +1,8 @@
 """The paper's minimum-energy walking problem stated on the generic OCP engine.
 
+(One concept, kept whole at about 450 lines: :func:`walking_problem` states the whole OCP of
+the reduced formulation with its stage bounds; the helpers serve it alone.)
+
 Decision parameters ``p = [step_length L, speed v, impulse P]``; phase durations are
 expressions of them: ``T1 = f L / v`` (single support) and ``T2 = (1 - f) L / v`` (double
 support), ``f`` the single-support fraction. The objective is the paper's eq. 5::
@@ -25,7 +28,6 @@ import casadi as ca
 import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
-from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import cost, walking
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE
@@ -41,6 +43,7 @@ from gaitopt.ocp.problem import (
     Problem,
 )
 from gaitopt.ocp.transcription import Transcription
+from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
@@ -165,7 +168,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
 
     Call :func:`gaitopt.gait.options.validate_options` first.
     """
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     stance, swing = legs
     f = options.single_support_fraction
     two_phases = options.double_support
@@ -384,7 +387,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
 def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition,
                  magnitude: Any) -> Any:
     """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
-    lifting = checked_biped(model).legs[0].contact
+    lifting = reduced_biped(model).stance.contact
     from gaitopt.dynamics.kinematics import contact_velocity
 
     v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
@@ -393,7 +396,7 @@ def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition
 
 def relabel_actuator(model: RobotModel, name: str) -> str | None:
     """The actuator of the other leg in the same role (hip_1 <-> hip_2, ...), or None."""
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     for i, leg in enumerate(legs):
         other = legs[1 - i]
         for mine, theirs in ((leg.hip_actuator, other.hip_actuator),

@@ -18,7 +18,6 @@ from numpy.typing import NDArray
 
 from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.kinematics import point_position
-from gaitopt.dynamics.reduced import checked_biped
 from gaitopt.gait import cost, walking
 from gaitopt.gait.accuracy import accuracy_record
 from gaitopt.gait.formulation import contact_sequence
@@ -27,6 +26,7 @@ from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp import Result, warm_start_of
+from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -123,7 +123,7 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
         samples = full_samples(model, res, count, _points_function(model),
                                point_names(model))
         return _gait(solution, phase_records, events, samples)
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     phases: list[GaitPhase] = []
     for name in traj:
         ph = traj[name]
@@ -198,7 +198,7 @@ def _vec(value: Any, n: int) -> Array:
 
 def _events(model: RobotModel, options: GaitOptions, traj: dict[str, Any], step: float,
             impulse: float) -> tuple[GaitEvent, ...]:
-    legs = checked_biped(model).legs
+    legs = reduced_biped(model).legs
     ss = traj[SINGLE]
     strike = walking.heel_strike(model, ss.x[-1], step, double_support=options.double_support)
     events = [GaitEvent(

@@ -1,9 +1,14 @@
 """Solving the walking problem robustly from a naive start: staged continuation.
 
+(One concept, kept whole at about 520 lines, a tenth of them this docstring: the stages are
+methods of one run that share its record of stages, results and grid costs.)
+
 The paper's authors climbed to the optimum by hand through sub-problems. gaitopt does it by
 itself, in stages that each warm-start the next (primal values and multipliers). Stages 1-3
-are data (:mod:`gaitopt.gait.stages`: :data:`~gaitopt.gait.stages.CONTACT_STAGES` and
-:data:`~gaitopt.gait.stages.RELEASES`) that one loop walks:
+and the switch of control model are data (:mod:`gaitopt.gait.stages`:
+:data:`~gaitopt.gait.stages.CONTACT_STAGES`, then
+:data:`~gaitopt.gait.stages.COARSE_COMPLETION`: :data:`~gaitopt.gait.stages.CONTROL_MODEL_STAGE`
+and :data:`~gaitopt.gait.stages.RELEASES`) that one loop each walks:
 
 1. ``relaxed contact``: the coarse grid (at most the paper's 8 + 5 knots) at the target speed
    (12 m/min when the speed is free) with no liftoff impulse, the unilateral contact
@@ -61,8 +66,7 @@ from typing import Any
 import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
-from gaitopt.gait.formulation import biped_of, checked_sequence, contact_sequence, stage_bounds
-from gaitopt.gait.full_physics import model_symmetry
+from gaitopt.gait.formulation import biped_for, checked_sequence, contact_sequence, stage_bounds
 from gaitopt.gait.guess import (
     default_running_step,
     default_step_length,
@@ -91,6 +95,8 @@ from gaitopt.gait.solution import (
 )
 from gaitopt.gait.stages import (
     ANKLES,
+    COARSE_COMPLETION,
+    COLD_CONTROL_MODEL,
     CONTACT_STAGES,
     PRIMAL_WARM_OPTIONS,
     RELEASES,
@@ -110,10 +116,8 @@ from gaitopt.gait.transcriptions import (
 from gaitopt.ocp import Guess, Result, WarmStart, refined_mesh
 from gaitopt.ocp.mesh import split_intervals
 from gaitopt.robot.model import RobotModel
+from gaitopt.robot.symmetry import leg_swap
 
-#: The control model of the cold stages (from the naive guess) and of the continuation in
-#: speed: the paper's, whatever the requested one (see the module docstring).
-COLD_CONTROL_MODEL = "paper"
 #: Reference speed (m/s) for the continuation fallback: the paper's optimal 12 m/min.
 REFERENCE_SPEED = 0.2
 #: Largest speed change (m/s) between two continuation steps.
@@ -192,7 +196,7 @@ class _Run:
         """The converged results of :meth:`cold`'s naive guesses: the first one, or with
         ``every_start`` all of them."""
         o, coarse = self.options, coarse_knots(self.options)
-        biped = biped_of(self.model, o)
+        biped = biped_for(self.model, o)
         generic = biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
         r_max = (0.0 if biped is None else
                  min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
@@ -215,7 +219,7 @@ class _Run:
                     from gaitopt.gait.sequence_guess import sequence_guess
 
                     guess = sequence_guess(self.model, contact_sequence(self.model, o),
-                                           model_symmetry(self.model).contacts, speed=speed,
+                                           leg_swap(self.model).contacts, speed=speed,
                                            step_length=step0, knots=coarse, ankle=o.ankle,
                                            ankle_torques=False)
                 elif o.gait == "run":
@@ -257,33 +261,13 @@ class _Run:
             return self.options
         return self.options.replace(control_model=COLD_CONTROL_MODEL)
 
-    def to_control_model(self, result: Result) -> Result:
-        """The coarse problem of the cold stages (same bounds: speed and fraction held, no
-        impulse, ankle torques held) in the requested control model, from ``result``'s
-        values (a solution of :data:`COLD_CONTROL_MODEL`'s NLP, whose multipliers do not
-        fit); ``result`` itself when the models agree."""
-        o = self.options
-        if o.control_model == COLD_CONTROL_MODEL:
-            return result
-        held = {spec.frees for spec in RELEASES if spec.frees and spec.runs(o)}
-        speed = result.parameters[SPEED]
-        bounds = held_bounds(o, held, speed, result, self.fractions)
-        bounds[SPEED] = (speed, speed)
-        return self.stage(f"control model {o.control_model}", coarse_knots(o), Relaxation(),
-                          result_guess(result), bounds, hold_ankles=ANKLES in held,
-                          solver_options=PRIMAL_WARM_OPTIONS)
-
     def complete(self, coarse: Result | None) -> Result | None:
-        """A coarse solution of the cold stages through the rest: the requested control
-        model, the releases and the requested grid (None for None)."""
+        """A coarse solution of the cold stages through the rest: :meth:`release` (the
+        requested control model and the releases) and the requested grid (None for None)."""
         if coarse is None:
             return None
-        outcome = self.to_control_model(coarse)
-        if outcome.success:
-            outcome = self.release(outcome)
-            if outcome.success:
-                outcome = self.refine(outcome)
-        return outcome
+        outcome = self.release(coarse)
+        return self.refine(outcome) if outcome.success else outcome
 
     def best_completion(self, starts: list[Result]) -> Result | None:
         """:meth:`complete` each of ``starts`` (their stages named ``start i/n: ...`` when
@@ -306,19 +290,25 @@ class _Run:
         return best
 
     def release(self, result: Result) -> Result:
-        """Free what the cold stages held, one :data:`RELEASES` stage at a time; each stage
-        holds what the later ones free (at ``result``'s values, the impulse at 0)."""
+        """The coarse solution of the cold stages through the :data:`COARSE_COMPLETION`
+        stages that run: the requested control model (from the values only), then what the
+        cold stages held freed one stage at a time. Each stage holds what the later ones
+        free, at the values of ``result`` or of the last ``values_only`` stage (the impulse
+        at 0, the ankle torques at zero)."""
         o, coarse = self.options, coarse_knots(self.options)
-        stages = [spec for spec in RELEASES if spec.runs(o)]
-        speed = result.parameters[SPEED]
+        stages = [spec for spec in COARSE_COMPLETION if spec.runs(o)]
         start = result
         for i, spec in enumerate(stages):
             held = {later.frees for later in stages[i + 1:] if later.frees}
-            result = self.stage(spec.name, coarse, spec.relax, result,
-                                held_bounds(o, held, speed, start, self.fractions),
+            guess = result_guess(result) if spec.values_only else result
+            result = self.stage(spec.title(o), coarse, spec.relax, guess,
+                                held_bounds(o, held, start.parameters[SPEED], start,
+                                            self.fractions),
                                 hold_ankles=ANKLES in held, solver_options=spec.solver_options)
             if not result.success:
                 return result
+            if spec.values_only:
+                start = result
         return result
 
     def refine(self, result: Result) -> Result:
@@ -453,7 +443,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         GaitOptionsError: invalid options, or a step so long that no naive start can place
             the legs (nothing was solved; the message says what to change).
     """
-    validate_options(options, biped_of(model, options))
+    validate_options(options, biped_for(model, options))
     checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()

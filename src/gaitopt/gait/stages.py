@@ -1,10 +1,12 @@
 """The continuation stages of the staged solve, described as data, and what each one holds.
 
 :data:`CONTACT_STAGES` run on the coarse grid (:func:`coarse_knots`) from each naive guess
-with everything that :data:`RELEASES` frees held (:func:`held_bounds`, :func:`held_ankles`);
-then each of :data:`RELEASES` that runs for the options frees one quantity, holding what the
-later ones free. :func:`gaitopt.gait.solve.solve_walking` walks these lists; the IPOPT
-options of the stages (and why) are here too.
+in :data:`COLD_CONTROL_MODEL` with everything that :data:`RELEASES` frees held
+(:func:`held_bounds`, :func:`held_ankles`); then each stage of :data:`COARSE_COMPLETION`
+that runs for the options: :data:`CONTROL_MODEL_STAGE` (the requested control model) and the
+:data:`RELEASES`, each freeing one quantity and holding what the later ones free.
+:func:`gaitopt.gait.solve.solve_walking` walks these lists; the IPOPT options of the stages
+(and why) are here too.
 """
 
 from __future__ import annotations
@@ -64,19 +66,30 @@ def coarse_knots(options: GaitOptions) -> tuple[int, int]:
 
 #: What the release stages free besides parameters: the ankle torques (held at zero before).
 ANKLES = "ankle torques"
+#: The control model of the contact stages (from the naive guess) and of the continuation in
+#: speed: the paper's, whatever the requested one (:mod:`gaitopt.gait.solve`).
+COLD_CONTROL_MODEL = "paper"
 
 
 @dataclass(frozen=True)
 class StageSpec:
-    """One continuation stage as data: its name, whether it runs for the options, the
-    contact relaxation, the quantity it frees (:data:`ANKLES` or a parameter name; every
-    earlier stage holds it) and IPOPT options merged over the transcription's."""
+    """One continuation stage as data: its name (``{control_model}`` stands for the
+    requested one), whether it runs for the options, the contact relaxation, the quantity it
+    frees (:data:`ANKLES` or a parameter name; every earlier stage holds it), IPOPT options
+    merged over the transcription's, and what it starts from: the previous stage's solution
+    with its multipliers, or (``values_only``) its values alone, for a stage whose NLP
+    differs from the previous one's (the later stages then hold at this stage's values)."""
 
     name: str
     runs: Callable[[GaitOptions], bool] = lambda options: True
     relax: Relaxation = Relaxation()
     frees: str | None = None
     solver_options: dict[str, Any] | None = None
+    values_only: bool = False
+
+    def title(self, options: GaitOptions) -> str:
+        """The stage's name for ``options`` (as printed and kept in the solution)."""
+        return self.name.format(control_model=options.control_model)
 
 
 #: Stages 1-2, on the coarse grid from each naive guess, everything in :data:`RELEASES`
@@ -94,6 +107,17 @@ RELEASES: tuple[StageSpec, ...] = (
     StageSpec("phase fractions free", runs=lambda o: frees_fractions(o), frees=FRACTION),
     StageSpec("speed free", runs=lambda o: o.speed is None, frees=SPEED),
 )
+
+
+#: The coarse problem of the contact stages solved again in the requested control model, from
+#: their solution's values (feasible for it: the jumps model only drops the control linkages;
+#: the multipliers belong to the other NLP), when it is not :data:`COLD_CONTROL_MODEL`.
+CONTROL_MODEL_STAGE = StageSpec(
+    "control model {control_model}",
+    runs=lambda o: o.control_model != COLD_CONTROL_MODEL,
+    solver_options=PRIMAL_WARM_OPTIONS, values_only=True)
+#: What a coarse solution of the contact stages goes through on the coarse grid, in order.
+COARSE_COMPLETION: tuple[StageSpec, ...] = (CONTROL_MODEL_STAGE, *RELEASES)
 
 
 def frees_fractions(options: GaitOptions) -> bool:

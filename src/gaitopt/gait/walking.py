@@ -3,7 +3,7 @@
 One code path for numbers and CasADi symbols: the OCP (``gaitopt.gait.problem``) calls these
 functions on symbols, the gait file writer and the checks call them on numbers.
 
-A step (``docs/walking.md``): leg 1 (``legs[0]``) stands with its tip at the origin.
+A step (``docs/walking.md``): leg 1 (``Biped.stance``) stands with its tip at the origin.
 
 * phase ``single_support``: state ``x = [z, zd]`` with ``z = [r, alpha, torso, hip_2,
   knee_2]`` (hip polar about tip 1, swing leg 2), 10 states;
@@ -32,7 +32,6 @@ from gaitopt.dynamics.reduced import (
     N_DOUBLE,
     N_SINGLE,
     ReducedSolution,
-    checked_biped,
     double_support_coordinates,
     double_support_dynamics,
     double_support_state,
@@ -41,8 +40,8 @@ from gaitopt.dynamics.reduced import (
     single_support_dynamics,
     single_support_state,
 )
-from gaitopt.robot.biped import Leg
-from gaitopt.robot.model import BASE_POSITION, RobotModel
+from gaitopt.robot.biped import Leg, reduced_biped
+from gaitopt.robot.model import RobotModel
 
 SINGLE = "single_support"
 DOUBLE = "double_support"
@@ -51,10 +50,10 @@ ORIGIN = (0.0, 0.0)
 
 def state_names(model: RobotModel, phase: str) -> tuple[str, ...]:
     """Names of the phase's states ``x = [z, zd]`` (rates end in ``_rate``)."""
-    legs = checked_biped(model).legs
+    biped = reduced_biped(model)
     z: tuple[str, ...]
     if phase == SINGLE:
-        z = ("r", "alpha", "torso", legs[1].hip, legs[1].knee)
+        z = ("r", "alpha", "torso", biped.swing.hip, biped.swing.knee)
     elif phase == DOUBLE:
         z = ("r", "alpha", "torso")
     else:
@@ -65,8 +64,8 @@ def state_names(model: RobotModel, phase: str) -> tuple[str, ...]:
 def control_names(model: RobotModel, phase: str, *, ankle: bool) -> tuple[str, ...]:
     """Actuators active in a phase, in model order: every joint actuator, plus the ankle
     actuators of the tips on the ground when ``ankle``."""
-    legs = checked_biped(model).legs
-    on_ground = {legs[0].contact} if phase == SINGLE else {legs[0].contact, legs[1].contact}
+    biped = reduced_biped(model)
+    on_ground = {biped.stance.contact} if phase == SINGLE else set(biped.contacts)
     names = []
     for a in model.actuators:
         if a.joint is not None or (ankle and a.contact in on_ground):
@@ -101,10 +100,10 @@ class PhasePoint:
 def single_support_point(model: RobotModel, x: Any, u: Any, controls: Sequence[str]
                          ) -> PhasePoint:
     """Reduced dynamics ``xdot = [zd, zdd]`` in single support on leg 1 (tip at the origin)."""
-    legs = checked_biped(model).legs
+    biped = reduced_biped(model)
     z, zd = split_state(x, N_SINGLE)
     q, _ = single_support_state(model, 0, z, zd, ORIGIN)
-    tau = generalized_forces(model, q, full_controls(model, controls, u), [legs[0].contact])
+    tau = generalized_forces(model, q, full_controls(model, controls, u), [biped.stance.contact])
     sol = single_support_dynamics(model, 0, z, zd, tau, ORIGIN)
     zdd = as_scalars(sol.zdd, N_SINGLE, "zdd")
     return PhasePoint(xdot=vector(list(zd) + zdd), solution=sol)
@@ -113,11 +112,11 @@ def single_support_point(model: RobotModel, x: Any, u: Any, controls: Sequence[s
 def double_support_point(model: RobotModel, x: Any, u: Any, controls: Sequence[str],
                          step_length: Scalar) -> PhasePoint:
     """Reduced dynamics in double support, tip 1 at the origin and tip 2 at ``(L, 0)``."""
-    legs = checked_biped(model).legs
+    biped = reduced_biped(model)
     z, zd = split_state(x, N_DOUBLE)
     front = (step_length, 0.0)
     q, _ = double_support_state(model, 0, z, zd, ORIGIN, front)
-    held = [legs[0].contact, legs[1].contact]
+    held = list(biped.contacts)
     tau = generalized_forces(model, q, full_controls(model, controls, u), held)
     sol = double_support_dynamics(model, 0, z, zd, tau, ORIGIN, front)
     zdd = as_scalars(sol.zdd, N_DOUBLE, "zdd")
@@ -165,15 +164,16 @@ def heel_strike(model: RobotModel, x_end: Any, step_length: Scalar, *,
     it, tip 2 strikes alone and the result is the relabelled single-support state of the next
     step.
     """
-    legs = checked_biped(model).legs
+    biped = reduced_biped(model)
     z, zd = split_state(x_end, N_SINGLE)
     q, qd_minus = single_support_state(model, 0, z, zd, ORIGIN)
-    contacts = [legs[0].contact, legs[1].contact] if double_support else [legs[1].contact]
+    contacts = list(biped.contacts) if double_support else [biped.swing.contact]
     sol = impact(model, q, qd_minus, contacts)
     if double_support:
         qs, qds = as_scalars(q, model.nq, "q"), as_scalars(sol.qd_plus, model.nq, "qd")
-        _, _, rd, alphad = polar_from_hip(ORIGIN, qs[BASE_POSITION], qds[BASE_POSITION])
-        x_next = vector([z[0], z[1], z[2], rd, alphad, qds[2]])
+        base = biped.base_position
+        _, _, rd, alphad = polar_from_hip(ORIGIN, qs[base], qds[base])
+        x_next = vector([*z[:N_DOUBLE], rd, alphad, qds[biped.base_angle]])
     else:
         x_next = relabelled_single_support_state(model, q, sol.qd_plus, (step_length, 0.0))
     return Transition(x_next=x_next, q=q, qd_before=qd_minus, qd_after=sol.qd_plus,
@@ -185,14 +185,15 @@ def liftoff(model: RobotModel, x_end: Any, step_length: Scalar, impulse: Scalar
     """Liftoff of tip 1 at the end of double support with an impulse of magnitude ``impulse``
     (N s) along leg 1 from tip to hip, tip 2 held; returns the relabelled single-support
     state of the next step."""
-    legs = checked_biped(model).legs
+    biped = reduced_biped(model)
     z, zd = split_state(x_end, N_DOUBLE)
     front = (step_length, 0.0)
     q, qd_minus = double_support_state(model, 0, z, zd, ORIGIN, front)
-    sol = liftoff_impulse(model, q, qd_minus, legs[0].contact, impulse, [legs[1].contact])
+    sol = liftoff_impulse(model, q, qd_minus, biped.stance.contact, impulse,
+                          [biped.swing.contact])
     x_next = relabelled_single_support_state(model, q, sol.qd_plus, front)
-    impulses = {legs[0].contact: sol.impulse_lifting,
-                **_pairs(sol.impulses_held, [legs[1].contact])}
+    impulses = {biped.stance.contact: sol.impulse_lifting,
+                **_pairs(sol.impulses_held, [biped.swing.contact])}
     return Transition(x_next=x_next, q=q, qd_before=qd_minus, qd_after=sol.qd_plus,
                       impulses=impulses)
 

@@ -1,9 +1,11 @@
-"""The biped structure of a model: a floating torso and two thigh-shank legs with tip contacts.
+"""The biped boundary: a floating torso and two thigh-shank legs with tip contacts.
 
 The walking problem and the Reduced Dynamics Algorithm need to know which links, joints,
-contact points and actuators form each leg. :func:`biped_structure` finds them in any model
-with that shape (not only the built-in ``five-link``) and explains clearly what is missing
-otherwise.
+contact points and actuators form each leg, which leg stands at the start of a step, how the
+legs swap after it and where the base coordinates are in ``q``. :func:`biped_of` finds them
+once per model in any model with that shape (not only the built-in ``five-link``) and explains
+clearly what is missing otherwise; the walking code asks it for a :class:`Biped` instead of
+looking at the model again.
 """
 
 from __future__ import annotations
@@ -11,8 +13,10 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_ANGLE, BASE_POSITION, RobotModel
+from gaitopt.robot.symmetry import LegSwap, leg_swap
 
 
 class BipedStructureError(ValueError):
@@ -57,20 +61,50 @@ class Leg:
 
 
 @dataclass(frozen=True)
-class BipedStructure:
-    """The two legs of a biped model, ``legs[0]`` being leg 1 (the first contact point)."""
+class Biped:
+    """The biped of a model: its two legs, which stands, how they swap, where the base is.
+
+    Attributes:
+        legs: ``legs[0]`` is leg 1 (the first contact point), the stance leg at the start of
+            a step; ``legs[1]`` leg 2, the swing leg.
+        swap: the leg swap after a step (permutations of ``q``, ``u`` and the contact names).
+        reduced: the model is exactly a torso and these two legs (5 links, 7 coordinates),
+            the shape the paper's reduced coordinates describe.
+        base_position, base_angle: where the floating base's ``(x, y)`` (m, world frame) and
+            angle (rad) are in ``q`` (the same for every model: :data:`BASE_POSITION`).
+    """
 
     legs: tuple[Leg, Leg]
+    swap: LegSwap
+    reduced: bool
+    base_position: ClassVar[slice] = BASE_POSITION
+    base_angle: ClassVar[int] = BASE_ANGLE
+
+    @property
+    def stance(self) -> Leg:
+        """Leg 1, standing at the origin at the start of a step."""
+        return self.legs[0]
+
+    @property
+    def swing(self) -> Leg:
+        """Leg 2, swinging at the start of a step and landing at ``(step_length, 0)``."""
+        return self.legs[1]
+
+    @property
+    def contacts(self) -> tuple[str, str]:
+        """The tip contact names ``(stance, swing)``."""
+        return self.legs[0].contact, self.legs[1].contact
 
     def other(self, i: int) -> int:
+        """The index of the other leg."""
         return 1 - i
 
 
 @functools.lru_cache(maxsize=64)
-def biped_structure(model: RobotModel) -> BipedStructure:
+def biped_of(model: RobotModel) -> Biped:
     """Identify the torso (the floating base) and the two legs of ``model``.
 
-    Built once per model: the model is immutable, so equal models share one structure (the
+    Built once per model: the model is immutable, so equal models share one biped (the
     walking code asks for it in many places); a model that is no biped raises every time.
 
     Requirements, each reported by name when violated: exactly two contact points; each on a
@@ -134,4 +168,25 @@ def biped_structure(model: RobotModel) -> BipedStructure:
         ))
     if legs[0].thigh == legs[1].thigh:
         raise BipedStructureError(f"model {name!r}: both contact points are on the same leg")
-    return BipedStructure(legs=(legs[0], legs[1]))
+    return Biped(legs=(legs[0], legs[1]), swap=leg_swap(model), reduced=model.nq == 7)
+
+
+def reduced_biped(model: RobotModel) -> Biped:
+    """The biped of ``model`` (:func:`biped_of`), required to have no links beyond torso and
+    legs: the shape of the paper's reduced coordinates (:mod:`gaitopt.dynamics.reduced`)."""
+    biped = biped_of(model)
+    if not biped.reduced:
+        raise BipedStructureError(
+            f"model {model.name!r} has {len(model.links)} links; the reduced biped dynamics "
+            "need exactly a torso and two thigh-shank legs (5 links, 7 coordinates)")
+    return biped
+
+
+def has_reduced_shape(model: RobotModel) -> bool:
+    """Whether ``model`` is a biped the reduced coordinates describe (:func:`reduced_biped`
+    would not raise)."""
+    try:
+        reduced_biped(model)
+    except BipedStructureError:
+        return False
+    return True

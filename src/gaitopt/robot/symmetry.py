@@ -9,10 +9,13 @@ other link, joint and actuator maps to itself.
 
 ``q_swapped = q[perm_q]`` exchanges the legs' coordinates (the base coordinates ``x, y`` and
 the base angle stay), ``u_swapped = u[perm_u]`` their actuators; both are involutions.
+:func:`leg_swap` holds both with the contact map, built once per model.
 """
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
@@ -136,3 +139,26 @@ def swap_permutations(model: RobotModel) -> tuple[NDArray[np.intp], NDArray[np.i
                                 "counterpart on the other side")
         perm_u[i] = matches[0]
     return perm_q, perm_u
+
+
+@dataclass(frozen=True)
+class LegSwap:
+    """How the legs swap after a step: permutations of ``q`` (nq,) and ``u`` (nu,), and the
+    contact names (every contact -> its counterpart, itself unless paired)."""
+
+    perm_q: tuple[int, ...]
+    perm_u: tuple[int, ...]
+    contacts: Mapping[str, str]
+
+
+@functools.lru_cache(maxsize=16)
+def leg_swap(model: RobotModel) -> LegSwap:
+    """The leg swap of ``model`` (declared in its file or inferred: :func:`model_symmetry`),
+    built once per model.
+
+    Raises:
+        SymmetryError: as :func:`swap_permutations`.
+    """
+    perm_q, perm_u = swap_permutations(model)
+    _, contacts = swap_maps(model)
+    return LegSwap(tuple(int(i) for i in perm_q), tuple(int(i) for i in perm_u), contacts)

@@ -1,6 +1,6 @@
 """The cost study's findings: which cost puts a model's optimum where people walk.
 
-Input: the rows of a cost study (:class:`gaitopt.study.cost_study.CostRow`, one speed-free
+Input: the rows of a cost study (:class:`gaitopt.study.cost_table.CostRow`, one speed-free
 optimum per model and case). Each finding is checked per model and gets a verdict, ``True``
 (holds), ``False`` (does not hold) or ``None`` (the study cannot tell: a case missing or
 failed), with the numbers behind it, keyed ``<quantity>.<case>`` (e.g. ``speed_m_min.paper``).
@@ -17,7 +17,7 @@ The ids (:data:`COST_FINDING_IDS`, listed in docs/costs.md) are stable; the clai
 5. ``costs.nearest_human``: some cost with physiological settings (paper, work, metabolic at a
    human resting power) puts the optimum where people walk: speed and step both within
    :data:`HUMAN_TOLERANCE`. The evidence names the nearest case by the distance of
-   :func:`gaitopt.study.cost_study.human_distance`.
+   :func:`gaitopt.study.cost_table.human_distance`.
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 
-from gaitopt.study.cost_study import HUMAN_RESTING_POWER, CostRow
+from gaitopt.study.cost_study import HUMAN_RESTING_POWER
+from gaitopt.study.cost_table import CostRow
 from gaitopt.study.findings import (
     HUMAN_OPTIMAL_SPEED_M_MIN,
     HUMAN_STEP_LENGTH,

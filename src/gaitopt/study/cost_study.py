@@ -36,14 +36,12 @@ standing still, 0.5 at half people's speed with people's step.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import os
 import re
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
@@ -51,8 +49,10 @@ from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import Formulation, GaitOptions
-from gaitopt.robot.biped import BipedStructureError
+from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
+from gaitopt.study.cost_table import CostRow
+from gaitopt.study.cost_table import CostStudyError as CostStudyError
 from gaitopt.study.executors import Backend
 from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH
 from gaitopt.study.plan import START_SPEED, SweepPoint, SweepSpec
@@ -60,7 +60,6 @@ from gaitopt.study.summary import (
     SUMMARY_FILE,
     VARIANTS,
     SummaryError,
-    csv_text,
     read_summary,
     rows_of,
 )
@@ -76,18 +75,9 @@ DEFAULT_RESTING_POWERS: tuple[float, ...] = (0.0, 0.6, 1.2, 2.4, 4.8)
 HUMAN_RESTING_POWER: tuple[float, float] = (1.2, 1.5)
 COST_STUDY_FILE = "cost_study.json"
 COST_STUDY_FORMAT = "gaitopt.cost-study"
-COST_TABLE_FILE = "costs.csv"
 DIRECT_FILE = "direct.gait.json"
 #: How a case's optimum was reached (the ``start`` column).
 STARTS = ("from 12 m/min", "direct")
-COST_COLUMNS: tuple[str, ...] = (
-    "model", "formulation", "case", "cost", "resting_power", "success", "status",
-    "speed_m_min", "step_length", "step_time", "cost_value", "human_distance", "start",
-    "other_cost_value", "file")
-
-
-class CostStudyError(ValueError):
-    """A cost study request or its files are invalid (names the setting or the file)."""
 
 
 @dataclass(frozen=True)
@@ -215,13 +205,7 @@ class CostStudySpec:
         """``reduced`` or ``full`` for ``model`` (see the module docstring)."""
         if self.formulation != "auto":
             return self.formulation
-        from gaitopt.dynamics.reduced import checked_biped
-
-        try:
-            checked_biped(model)
-        except BipedStructureError:
-            return "full"
-        return "reduced"
+        return "reduced" if has_reduced_shape(model) else "full"
 
     def gait_of(self, model: RobotModel) -> str:
         """``walk`` or ``heel-toe`` for ``model``: with ``gait="auto"``, ``heel-toe`` when the
@@ -273,54 +257,6 @@ def write_settings(spec: CostStudySpec, directory: str | os.PathLike[str]) -> Pa
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(spec.settings(), indent=2) + "\n")
     return path
-
-
-# -- the results table ---------------------------------------------------------------------------
-
-def human_distance(speed_m_min: float, step_length: float) -> float:
-    """``sqrt((v / 80 - 1)^2 + (L / 0.75 - 1)^2)``: 0 at people's walk (module docstring)."""
-    return math.hypot(speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN - 1.0,
-                      step_length / HUMAN_STEP_LENGTH - 1.0)
-
-
-@dataclass(frozen=True, kw_only=True)
-class CostRow:
-    """The speed-free optimum of one (model, case): speed m/min, step m, step time s, the
-    cost's value (its own units, docs/costs.md), NaN where the solve failed; ``file`` the gait
-    file relative to the study directory."""
-
-    model: str
-    formulation: str
-    case: str
-    cost: str
-    resting_power: float
-    success: bool
-    status: str
-    speed_m_min: float
-    step_length: float
-    step_time: float
-    cost_value: float
-    file: str
-    start: str = ""
-    other_cost_value: float = math.nan
-    human_distance: float = field(init=False)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "human_distance",
-                           human_distance(self.speed_m_min, self.step_length)
-                           if self.success else math.nan)
-
-    def as_csv_dict(self) -> dict[str, str]:
-        out = {}
-        for col in COST_COLUMNS:
-            value = getattr(self, col)
-            if isinstance(value, bool):
-                out[col] = "true" if value else "false"
-            elif isinstance(value, float):
-                out[col] = "" if math.isnan(value) else repr(value)
-            else:
-                out[col] = str(value)
-        return out
 
 
 def direct_gait(sweep: CostSweep, directory: str | os.PathLike[str]) -> Gait | None:
@@ -418,49 +354,3 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
     return rows
 
 
-def cost_table_csv(rows: Sequence[CostRow]) -> str:
-    """The CSV text of the rows (header: :data:`COST_COLUMNS`)."""
-    return csv_text(rows, COST_COLUMNS)
-
-
-def write_cost_table(directory: str | os.PathLike[str], rows: Sequence[CostRow]) -> Path:
-    """Write ``costs.csv`` atomically."""
-    path = Path(directory) / COST_TABLE_FILE
-    write_text_atomic(path, cost_table_csv(rows))
-    return path
-
-
-def read_cost_table(path: str | os.PathLike[str]) -> list[CostRow]:
-    """Read ``costs.csv``; errors name the file, the line and the column."""
-    source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CostStudyError(f"{source}: cannot read the cost table ({exc})") from None
-    reader = csv.DictReader(io.StringIO(text))
-    missing = [c for c in COST_COLUMNS if c not in (reader.fieldnames or [])]
-    if missing:
-        raise CostStudyError(f"{source}: line 1: missing columns {', '.join(missing)}")
-    rows = []
-    for line, raw in enumerate(reader, start=2):
-        def number(col: str, raw: dict[str, str] = raw, line: int = line) -> float:
-            value = (raw[col] or "").strip()
-            try:
-                return float(value) if value else math.nan
-            except ValueError:
-                raise CostStudyError(f"{source}: line {line}: column {col}: expected a "
-                                     f"number, got {value!r}") from None
-
-        success = (raw["success"] or "").strip().lower()
-        if success not in ("true", "false"):
-            raise CostStudyError(f"{source}: line {line}: column success: expected true or "
-                                 f"false, got {success!r}")
-        rows.append(CostRow(model=raw["model"], formulation=raw["formulation"],
-                            case=raw["case"], cost=raw["cost"],
-                            resting_power=number("resting_power"), success=success == "true",
-                            status=raw["status"] or "", speed_m_min=number("speed_m_min"),
-                            step_length=number("step_length"), step_time=number("step_time"),
-                            cost_value=number("cost_value"), file=raw["file"] or "",
-                            start=raw["start"] or "",
-                            other_cost_value=number("other_cost_value")))
-    return rows

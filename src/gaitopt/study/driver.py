@@ -31,18 +31,15 @@ Ctrl-C the driver first writes every point already returned, then stops the work
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import time
-from collections.abc import Callable, Collection, Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.formulation import biped_of
+from gaitopt.gait.formulation import biped_for
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptionsError, validate_options
 from gaitopt.ocp import Result
@@ -55,43 +52,31 @@ from gaitopt.study.executors import (
     local_backend,
 )
 from gaitopt.study.plan import (
-    SETTINGS_FILE,
-    SETTINGS_FORMAT,
     SweepPoint,
     SweepSpec,
     SweepSpecError,
-    settings_differences,
-    settings_document,
-    sweep_settings,
-    with_option_defaults,
 )
 from gaitopt.study.summary import (
-    GAITS_DIR,
-    SUMMARY_FILE,
-    SummaryError,
     SummaryRow,
-    gait_relpath,
-    read_summary,
-    summary_row,
-    variant_flags,
-    write_summary,
+)
+from gaitopt.study.sweep_directory import SweepSettingsError as SweepSettingsError
+from gaitopt.study.sweep_directory import (
+    directory_lock,
+    prepare_directory,
+    remove_leftovers,
+    scan_directory,
+    write_summaries,
 )
 from gaitopt.study.worker import (
     PointOutcome,
     PointTask,
     SavedGait,
     failed_point_row,
-    gait_file_matches,
     solve_point,
 )
 
-LOCK_FILE = ".sweep.lock"
 #: Restarts of a broken process pool in a row (no point finishing between) before giving up.
 MAX_WORKER_DEATHS = 3
-
-
-class SweepSettingsError(ValueError):
-    """The sweep directory holds another sweep (or one is running there)."""
 
 
 @dataclass(frozen=True)
@@ -142,138 +127,13 @@ StartFn = Callable[[SweepStart], None]
 PointFn = Callable[[SweepPoint, PointOutcome, Counts], None]
 
 
-# -- the directory ----------------------------------------------------------------------------
-
-@contextmanager
-def directory_lock(directory: Path) -> Iterator[None]:
-    """Hold an exclusive lock on the sweep directory (released when the process ends, even
-    by SIGKILL); raise :class:`SweepSettingsError` if another sweep holds it."""
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover  (not POSIX: no lock)
-        yield
-        return
-    fh = open(directory / LOCK_FILE, "a")  # noqa: SIM115  (held for the whole sweep)
-    try:
-        try:
-            fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise SweepSettingsError(f"{directory}: another sweep is running in this "
-                                     "directory; wait for it or use another directory") from None
-        yield
-    finally:
-        fh.close()
-
-
-def prepare_directory(spec: SweepSpec, directory: Path) -> None:
-    """Create the directory and write ``sweep.json``, or check that the one there has the
-    same settings (:class:`SweepSettingsError` otherwise)."""
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / SETTINGS_FILE
-    wanted = sweep_settings(spec)
-    if path.exists():
-        try:
-            saved = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise SweepSettingsError(f"{path}: cannot read the sweep settings ({exc})") from None
-        if not isinstance(saved, dict) or saved.get("format") != SETTINGS_FORMAT:
-            raise SweepSettingsError(f"{path}: not a gaitopt sweep settings file")
-        diffs = settings_differences(with_option_defaults(saved.get("settings", {})), wanted)
-        if diffs:
-            raise SweepSettingsError(
-                f"{directory} holds a sweep made with other settings, so it cannot be resumed "
-                f"with these; use another directory (-o) or the same settings. Differences: "
-                + "; ".join(diffs))
-        return
-    if (directory / SUMMARY_FILE).exists() or (directory / GAITS_DIR).exists():
-        raise SweepSettingsError(f"{directory} holds sweep results but no {SETTINGS_FILE}; "
-                                 "use another directory")
-    write_text_atomic(path, json.dumps(settings_document(spec), indent=2) + "\n")
-
-
-def remove_leftovers(directory: Path) -> int:
-    """Delete the temporary files of atomic writes interrupted by a kill (``.<name>.*.tmp``
-    next to gait files and summaries); returns how many."""
-    count = 0
-    for path in directory.rglob(".*.tmp"):
-        if path.is_file() and (".gait.json." in path.name or path.name.startswith(
-                (f".{SUMMARY_FILE}.", f".{SETTINGS_FILE}."))):
-            path.unlink(missing_ok=True)
-            count += 1
-    return count
-
-
-@dataclass
-class _Scan:
-    kept: dict[str, SummaryRow] = field(default_factory=dict)
-    old_failed: dict[str, SummaryRow] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-
-
-def scan_directory(spec: SweepSpec, directory: Path) -> _Scan:
-    """Which points an earlier run finished (see the module docstring), and the failed rows
-    it recorded for the others."""
-    scan = _Scan()
-    for point in spec.points:
-        path = directory / point.key
-        if not path.exists():
-            continue
-        try:
-            gait = Gait.load(path)
-        except GaitFileError as exc:
-            scan.notes.append(f"{point.key}: unreadable ({exc}); solving it again")
-            continue
-        why = gait_file_matches(gait, spec.model, spec.options(point))
-        if why:
-            scan.notes.append(f"{point.key}: not kept, {why}; solving it again")
-            continue
-        ankle, impulse = variant_flags(point.variant)
-        scan.kept[point.key] = summary_row(gait, ankle=ankle, impulse=impulse,
-                                           speed_mode=point.speed_mode, file=point.relfile)
-    by_key = {p.key: p for p in spec.points}
-    for sub in sorted({p.subdir for p in spec.points}):
-        summary = directory / sub / SUMMARY_FILE
-        if not summary.exists():
-            continue
-        try:
-            rows = read_summary(summary)
-        except SummaryError as exc:
-            scan.notes.append(f"ignoring the earlier summary: {exc}")
-            continue
-        for row in rows:
-            if row.success:
-                continue
-            speed = None if row.speed_mode == "free" else row.speed_m_s
-            if speed is not None and not math.isfinite(speed):
-                continue
-            rel = gait_relpath(ankle=row.ankle, impulse=row.impulse, speed_mode=row.speed_mode,
-                               speed_m_s=speed)
-            key = f"{sub}/{rel}" if sub else rel
-            if key in by_key and key not in scan.kept:
-                scan.old_failed[key] = row
-    return scan
-
-
-def write_summaries(spec: SweepSpec, directory: Path, rows: dict[str, SummaryRow],
-                    subdirs: Collection[str] | None = None) -> list[Path]:
-    """Write ``summary.csv`` of each sub-sweep (``subdirs``: only these) from ``rows``, in
-    grid order (variant, speed ascending, speed-free last)."""
-    written = []
-    for sub in sorted({p.subdir for p in spec.points}):
-        if subdirs is not None and sub not in subdirs:
-            continue
-        ordered = [rows[p.key] for p in spec.points if p.subdir == sub and p.key in rows]
-        written.append(write_summary(directory / sub / SUMMARY_FILE, ordered))
-    return written
-
-
 def check_points(spec: SweepSpec) -> None:
     """Validate every point's options before any solve (:class:`SweepSpecError` names the
     point and the option)."""
     for point in spec.points:
         options = spec.options(point)  # the legs as the point's formulation sees them
         try:
-            validate_options(options, biped_of(spec.model, options))
+            validate_options(options, biped_for(spec.model, options))
         except GaitOptionsError as exc:
             raise SweepSpecError(f"{point.label().strip()}: {exc}") from None
 

@@ -99,16 +99,7 @@ class SummaryRow:
             raise ValueError(f"speed_mode: expected 'fixed' or 'free', got {self.speed_mode!r}")
 
     def as_csv_dict(self) -> dict[str, str]:
-        out: dict[str, str] = {}
-        for col in SUMMARY_COLUMNS:
-            value: Any = getattr(self, col)
-            if isinstance(value, bool):
-                out[col] = "true" if value else "false"
-            elif isinstance(value, float):
-                out[col] = "" if math.isnan(value) else repr(value)
-            else:
-                out[col] = str(value)
-        return out
+        return csv_cells(self, SUMMARY_COLUMNS)
 
 
 def summary_row(gait: Gait, *, ankle: bool, impulse: bool, speed_mode: SpeedMode,
@@ -131,6 +122,21 @@ def failed_row(*, ankle: bool, impulse: bool, speed_mode: SpeedMode, status: str
         speed_mode=speed_mode, speed_m_s=speed_m_s, speed_m_min=speed_m_s * 60.0,
         step_length=math.nan, step_time=math.nan, cost=math.nan, status=status, success=False,
         iterations=iterations, wall_time_s=wall_time_s, file="")
+
+
+def csv_cells(row: Any, columns: Sequence[str]) -> dict[str, str]:
+    """The CSV cells of ``row``'s attributes ``columns``: booleans ``true``/``false``, floats
+    by ``repr`` (exact round trip) with NaN as an empty cell, anything else by ``str``."""
+    out: dict[str, str] = {}
+    for col in columns:
+        value: Any = getattr(row, col)
+        if isinstance(value, bool):
+            out[col] = "true" if value else "false"
+        elif isinstance(value, float):
+            out[col] = "" if math.isnan(value) else repr(value)
+        else:
+            out[col] = str(value)
+    return out
 
 
 def csv_text(rows: Iterable[Any], columns: Sequence[str]) -> str:

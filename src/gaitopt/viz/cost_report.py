@@ -24,12 +24,8 @@ from matplotlib.figure import Figure
 
 from gaitopt.fileio import write_text_atomic
 from gaitopt.study.cost_findings import assess_cost_findings, physiological, ranked
-from gaitopt.study.cost_study import (
-    COST_TABLE_FILE,
-    HUMAN_RESTING_POWER,
-    CostRow,
-    read_cost_table,
-)
+from gaitopt.study.cost_study import HUMAN_RESTING_POWER
+from gaitopt.study.cost_table import COST_TABLE_FILE, CostRow, read_cost_table
 from gaitopt.study.findings import (
     HUMAN_OPTIMAL_SPEED_M_MIN,
     HUMAN_STEP_LENGTH,
@@ -145,7 +141,7 @@ def write_cost_report(study_dir: str | os.PathLike[str], out_dir: str | os.PathL
                       svg: bool = True) -> CostReportInfo:
     """Write the cost study's report (module docstring) from ``study_dir/costs.csv``.
 
-    Raises :class:`gaitopt.study.cost_study.CostStudyError` if the table is missing or
+    Raises :class:`gaitopt.study.cost_table.CostStudyError` if the table is missing or
     invalid."""
     rows = read_cost_table(Path(study_dir) / COST_TABLE_FILE)
     out = Path(out_dir)

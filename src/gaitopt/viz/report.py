@@ -1,5 +1,8 @@
 """The report of a sweep: one self-contained HTML file plus every figure as PNG and SVG.
 
+(One concept, kept whole at about 410 lines: one HTML page, its sections and tables; the
+figures are drawn in :mod:`gaitopt.viz.sweep_figures`.)
+
 ``write_report(sweep_dir, out_dir)`` reads the sweep directory (``summary.csv`` and the gait
 files it names, layout in :mod:`gaitopt.study.summary`) and writes to ``out_dir``:
 

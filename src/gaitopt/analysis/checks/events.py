@@ -26,9 +26,9 @@ from gaitopt.analysis.checks.check import Check, Worst
 from gaitopt.dynamics.functions import impact_function, liftoff_function
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, sequence_from_dict
-from gaitopt.gait.full_physics import model_symmetry, per_point
+from gaitopt.gait.full_physics import per_point
 from gaitopt.gait.gait_file import Gait, GaitEvent
-from gaitopt.robot.symmetry import swap_names, swap_permutations
+from gaitopt.robot.symmetry import leg_swap, swap_names, swap_permutations
 
 Array = NDArray[np.float64]
 
@@ -62,7 +62,7 @@ def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...], i: int
     spec = _sequence_event(gait, i, event)
     if spec is not None:
         seq, ev = spec
-        after = seq.holds_after(i, model_symmetry(model).contacts)
+        after = seq.holds_after(i, leg_swap(model).contacts)
         touchdown, impulse = bool(ev.touchdown), ev.impulse
     else:
         touchdown, impulse = event.name in TOUCHDOWNS, event.name in IMPULSE_RELEASES

@@ -38,7 +38,7 @@ from gaitopt.dynamics.rnea import rnea
 from gaitopt.gait import walking
 from gaitopt.gait.contact_sequence import phase_holds, sequence_from_dict
 from gaitopt.gait.gait_file import Gait, GaitPhase
-from gaitopt.robot.biped import biped_structure
+from gaitopt.robot.biped import biped_of
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -151,8 +151,8 @@ def ground_points(gait: Gait) -> dict[str, Array]:
         anchored = dict(seq.anchors)
         return {c.name: np.array([seq.ground_x(c.name, step) if c.name in anchored else np.nan,
                                   0.0]) for c in gait.model.contacts}
-    legs = biped_structure(gait.model).legs
-    return {legs[0].contact: np.array([0.0, 0.0]), legs[1].contact: np.array([step, 0.0])}
+    stance, swing = biped_of(gait.model).contacts
+    return {stance: np.array([0.0, 0.0]), swing: np.array([step, 0.0])}
 
 
 def body_size(model: RobotModel) -> float:

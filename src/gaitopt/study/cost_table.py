@@ -1,0 +1,121 @@
+"""The cost study's results table: one row per (model, case), the speed-free optimum, and its
+file ``costs.csv`` (:mod:`gaitopt.study.cost_study` fills it; :mod:`gaitopt.viz.cost_report`
+and :mod:`gaitopt.study.cost_findings` read it).
+
+Columns (:data:`COST_COLUMNS`): the model, its formulation, the case (``paper``, ``work``,
+``metabolic-rest-<P>``), the cost and resting power (W/kg), whether the solve converged and
+its status, speed (m/min), step length (m), step time (s), the cost's value (its own units,
+docs/costs.md), the distance from human walking (:func:`human_distance`), which start won and
+the other start's cost, and the gait file relative to the study directory. NaN is written as
+an empty cell.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from gaitopt.fileio import write_text_atomic
+from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH
+from gaitopt.study.summary import csv_cells, csv_text
+
+COST_TABLE_FILE = "costs.csv"
+COST_COLUMNS: tuple[str, ...] = (
+    "model", "formulation", "case", "cost", "resting_power", "success", "status",
+    "speed_m_min", "step_length", "step_time", "cost_value", "human_distance", "start",
+    "other_cost_value", "file")
+
+
+class CostStudyError(ValueError):
+    """A cost study request or its files are invalid (names the setting or the file)."""
+
+
+def human_distance(speed_m_min: float, step_length: float) -> float:
+    """``sqrt((v / 80 - 1)^2 + (L / 0.75 - 1)^2)``: 0 at people's walk
+    (:mod:`gaitopt.study.cost_study`)."""
+    return math.hypot(speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN - 1.0,
+                      step_length / HUMAN_STEP_LENGTH - 1.0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class CostRow:
+    """The speed-free optimum of one (model, case): speed m/min, step m, step time s, the
+    cost's value (its own units, docs/costs.md), NaN where the solve failed; ``file`` the gait
+    file relative to the study directory."""
+
+    model: str
+    formulation: str
+    case: str
+    cost: str
+    resting_power: float
+    success: bool
+    status: str
+    speed_m_min: float
+    step_length: float
+    step_time: float
+    cost_value: float
+    file: str
+    start: str = ""
+    other_cost_value: float = math.nan
+    human_distance: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "human_distance",
+                           human_distance(self.speed_m_min, self.step_length)
+                           if self.success else math.nan)
+
+    def as_csv_dict(self) -> dict[str, str]:
+        return csv_cells(self, COST_COLUMNS)
+
+
+def cost_table_csv(rows: Sequence[CostRow]) -> str:
+    """The CSV text of the rows (header: :data:`COST_COLUMNS`)."""
+    return csv_text(rows, COST_COLUMNS)
+
+
+def write_cost_table(directory: str | os.PathLike[str], rows: Sequence[CostRow]) -> Path:
+    """Write ``costs.csv`` atomically."""
+    path = Path(directory) / COST_TABLE_FILE
+    write_text_atomic(path, cost_table_csv(rows))
+    return path
+
+
+def read_cost_table(path: str | os.PathLike[str]) -> list[CostRow]:
+    """Read ``costs.csv``; errors name the file, the line and the column."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise CostStudyError(f"{source}: cannot read the cost table ({exc})") from None
+    reader = csv.DictReader(io.StringIO(text))
+    missing = [c for c in COST_COLUMNS if c not in (reader.fieldnames or [])]
+    if missing:
+        raise CostStudyError(f"{source}: line 1: missing columns {', '.join(missing)}")
+    rows = []
+    for line, raw in enumerate(reader, start=2):
+        def number(col: str, raw: dict[str, str] = raw, line: int = line) -> float:
+            value = (raw[col] or "").strip()
+            try:
+                return float(value) if value else math.nan
+            except ValueError:
+                raise CostStudyError(f"{source}: line {line}: column {col}: expected a "
+                                     f"number, got {value!r}") from None
+
+        success = (raw["success"] or "").strip().lower()
+        if success not in ("true", "false"):
+            raise CostStudyError(f"{source}: line {line}: column success: expected true or "
+                                 f"false, got {success!r}")
+        rows.append(CostRow(model=raw["model"], formulation=raw["formulation"],
+                            case=raw["case"], cost=raw["cost"],
+                            resting_power=number("resting_power"), success=success == "true",
+                            status=raw["status"] or "", speed_m_min=number("speed_m_min"),
+                            step_length=number("step_length"), step_time=number("step_time"),
+                            cost_value=number("cost_value"), file=raw["file"] or "",
+                            start=raw["start"] or "",
+                            other_cost_value=number("other_cost_value")))
+    return rows
