@@ -38,11 +38,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from gaitopt.gait.check_grid import CHECK_KNOTS, check_knots, first_order_factor
 from gaitopt.study.plan import SETTINGS_FILE
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, read_summary
 
-#: The check grid of the known study grids; any other grid is refined by half its knots.
-CHECK_KNOTS: dict[tuple[int, int], tuple[int, int]] = {(16, 6): (24, 8), (8, 5): (16, 6)}
 #: The relative cost change the statements single out: where the estimate exceeds it, they say
 #: at how many points and at which speeds.
 WITHIN = 0.01
@@ -50,12 +49,6 @@ WITHIN = 0.01
 CHECK_DIR = "check-grid"
 #: The folder of the refinement sweep inside the study directory.
 REFINE_DIR = "refine-grid"
-
-
-def check_knots(knots: tuple[int, int]) -> tuple[int, int]:
-    """The finer grid of the check sweep: :data:`CHECK_KNOTS`, else 1.5 times the knots."""
-    k = (int(knots[0]), int(knots[1]))
-    return CHECK_KNOTS.get(k, (math.ceil(1.5 * k[0]), math.ceil(1.5 * k[1])))
 
 
 @dataclass(frozen=True)
@@ -115,17 +108,6 @@ class PointError:
         optimum) the speed: what decides a refinement."""
         return max(self.cost_error, self.step_error / abs(self._finer.step_length),
                    self.speed_error / abs(self._finer.speed_m_min))
-
-
-def first_order_factor(coarse: int, fine: int, *, of_finer: bool) -> float:
-    """Error of a grid from the change between two grids of ``coarse`` and ``fine`` knots
-    (single support), if the error falls as ``C / knots``: the coarse grid's error is the
-    change times ``fine / (fine - coarse)`` (3 for 16 to 24 knots), the fine grid's times
-    ``coarse / (fine - coarse)`` (2 for 24 to 36). With the measured orders of the default
-    grids (1.3 to 2, docs/walking.md section 6) it overestimates the error."""
-    if fine <= coarse:
-        return 1.0
-    return (coarse if of_finer else fine) / (fine - coarse)
 
 
 def _key(row: SummaryRow) -> tuple[str, str, float]:
@@ -314,3 +296,7 @@ def knot_spacing(sweep_dir: str | os.PathLike[str]) -> str:
         return str(settings["settings"]["options"].get("knot_spacing", "uniform"))
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return "uniform"
+
+
+__all__ = ["CHECK_DIR", "CHECK_KNOTS", "REFINE_DIR", "WITHIN", "GridError", "PointError",
+           "check_knots", "first_order_factor", "grid_error", "knot_spacing", "sweep_grid"]
