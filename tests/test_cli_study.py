@@ -15,6 +15,7 @@ from gaitopt.cli.study import parse_speeds, parse_variants
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.driver import prepare_directory
+from gaitopt.study.grid_error import grid_error
 from gaitopt.study.plan import SweepSpec
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, read_summary
 from tests.viz.synthetic import synthetic_gait, synthetic_sweep
@@ -194,6 +195,10 @@ def test_study_writes_the_report_and_an_animation(runner: CliRunner, tmp_path: P
     assert again and all(r.success for r in again)
     assert list(Gait.load(folder / "refine-grid" / again[0].file).options["knots"]) == [36, 12]
     assert "36+12 knots at the" in page and f"refine-grid/{again[0].file}" in page
+    # After the refinement levels every figure is within 1 % by its estimate.
+    errors = grid_error(folder, rows)
+    assert errors is not None and len(errors.points) == 16
+    assert all(p.relative <= 0.01 for p in errors.points)
 
 
 def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,

@@ -315,14 +315,14 @@ def _optimum_error(errors: GridError | None, row: SummaryRow) -> str:
         return "not checked"
     p = found[0]
     grid = f"to {errors.check_knots[0]}+{errors.check_knots[1]}"
-    if p.refined and errors.refine_knots is not None:
-        grid = (f"solved on {errors.refine_knots[0]}+{errors.refine_knots[1]}, change from "
-                f"{errors.check_knots[0]}+{errors.check_knots[1]}")
+    if p.refined and p.grid is not None and p.check_grid is not None:
+        grid = (f"solved on {p.grid[0]}+{p.grid[1]}, change from "
+                f"{p.check_grid[0]}+{p.check_grid[1]}")
     moved = "" if row.speed_mode == "fixed" else f"speed {p.speed_m_min:+.2f} m/min, "
     estimate = "" if row.speed_mode == "fixed" else f"speed {p.speed_error:.2f} m/min, "
     return (f"{grid} knots: cost {100 * p.cost:.2f} %, {moved}step {p.step_length:+.4f} m; "
             f"error estimate ({p.factor:g} x): cost {100 * p.cost_error:.2f} %, {estimate}"
-            f"step {p.step_error:.4f} m")
+            f"step {p.step_error:.4f} m ({100 * p.step_relative:.2f} %)")
 
 
 def _solver_table(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None],
