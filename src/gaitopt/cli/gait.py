@@ -313,7 +313,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
                   f"equality, {s['inequality_constraints']} inequality constraints")
     table.add_row("iterations (last stage)", str(s["iterations"]))
-    for row in accuracy_rows(s["accuracy"]):
+    for row in accuracy_rows(s["accuracy"], speed=gait.speed, step_length=gait.step_length):
         table.add_row(*row)
     table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
     console.print(table)
@@ -328,9 +328,11 @@ def phase_fractions_text(sequence: ContactSequence, gait: Gait) -> str:
                      for ph, rec in zip(sequence.phases, solved, strict=True))
 
 
-def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
-    """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase and
-    the cost's discretization error estimate."""
+def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
+                  step_length: float | None = None) -> list[tuple[str, str]]:
+    """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase,
+    the cost's discretization error estimate and how far speed and step length moved (with
+    their estimates relative to the gait's ``speed`` and ``step_length`` when given)."""
     errors = ", ".join(f"{name} {'n/a' if e is None else f'{e:.1e}'} "
                        f"({accuracy['knots'][name]} knots)"
                        for name, e in accuracy["collocation_error"].items())
@@ -360,10 +362,15 @@ def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
         text = f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"
         ev, el = accuracy.get("speed_error"), accuracy.get("step_length_error")
         if check is not None and ev is not None and el is not None:
-            text += (f"; estimate {factor:g} x: speed {60 * ev:.3f} m/min, step length "
-                     f"{el:.4f} m")
+            text += (f"; estimate {factor:g} x: speed {60 * ev:.3f} m/min{_share(ev, speed)}, "
+                     f"step length {el:.4f} m{_share(el, step_length)}")
         rows.append((moved, text))
     return rows
+
+
+def _share(error: float, value: float | None) -> str:
+    """`` (0.55 %)``: ``error`` relative to ``value`` (nothing without a value)."""
+    return "" if not value else f" ({100 * error / abs(value):.2f} %)"
 
 
 @cli.command("verify")
