@@ -207,11 +207,12 @@ def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,
     gait."""
     for name, args, expected in (
             ("full", ["--formulation", "full", "--control-model", "jumps"],
-             {"formulation": "full", "control_model": "jumps", "cost": "paper"}),
+             {"formulation": "full", "control_model": "jumps", "cost": "paper",
+              "knot_spacing": "cosine"}),  # the default spacing
             ("metabolic", ["--cost", "metabolic", "--resting-power", "2.0",
-                           "--knot-spacing", "cosine"],
+                           "--knot-spacing", "uniform"],
              {"formulation": "reduced", "cost": "metabolic", "resting_power": 2.0,
-              "knot_spacing": "cosine"})):
+              "knot_spacing": "uniform"})):
         folder = tmp_path / name
         result = runner.invoke(cli, ["sweep", "-o", str(folder), "--speeds", "12,15",
                                      "--variants", "ankle", "--no-free", "--workers", "0",

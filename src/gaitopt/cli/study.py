@@ -309,8 +309,9 @@ def _workers_option(f: Any) -> Any:
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
 @min_knee_flexion_option
-@_spacing_option("uniform", "The knots of each phase: uniform, or cosine-spaced (clustered at "
-                            "the events; docs/walking.md section 6).")
+@_spacing_option("cosine", "The knots of each phase: cosine-spaced (clustered at the events, "
+                           "the default of every solve since 2026-12-02; docs/walking.md "
+                           "section 6) or uniform (always with --paper-grid).")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
