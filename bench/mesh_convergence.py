@@ -62,7 +62,9 @@ def worst_interval(result: Result) -> str:
 def row(model: str, grid: tuple[int, int], clearance: float | None,
         profile: str = "quartic") -> dict[str, Any]:
     robot = load_model("five-link")
-    options = GaitOptions(knots=grid, swing_clearance=clearance,
+    # Uniform knots, as the tables of docs/walking.md section 6 were measured (the default
+    # spacing is cosine since 2026-12-02).
+    options = GaitOptions(knots=grid, swing_clearance=clearance, knot_spacing="uniform",
                           clearance_profile=profile,  # type: ignore[arg-type]
                           **MODELS[model])
     start = time.perf_counter()
