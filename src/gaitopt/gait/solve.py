@@ -339,13 +339,16 @@ class _Run:
     def check(self, result: Result) -> None:
         """Stage ``check grid``: the problem on :func:`~gaitopt.gait.check_grid.check_knots`
         of the requested knots (same spacing), everything free, from ``result``'s values and
-        multipliers. Its cost (kept in ``grid_costs`` after the answer's) is what the cost
-        error estimate compares with (:mod:`gaitopt.gait.accuracy`); a check that fails
-        leaves the answer without that estimate, never changes it."""
+        multipliers, with the target grid's Hessian (quasi-Newton in the compressed form, whose
+        exact Hessian takes seconds to build). Its cost (kept in ``grid_costs`` after the
+        answer's) is what the cost error estimate compares with
+        (:mod:`gaitopt.gait.accuracy`); a check that fails leaves the answer without that
+        estimate, never changes it."""
         o = self.options
         finer = o.replace(knots=check_knots(o.knots))
         self.stage("check grid", target_grid(self.model, finer), Relaxation(), result,
-                   parameter_bounds(o), solver_options=PRIMAL_WARM_OPTIONS)
+                   parameter_bounds(o),
+                   solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
 
     def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
         """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
