@@ -18,9 +18,10 @@ Every figure's caption and the headline table state the sweep's grid (knots and 
 and, when a check sweep on a finer grid exists (``<sweep>/check-grid``, written by ``gaitopt
 study``; :mod:`gaitopt.study.grid_error`), the error estimate of what it shows: the largest
 change of the cost (or step length) to the finer grid over the points shown, and for each
-speed-free optimum how far its speed and step length move. Points re-solved in a refinement
-sweep (``<sweep>/refine-grid``) are shown with their refined values and gaits, and the
-captions say on which grid and with which estimate (the change from the check grid).
+speed-free optimum how far its speed and step length move (step lengths in m and relative).
+Points re-solved in refinement sweeps (``<sweep>/refine-grid``, ``refine-grid-2``, ...) are
+shown with their values and gaits on their finest grid, and the captions say on which grids
+and with which estimate (the change from the grid before).
 """
 
 from __future__ import annotations
