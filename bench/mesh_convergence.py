@@ -15,7 +15,7 @@ Run: ``python bench/mesh_convergence.py [--models paper jumps] [--grids 8,5 16,6
 
 ``--study DIR`` measures the converged values of a study (``gaitopt study -o DIR``) instead:
 for each ``--variants`` x ``--speeds`` point (m/min, or ``free`` for the speed-free optimum)
-it takes the point's gait from the study's finest grid (its refinement sweep, else its check
+it takes the point's gait from the study's finest grid (its deepest refinement sweep, else its check
 sweep), solves the same problem warm-started from it on each ``--grids`` grid in turn (each
 from the previous; ``--spacing`` uniform or cosine knots, default the study's), and prints
 each grid's values and their distance to the finest grid (cost relative).
@@ -40,7 +40,7 @@ from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import solve_walking
 from gaitopt.ocp import Result
 from gaitopt.robot import load_model
-from gaitopt.study.grid_error import CHECK_DIR, REFINE_DIR, sweep_grid
+from gaitopt.study.grid_error import CHECK_DIR, MAX_REFINE_LEVELS, refine_dir_name, sweep_grid
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, read_summary
 
 MODELS: dict[str, dict[str, Any]] = {
@@ -62,7 +62,9 @@ def worst_interval(result: Result) -> str:
 def row(model: str, grid: tuple[int, int], clearance: float | None,
         profile: str = "quartic") -> dict[str, Any]:
     robot = load_model("five-link")
-    options = GaitOptions(knots=grid, swing_clearance=clearance,
+    # Uniform knots, as the tables of docs/walking.md section 6 were measured (the default
+    # spacing is cosine since 2026-12-02).
+    options = GaitOptions(knots=grid, swing_clearance=clearance, knot_spacing="uniform",
                           clearance_profile=profile,  # type: ignore[arg-type]
                           **MODELS[model])
     start = time.perf_counter()
@@ -96,9 +98,10 @@ def line(r: dict[str, Any]) -> str:
 
 def study_grids(study: Path) -> list[tuple[str, Path]]:
     """The study's sweeps, coarse to fine: (``16+6``, directory) for the main, check and
-    refinement sweeps that exist."""
+    refinement sweeps (every level) that exist."""
     out = []
-    for d in (study, study / CHECK_DIR, study / REFINE_DIR):
+    levels = [study / refine_dir_name(k) for k in range(1, MAX_REFINE_LEVELS + 1)]
+    for d in (study, study / CHECK_DIR, *levels):
         grid = sweep_grid(d)
         if grid is not None and (d / SUMMARY_FILE).exists():
             out.append((f"{grid[0][0]}+{grid[0][1]}", d))

@@ -52,7 +52,8 @@ def test_the_options_reach_the_gait_file_and_the_summary(tmp_path: Path) -> None
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert "collocation error (largest per interval)" in text
-    assert "cost error estimate" in text and "n/a (one grid" in text
+    # cosine-spaced 8 + 5 knots (the default spacing) checked on 16 + 6 (factor 16 / 8)
+    assert "cost error estimate" in text and "2 x the change to 16+6 knots" in text
     options = Gait.load(out).options
     assert options["control_model"] == "jumps" and options["swing_clearance"] == 0.01
     assert options["clearance_profile"] == "quartic" and options["mesh_tol"] is None

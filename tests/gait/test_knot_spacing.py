@@ -28,7 +28,9 @@ def test_cosine_knots_cluster_at_both_ends() -> None:
 
 def test_target_grid() -> None:
     model = load_model("five-link")
-    assert target_grid(model, GaitOptions()) == (16, 6)
+    assert target_grid(model, GaitOptions(knot_spacing="uniform")) == (16, 6)
+    assert GaitOptions().knot_spacing == "cosine" == GaitOptions.paper(knot_spacing="cosine"
+                                                                       ).knot_spacing
     ss, ds = target_grid(model, GaitOptions(knot_spacing="cosine", knots=(24, 8)))
     np.testing.assert_array_equal(ss, cosine_knots(24))
     np.testing.assert_array_equal(ds, cosine_knots(8))

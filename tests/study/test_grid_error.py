@@ -193,3 +193,48 @@ def test_grid_error_reads_the_refinement_sweep(tmp_path: Path) -> None:
     errors = grid_error(tmp_path, study)
     assert errors is not None and errors.refine_knots == (36, 12)
     assert errors.reported(study)[0].cost == 1020.0
+
+
+def test_a_point_refined_twice_reports_its_finest_grid_and_the_one_before() -> None:
+    """45 m/min: re-solved on 36 + 12 (step still 1.3 % off by 2 x its change) and again on
+    54 + 18: the study reports the 54 + 18 row with 2 x its change from 36 + 12 (54 / 27),
+    says which grid each re-solved point is on, and states step lengths relative too."""
+    from gaitopt.study.grid_error import RefineLevel
+
+    study = [row("plain", v, 1000.0, 0.3) for v in (12.0, 45.0)]
+    check = [row("plain", 12.0, 999.0, 0.3), row("plain", 45.0, 1015.0, 0.3)]
+    level1 = RefineLevel((row("plain", 45.0, 1016.0, 0.298),), (36, 12), "refine-grid")
+    once = GridError.compare(study, check, knots=(16, 6), control_model="jumps",
+                             check=(24, 8), refine_levels=[level1])
+    p45 = once.of([study[1]])[0]
+    assert p45.level == 1 and p45.step_relative == pytest.approx(2 * 0.002 / 0.298)
+    assert [p.row.speed_m_min for p in once.to_refine(2)] == [45.0]  # 1.3 % > 1 %
+    assert once.to_refine(1) == [] == once.to_refine()  # 12 m/min is within 1 %
+    level2 = RefineLevel((row("plain", 45.0, 1016.5, 0.2976),), (54, 18), "refine-grid-2")
+    twice = GridError.compare(study, check, knots=(16, 6), control_model="jumps",
+                              check=(24, 8), refine_levels=[level1, level2])
+    p45 = twice.of([study[1]])[0]
+    assert (p45.level, p45.grid, p45.check_grid, p45.factor) == (2, (54, 18), (36, 12), 2.0)
+    assert p45.row.cost == 1016.5 and p45.check.cost == 1016.0
+    assert p45.step_error == pytest.approx(2 * 0.0004)
+    assert twice.levels == ((36, 12), (54, 18)) and twice.to_refine(3) == []
+    assert twice.reported(study)[1].cost == 1016.5
+    text = twice.statement(what="step length")
+    assert "54+18 knots at the 1 point (45 m/min)" in text
+    assert "2 x the change from 36+12 knots to 54+18 knots" in text
+    assert f"step length within 0.0008 m and {100 * 0.0008 / 0.2976:.2f} %" in text
+
+
+def test_grid_error_reads_every_refinement_level(tmp_path: Path) -> None:
+    study = [row("plain", 45.0, 1000.0, 0.3)]
+    settings(tmp_path, (16, 6), "jumps")
+    settings(tmp_path / CHECK_DIR, (24, 8), "jumps")
+    write_summary(tmp_path / CHECK_DIR / "summary.csv", [row("plain", 45.0, 1015.0, 0.3)])
+    for folder, knots, cost in ((REFINE_DIR, (36, 12), 1020.0),
+                                (f"{REFINE_DIR}-2", (54, 18), 1021.0)):
+        settings(tmp_path / folder, knots, "jumps")
+        write_summary(tmp_path / folder / "summary.csv", [row("plain", 45.0, cost, 0.3)])
+    errors = grid_error(tmp_path, study)
+    assert errors is not None and errors.levels == ((36, 12), (54, 18))
+    assert errors.reported(study)[0].cost == 1021.0
+    assert errors.points[0].cost_error == pytest.approx(2.0 / 1021.0)

@@ -313,7 +313,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
                   f"equality, {s['inequality_constraints']} inequality constraints")
     table.add_row("iterations (last stage)", str(s["iterations"]))
-    for row in accuracy_rows(s["accuracy"]):
+    for row in accuracy_rows(s["accuracy"], speed=gait.speed, step_length=gait.step_length):
         table.add_row(*row)
     table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
     console.print(table)
@@ -328,9 +328,11 @@ def phase_fractions_text(sequence: ContactSequence, gait: Gait) -> str:
                      for ph, rec in zip(sequence.phases, solved, strict=True))
 
 
-def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
-    """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase and
-    the cost's discretization error estimate."""
+def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
+                  step_length: float | None = None) -> list[tuple[str, str]]:
+    """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase,
+    the cost's discretization error estimate and how far speed and step length moved (with
+    their estimates relative to the gait's ``speed`` and ``step_length`` when given)."""
     errors = ", ".join(f"{name} {'n/a' if e is None else f'{e:.1e}'} "
                        f"({accuracy['knots'][name]} knots)"
                        for name, e in accuracy["collocation_error"].items())
@@ -340,17 +342,35 @@ def accuracy_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
     rows = [("collocation error (largest per interval)", errors)]
     if accuracy["cost_error"] is None:
         rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
+        return rows
+    check = accuracy.get("check_knots")
+    grid = "+".join(str(k) for k in (check or accuracy["previous_knots"]).values())
+    factor = accuracy.get("cost_error_factor") or 1.0
+    rel = accuracy.get("cost_error_relative")
+    if check is not None:
+        how = f"{factor:g} x the change to {grid} knots, J {accuracy['check_cost']:.6g}"
+        moved = f"change to {grid} knots"
     else:
-        prev = "+".join(str(k) for k in accuracy["previous_knots"].values())
-        rel = accuracy.get("cost_error_relative")
-        share = "" if rel is None else f" = {100 * rel:.2g} % of J"
-        rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} "
-                     f"(change from {prev} knots, J {accuracy['previous_cost']:.6g})"))
-        dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
-        if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
-            rows.append(("change from " + prev + " knots",
-                         f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"))
+        how = f"change from {grid} knots, J {accuracy['previous_cost']:.6g}"
+        moved = f"change from {grid} knots"
+    share = "" if rel is None else (
+        f" = {100 * rel:.2f} % of J: " + ("within 1 %" if rel <= 0.01 else
+                                          "above 1 % (a finer --knots or --mesh-tol 1e-4)"))
+    rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} ({how})"))
+    dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
+    if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
+        text = f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"
+        ev, el = accuracy.get("speed_error"), accuracy.get("step_length_error")
+        if check is not None and ev is not None and el is not None:
+            text += (f"; estimate {factor:g} x: speed {60 * ev:.3f} m/min{_share(ev, speed)}, "
+                     f"step length {el:.4f} m{_share(el, step_length)}")
+        rows.append((moved, text))
     return rows
+
+
+def _share(error: float, value: float | None) -> str:
+    """`` (0.55 %)``: ``error`` relative to ``value`` (nothing without a value)."""
+    return "" if not value else f" ({100 * error / abs(value):.2f} %)"
 
 
 @cli.command("verify")

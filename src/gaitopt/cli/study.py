@@ -43,11 +43,12 @@ from gaitopt.study.driver import default_workers
 from gaitopt.study.executors import BackendError
 from gaitopt.study.grid_error import (
     CHECK_DIR,
-    REFINE_DIR,
+    MAX_REFINE_LEVELS,
     WITHIN,
     GridError,
     check_knots,
     grid_error,
+    refine_dir_name,
 )
 from gaitopt.study.plan import START_SPEED, SweepSpecError
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
@@ -107,8 +108,9 @@ def _workers_option(f: Any) -> Any:
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
 @min_knee_flexion_option
-@_spacing_option("uniform", "The knots of each phase: uniform, or cosine-spaced (clustered at "
-                            "the events; docs/walking.md section 6).")
+@_spacing_option("cosine", "The knots of each phase: cosine-spaced (clustered at the events, "
+                           "the default of every solve since 2026-12-02; docs/walking.md "
+                           "section 6) or uniform (always with --paper-grid).")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
@@ -261,35 +263,48 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
 def refine_points(console: Console, directory: Path, model_name: str, grid: dict[str, Any],
                   errors: GridError | None, *, workers: int | None,
                   scheduler: str | None) -> None:
-    """The refinement sweep of a study (:mod:`gaitopt.study.grid_error`): the points whose
-    change to the check grid exceeds 1 % (every variant at their speeds, and the speed-free
-    optima if one of them is among them), solved on the next finer grid in
-    ``DIR/refine-grid``, each warm-started from the check sweep's gait of the same point
-    (no continuation: the points are independent and may be far apart in speed)."""
+    """The refinement sweeps of a study (:mod:`gaitopt.study.grid_error`): the points whose
+    estimate exceeds 1 % (cost, step length or the speed of a speed-free optimum; every
+    variant at their speeds, and the speed-free optima if one of them is among them), solved
+    on the next finer grid (1.5 times the knots) in ``DIR/refine-grid``, each warm-started
+    from the check sweep's gait of the same point (no continuation: the points are
+    independent and may be far apart in speed); then those whose estimate from their last
+    two grids still exceeds 1 % on the next grid in ``DIR/refine-grid-2``, and so on, at
+    most :data:`~gaitopt.study.grid_error.MAX_REFINE_LEVELS` levels."""
     if errors is None or errors.check_knots is None:
         return
-    points = errors.to_refine()
-    if not points and not (directory / REFINE_DIR / SUMMARY_FILE).exists():
-        return
-    # Rerunning a finished study: refine the same points again (they are kept).
-    done = [p.row for p in errors.points if p.refined]
-    rows = [p.row for p in points] + done
-    finer = check_knots(errors.check_knots)
-    speeds = sorted({round(r.speed_m_min, 6) for r in rows if r.speed_mode == "fixed"})
-    console.print(f"refinement grid {finer[0]}+{finer[1]} knots: {len(points)} points "
-                  f"changed by more than {100 * WITHIN:g} % to the check grid",
-                  soft_wrap=True)
-    if not speeds:  # only speed-free optima: solve them from the check grid's start speed
-        speeds = [START_SPEED * 60.0]
-    spec = replace(make_spec(model_name=model_name, speeds=",".join(f"{v:g}" for v in speeds),
-                             variants=",".join(sorted({r.variant for r in rows})),
-                             free=any(r.speed_mode == "free" for r in rows),
-                             step_length="free", single_support="0.85",
-                             problem={**grid, "knots": finer}), continuation=False)
-    check = directory / CHECK_DIR
-    seeds = {p.key: check / p.key for p in spec.points if (check / p.key).exists()}
-    run_with_progress(console, spec, directory / REFINE_DIR, workers=workers,
-                      scheduler=scheduler, seeds=seeds)
+    from gaitopt.study.summary import read_summary
+
+    study_rows = read_summary(directory / SUMMARY_FILE)
+    previous, knots = directory / CHECK_DIR, errors.check_knots
+    for level in range(1, MAX_REFINE_LEVELS + 1):
+        folder = directory / refine_dir_name(level)
+        points = errors.to_refine(level)
+        if not points and not (folder / SUMMARY_FILE).exists():
+            return
+        # Rerunning a finished study: refine the same points again (they are kept).
+        done = [p.row for p in errors.points if p.level >= level]
+        rows = [p.row for p in points] + done
+        knots = check_knots(knots)
+        speeds = sorted({round(r.speed_m_min, 6) for r in rows if r.speed_mode == "fixed"})
+        console.print(f"refinement grid {knots[0]}+{knots[1]} knots: {len(points)} points "
+                      f"estimated above {100 * WITHIN:g} % on the grid before",
+                      soft_wrap=True)
+        if not speeds:  # only speed-free optima: solve them from the check grid's start speed
+            speeds = [START_SPEED * 60.0]
+        spec = replace(make_spec(model_name=model_name,
+                                 speeds=",".join(f"{v:g}" for v in speeds),
+                                 variants=",".join(sorted({r.variant for r in rows})),
+                                 free=any(r.speed_mode == "free" for r in rows),
+                                 step_length="free", single_support="0.85",
+                                 problem={**grid, "knots": knots}), continuation=False)
+        seeds = {p.key: previous / p.key for p in spec.points if (previous / p.key).exists()}
+        run_with_progress(console, spec, folder, workers=workers, scheduler=scheduler,
+                          seeds=seeds)
+        errors = grid_error(directory, study_rows)
+        if errors is None:
+            return
+        previous = folder
 
 
 def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,

@@ -48,12 +48,14 @@ KNOT_SPACINGS = ("uniform", "cosine")
 #: and ``--paper-grid``. Its cost is about 13 % above the fine-grid limit (docs/walking.md,
 #: section 6); it is kept to reproduce the paper.
 PAPER_GRID: dict[str, Any] = {"knots": (8, 5), "control_model": "paper",
-                              "transcription": "hermite-simpson"}
+                              "transcription": "hermite-simpson", "knot_spacing": "uniform"}
 #: Fields whose default changed, with the value they had before: a gait file or sweep written
 #: before the field existed was solved with it (the control model arrived while the paper's
 #: was the default, the transcription field while the compressed form was), so data that
-#: lacks the field means this value, not today's default.
-LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper", "transcription": "hermite-simpson"}
+#: lacks the field means this value, not today's default. (Knots were uniform before the
+#: knot spacing became a field and its default until 2026-12-02.)
+LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper", "transcription": "hermite-simpson",
+                                   "knot_spacing": "uniform"}
 
 
 class GaitOptionsError(ValueError):
@@ -154,8 +156,9 @@ class GaitOptions:
             parabola's slope at the ends is a least vertical tip velocity ``4 c / T1`` at the
             liftoff and the heel strike, which makes its cost grow with the grid (measured in
             docs/walking.md); the quartic has zero slope there.
-        knot_spacing: ``"uniform"`` or ``"cosine"``: the knots of the target grid (``knots``,
-            not the coarse stages) at ``tau_k = (1 - cos(pi k / (N - 1))) / 2`` in each phase,
+        knot_spacing: ``"cosine"`` (the default since 2026-12-02; the paper's preset:
+            ``"uniform"``) or ``"uniform"``: the knots of the target grid (``knots``, not the
+            coarse stages) at ``tau_k = (1 - cos(pi k / (N - 1))) / 2`` in each phase,
             clustered at the events, where fast walks have a boundary layer before the heel
             strike that a uniform grid resolves at first order only (docs/walking.md,
             section 6).
@@ -197,7 +200,7 @@ class GaitOptions:
     control_model: ControlModel = "jumps"
     swing_clearance: float | None = None
     clearance_profile: ClearanceProfile = "quartic"
-    knot_spacing: KnotSpacing = "uniform"
+    knot_spacing: KnotSpacing = "cosine"
 
     # -- derived -------------------------------------------------------------------------------
     @property

@@ -66,6 +66,7 @@ from typing import Any
 import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
+from gaitopt.gait.check_grid import check_knots
 from gaitopt.gait.formulation import biped_for, checked_sequence, contact_sequence, stage_bounds
 from gaitopt.gait.guess import (
     default_running_step,
@@ -314,11 +315,30 @@ class _Run:
     def refine(self, result: Result) -> Result:
         """The requested grid, when finer than the coarse one: first with the step length and
         speed held at the coarse solution's (a fine grid started from a coarse solution with
-        them free can wander to a far worse local optimum), then released."""
+        them free can wander to a far worse local optimum), then released. Without
+        ``mesh_tol``, then :meth:`check`: the same problem on the check grid, for the cost
+        error estimate; the target grid's solution is the answer."""
         o = self.options
         if tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform":
             return result
-        return self.on_grid("target grid", target_grid(self.model, o), result)
+        fine = self.on_grid("target grid", target_grid(self.model, o), result)
+        if fine.success and o.mesh_tol is None:
+            self.check(fine)
+        return fine
+
+    def check(self, result: Result) -> None:
+        """Stage ``check grid``: the problem on :func:`~gaitopt.gait.check_grid.check_knots`
+        of the requested knots (same spacing), everything free, from ``result``'s values and
+        multipliers, with the target grid's Hessian (quasi-Newton in the compressed form, whose
+        exact Hessian takes seconds to build). Its cost (kept in ``grid_costs`` after the
+        answer's) is what the cost error estimate compares with
+        (:mod:`gaitopt.gait.accuracy`); a check that fails leaves the answer without that
+        estimate, never changes it."""
+        o = self.options
+        finer = o.replace(knots=check_knots(o.knots))
+        self.stage("check grid", target_grid(self.model, finer), Relaxation(), result,
+                   parameter_bounds(o),
+                   solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
 
     def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
         """Solve on ``grid`` from ``result`` (another grid): the step length and speed held

@@ -38,24 +38,26 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from gaitopt.gait.check_grid import CHECK_KNOTS, check_knots, first_order_factor
 from gaitopt.study.plan import SETTINGS_FILE
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, read_summary
 
-#: The check grid of the known study grids; any other grid is refined by half its knots.
-CHECK_KNOTS: dict[tuple[int, int], tuple[int, int]] = {(16, 6): (24, 8), (8, 5): (16, 6)}
 #: The relative cost change the statements single out: where the estimate exceeds it, they say
 #: at how many points and at which speeds.
 WITHIN = 0.01
 #: The folder of the check sweep inside the study directory.
 CHECK_DIR = "check-grid"
-#: The folder of the refinement sweep inside the study directory.
+#: The folder of the (first) refinement sweep inside the study directory; the later levels
+#: are ``refine-grid-2``, ``refine-grid-3`` (:func:`refine_dir_name`).
 REFINE_DIR = "refine-grid"
+#: The most refinement levels a study solves (36 + 12, 54 + 18 and 81 + 27 knots after the
+#: default's 16 + 6 and 24 + 8).
+MAX_REFINE_LEVELS = 3
 
 
-def check_knots(knots: tuple[int, int]) -> tuple[int, int]:
-    """The finer grid of the check sweep: :data:`CHECK_KNOTS`, else 1.5 times the knots."""
-    k = (int(knots[0]), int(knots[1]))
-    return CHECK_KNOTS.get(k, (math.ceil(1.5 * k[0]), math.ceil(1.5 * k[1])))
+def refine_dir_name(level: int) -> str:
+    """The folder of refinement level ``level`` (1, 2, ...) inside the study directory."""
+    return REFINE_DIR if level == 1 else f"{REFINE_DIR}-{level}"
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,11 @@ class PointError:
     #: The first-order factor from the change between the two grids to the error of the
     #: reported one (:func:`first_order_factor`).
     factor: float = 1.0
+    #: The refinement level ``row`` comes from (0: the study's grid, 1: ``refine-grid``, ...)
+    #: and the knots of ``row``'s and ``check``'s grids (None when not known).
+    level: int = 0
+    grid: tuple[int, int] | None = None
+    check_grid: tuple[int, int] | None = None
 
     @property
     def _finer(self) -> SummaryRow:
@@ -110,22 +117,16 @@ class PointError:
         return self.factor * abs(self.speed_m_min)
 
     @property
+    def step_relative(self) -> float:
+        """The step length's error estimate relative to the finer grid's step length."""
+        return self.step_error / abs(self._finer.step_length)
+
+    @property
     def relative(self) -> float:
         """The largest estimated relative error of the cost, the step length and (speed-free
         optimum) the speed: what decides a refinement."""
         return max(self.cost_error, self.step_error / abs(self._finer.step_length),
                    self.speed_error / abs(self._finer.speed_m_min))
-
-
-def first_order_factor(coarse: int, fine: int, *, of_finer: bool) -> float:
-    """Error of a grid from the change between two grids of ``coarse`` and ``fine`` knots
-    (single support), if the error falls as ``C / knots``: the coarse grid's error is the
-    change times ``fine / (fine - coarse)`` (3 for 16 to 24 knots), the fine grid's times
-    ``coarse / (fine - coarse)`` (2 for 24 to 36). With the measured orders of the default
-    grids (1.3 to 2, docs/walking.md section 6) it overestimates the error."""
-    if fine <= coarse:
-        return 1.0
-    return (coarse if of_finer else fine) / (fine - coarse)
 
 
 def _key(row: SummaryRow) -> tuple[str, str, float]:
@@ -134,9 +135,20 @@ def _key(row: SummaryRow) -> tuple[str, str, float]:
 
 
 @dataclass(frozen=True)
+class RefineLevel:
+    """One refinement sweep of a study: its converged rows, its knots, and its folder
+    relative to the study's (``refine-grid``, ``refine-grid-2``, ...)."""
+
+    rows: tuple[SummaryRow, ...]
+    knots: tuple[int, int]
+    prefix: str = REFINE_DIR
+
+
+@dataclass(frozen=True)
 class GridError:
-    """The study's grid, the check grid, the refinement grid (None without a refinement
-    sweep), and every point solved on two of them (refined points with their last two)."""
+    """The study's grid, the check grid, the refinement grids (``levels``: the knots of each
+    refinement sweep that re-solved a point; ``refine_knots`` the first, None without one),
+    and every point solved on two of them (refined points with their last two)."""
 
     knots: tuple[int, int]
     control_model: str
@@ -144,6 +156,7 @@ class GridError:
     points: tuple[PointError, ...]
     refine_knots: tuple[int, int] | None = None
     spacing: str = "uniform"
+    levels: tuple[tuple[int, int], ...] = ()
 
     @staticmethod
     def compare(rows: Sequence[SummaryRow], check_rows: Sequence[SummaryRow], *,
@@ -151,13 +164,19 @@ class GridError:
                 check: tuple[int, int] | None,
                 refine_rows: Sequence[SummaryRow] = (),
                 refine: tuple[int, int] | None = None,
-                refine_prefix: str = REFINE_DIR) -> GridError:
+                refine_prefix: str = REFINE_DIR,
+                refine_levels: Sequence[RefineLevel] = ()) -> GridError:
         """Pair the converged rows of the study and of the check sweep by variant, speed mode
-        and speed (0.01 m/min); a point also converged in the refinement sweep is paired as
-        (refinement row, check row), the refinement row's file made relative to the study
-        (``refine_prefix``: the refinement sweep's folder relative to the study's)."""
+        and speed (0.01 m/min); a point also converged in refinement sweeps is paired as
+        (its row on the finest of them, its row on the grid before), the row's file made
+        relative to the study (the level's ``prefix``). ``refine_levels`` are the
+        refinement sweeps from coarse to fine; ``refine_rows``, ``refine`` and
+        ``refine_prefix`` give a single one."""
+        levels = list(refine_levels)
+        if refine is not None and not levels:
+            levels = [RefineLevel(tuple(refine_rows), refine, refine_prefix)]
         ok = _converged(check_rows)
-        fine = _converged(refine_rows) if refine is not None else {}
+        fine = [_converged(level.rows) for level in levels]
         pairs = []
         for r in rows:
             if not (r.success and math.isfinite(r.cost)):
@@ -165,17 +184,26 @@ class GridError:
             found = _find(ok, r)
             if found is None:
                 continue
-            better = _find(fine, r)
-            if better is None or refine is None:
-                factor = first_order_factor(knots[0], check[0], of_finer=False) if check else 1.0
-                pairs.append(PointError(r, found, factor=factor))
-            else:
-                factor = first_order_factor(check[0], refine[0], of_finer=True) if check else 1.0
-                pairs.append(PointError(replace(better, file=f"{refine_prefix}/{better.file}"
-                                                if better.file else ""),
-                                        found, refined=True, factor=factor))
+            point = PointError(r, found, factor=first_order_factor(knots[0], check[0],
+                                                                   of_finer=False)
+                               if check else 1.0, grid=knots, check_grid=check)
+            before, before_knots = found, check
+            for k, (level, solved) in enumerate(zip(levels, fine, strict=True), start=1):
+                better = _find(solved, r)
+                if better is None:
+                    continue
+                factor = (first_order_factor(before_knots[0], level.knots[0], of_finer=True)
+                          if before_knots else 1.0)
+                point = PointError(replace(better, file=f"{level.prefix}/{better.file}"
+                                           if better.file else ""),
+                                   before, refined=True, factor=factor, level=k,
+                                   grid=level.knots, check_grid=before_knots)
+                before, before_knots = better, level.knots
+            pairs.append(point)
+        used = tuple(level.knots for k, level in enumerate(levels, start=1)
+                     if any(p.level >= k for p in pairs))
         return GridError(knots, control_model, check, tuple(pairs),
-                         refine if any(p.refined for p in pairs) else None)
+                         used[0] if used else None, levels=used)
 
     @property
     def grid(self) -> str:
@@ -194,10 +222,12 @@ class GridError:
         return next((p for p in self.points if p.row.variant == variant
                      and p.row.speed_mode == "free"), None)
 
-    def to_refine(self) -> list[PointError]:
-        """The points not yet refined whose estimate exceeds :data:`WITHIN` (cost, step
-        length or speed, relative)."""
-        return [p for p in self.points if not p.refined and p.relative > WITHIN]
+    def to_refine(self, level: int | None = None) -> list[PointError]:
+        """The points whose estimate exceeds :data:`WITHIN` (cost, step length or speed,
+        relative): not yet refined (``level`` None), or reported from refinement level
+        ``level - 1`` (those refinement level ``level`` re-solves; 1: not yet refined)."""
+        at = 0 if level is None else level - 1
+        return [p for p in self.points if p.level == at and p.relative > WITHIN]
 
     def reported(self, rows: Sequence[SummaryRow]) -> list[SummaryRow]:
         """``rows`` (the study's) with each refined point's row in place of its own."""
@@ -207,7 +237,7 @@ class GridError:
     def statement(self, points: Sequence[PointError] | None = None, *,
                   what: str = "cost") -> str:
         """One sentence: the grid and the largest estimate over ``points`` (default: all)
-        of ``what`` (``cost`` relative, or ``step length`` in m)."""
+        of ``what`` (``cost`` relative, or ``step length`` in m and relative)."""
         chosen = list(self.points if points is None else points)
         if self.check_knots is None or not chosen:
             return f"Grid: {self.grid}; no error estimate (no point solved on a finer grid)."
@@ -216,33 +246,47 @@ class GridError:
         where = ", ".join(part for part in (
             f"{fixed} fixed-speed point{'s' if fixed != 1 else ''}" if fixed else "",
             f"{free} speed-free optim{'a' if free != 1 else 'um'}" if free else "") if part)
-        check = f"{self.check_knots[0]}+{self.check_knots[1]} knots"
+        check = _knots(self.check_knots)
         if what == "step length":
             worst = max(p.step_error for p in chosen)
-            value = f"step length within {worst:.4f} m"
+            relative = max(p.step_relative for p in chosen)
+            value = f"step length within {worst:.4f} m and {100 * relative:.2f} %"
+            above = [p for p in chosen if p.step_relative > WITHIN]
+            errors = [p.step_relative for p in chosen]
         else:
             worst = max(p.cost_error for p in chosen)
             value = f"cost within {100 * worst:.2f} %"
             above = [p for p in chosen if p.cost_error > WITHIN]
-            if above:
-                below = max((p.cost_error for p in chosen if p.cost_error <= WITHIN),
-                            default=0.0)
-                value += (f"; above {100 * WITHIN:g} % at {len(above)} of {len(chosen)} "
-                          f"points ({_span(above)}), within {100 * below:.2f} % at the others")
+            errors = [p.cost_error for p in chosen]
+        if above:
+            below = max((e for e in errors if e <= WITHIN), default=0.0)
+            value += (f"; above {100 * WITHIN:g} % at {len(above)} of {len(chosen)} "
+                      f"points ({_span(above)}), within {100 * below:.2f} % at the others")
         refined = [p for p in chosen if p.refined]
         factor = f"{chosen[0].factor:g} x " if chosen[0].factor != 1.0 else ""
-        if not refined or self.refine_knots is None:
+        if not refined or not self.levels:
             return (f"Grid: {self.grid}. Error estimate ({factor}the change to {check} at "
                     f"{where}): {value}.")
-        fine = f"{self.refine_knots[0]}+{self.refine_knots[1]} knots"
-        count = f"{len(refined)} point{'s' if len(refined) != 1 else ''}"
+        shown = [(k, grid, [p for p in refined if p.level == k])
+                 for k, grid in enumerate(self.levels, start=1)]
+        shown = [(k, grid, at) for k, grid, at in shown if at]
+        grids = ", ".join(
+            f"{_knots(grid)} at the {len(at)} point{'s' if len(at) != 1 else ''} "
+            f"({_span(at)})" for _, grid, at in shown)
         coarse = next((p.factor for p in chosen if not p.refined), None)
-        return (f"Grid: {self.grid}, and {fine} at the {count} ({_span(refined)}) whose "
-                f"estimate exceeded {100 * WITHIN:g} % (re-solved). Error estimate (first "
-                f"order from each point's last two grids: "
+        changes = ", ".join(
+            f"{at[0].factor:g} x the change from {_knots(at[0].check_grid or self.check_knots)}"
+            f" to {_knots(grid)}" for _, grid, at in shown)
+        return (f"Grid: {self.grid}, and {grids} whose estimate exceeded "
+                f"{100 * WITHIN:g} % (re-solved). Error estimate (first order from each "
+                f"point's last two grids: "
                 + (f"{coarse:g} x the change to {check}, " if coarse is not None else "")
-                + f"{refined[0].factor:g} x the change from {check} to {fine} at the re-solved "
-                f"points; at {where}): {value}.")
+                + f"{changes} at the re-solved points; at {where}): {value}.")
+
+
+def _knots(knots: tuple[int, int]) -> str:
+    """``24+8 knots``."""
+    return f"{knots[0]}+{knots[1]} knots"
 
 
 def _span(points: Sequence[PointError]) -> str:
@@ -282,10 +326,10 @@ def grid_error(sweep_dir: str | os.PathLike[str], rows: Sequence[SummaryRow],
                check_dir: str | os.PathLike[str] | None = None,
                refine_dir: str | os.PathLike[str] | None = None) -> GridError | None:
     """The grid error of the sweep in ``sweep_dir`` (its ``rows``) against the check sweep in
-    ``check_dir`` (default ``<sweep_dir>/check-grid``) and the refinement sweep in
-    ``refine_dir`` (default ``<sweep_dir>/refine-grid``, when it exists); without a check
-    sweep, the grid alone (no points). None when the sweep's grid is unknown (no
-    ``sweep.json``). Only sweeps of the study's control model count."""
+    ``check_dir`` (default ``<sweep_dir>/check-grid``) and the refinement sweeps (default
+    ``<sweep_dir>/refine-grid``, then ``refine-grid-2``, ... while they exist; or the one in
+    ``refine_dir``); without a check sweep, the grid alone (no points). None when the sweep's
+    grid is unknown (no ``sweep.json``). Only sweeps of the study's control model count."""
     grid = sweep_grid(sweep_dir)
     if grid is None:
         return None
@@ -294,16 +338,20 @@ def grid_error(sweep_dir: str | os.PathLike[str], rows: Sequence[SummaryRow],
     summary = check / SUMMARY_FILE
     if check_grid is None or not summary.exists() or check_grid[1] != grid[1]:
         return GridError(grid[0], grid[1], None, (), spacing=knot_spacing(sweep_dir))
-    refine = Path(refine_dir) if refine_dir is not None else Path(sweep_dir) / REFINE_DIR
-    refine_grid = sweep_grid(refine)
-    fine_rows: list[SummaryRow] = []
-    if (refine_grid is not None and refine_grid[1] == grid[1]
-            and (refine / SUMMARY_FILE).exists()):
-        fine_rows = read_summary(refine / SUMMARY_FILE)
+    folders = ([Path(refine_dir)] if refine_dir is not None else
+               [Path(sweep_dir) / refine_dir_name(k)
+                for k in range(1, MAX_REFINE_LEVELS + 1)])
+    levels: list[RefineLevel] = []
+    for folder in folders:
+        level_grid = sweep_grid(folder)
+        if (level_grid is None or level_grid[1] != grid[1]
+                or not (folder / SUMMARY_FILE).exists()):
+            break
+        levels.append(RefineLevel(tuple(read_summary(folder / SUMMARY_FILE)), level_grid[0],
+                                  Path(os.path.relpath(folder, sweep_dir)).as_posix()))
     errors = GridError.compare(rows, read_summary(summary), knots=grid[0],
-                               control_model=grid[1], check=check_grid[0], refine_rows=fine_rows,
-                               refine=refine_grid[0] if fine_rows and refine_grid else None,
-                               refine_prefix=Path(os.path.relpath(refine, sweep_dir)).as_posix())
+                               control_model=grid[1], check=check_grid[0],
+                               refine_levels=levels)
     return replace(errors, spacing=knot_spacing(sweep_dir))
 
 
@@ -314,3 +362,8 @@ def knot_spacing(sweep_dir: str | os.PathLike[str]) -> str:
         return str(settings["settings"]["options"].get("knot_spacing", "uniform"))
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return "uniform"
+
+
+__all__ = ["CHECK_DIR", "CHECK_KNOTS", "MAX_REFINE_LEVELS", "REFINE_DIR", "WITHIN", "GridError",
+           "PointError", "RefineLevel", "check_knots", "first_order_factor", "grid_error",
+           "knot_spacing", "refine_dir_name", "sweep_grid"]

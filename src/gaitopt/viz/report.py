@@ -21,9 +21,10 @@ Every figure's caption and the headline table state the sweep's grid (knots and 
 and, when a check sweep on a finer grid exists (``<sweep>/check-grid``, written by ``gaitopt
 study``; :mod:`gaitopt.study.grid_error`), the error estimate of what it shows: the largest
 change of the cost (or step length) to the finer grid over the points shown, and for each
-speed-free optimum how far its speed and step length move. Points re-solved in a refinement
-sweep (``<sweep>/refine-grid``) are shown with their refined values and gaits, and the
-captions say on which grid and with which estimate (the change from the check grid).
+speed-free optimum how far its speed and step length move (step lengths in m and relative).
+Points re-solved in refinement sweeps (``<sweep>/refine-grid``, ``refine-grid-2``, ...) are
+shown with their values and gaits on their finest grid, and the captions say on which grids
+and with which estimate (the change from the grid before).
 """
 
 from __future__ import annotations
@@ -318,14 +319,14 @@ def _optimum_error(errors: GridError | None, row: SummaryRow) -> str:
         return "not checked"
     p = found[0]
     grid = f"to {errors.check_knots[0]}+{errors.check_knots[1]}"
-    if p.refined and errors.refine_knots is not None:
-        grid = (f"solved on {errors.refine_knots[0]}+{errors.refine_knots[1]}, change from "
-                f"{errors.check_knots[0]}+{errors.check_knots[1]}")
+    if p.refined and p.grid is not None and p.check_grid is not None:
+        grid = (f"solved on {p.grid[0]}+{p.grid[1]}, change from "
+                f"{p.check_grid[0]}+{p.check_grid[1]}")
     moved = "" if row.speed_mode == "fixed" else f"speed {p.speed_m_min:+.2f} m/min, "
     estimate = "" if row.speed_mode == "fixed" else f"speed {p.speed_error:.2f} m/min, "
     return (f"{grid} knots: cost {100 * p.cost:.2f} %, {moved}step {p.step_length:+.4f} m; "
             f"error estimate ({p.factor:g} x): cost {100 * p.cost_error:.2f} %, {estimate}"
-            f"step {p.step_error:.4f} m")
+            f"step {p.step_error:.4f} m ({100 * p.step_relative:.2f} %)")
 
 
 def _solver_table(rows: Sequence[SummaryRow], optimal: Mapping[str, SummaryRow | None],
