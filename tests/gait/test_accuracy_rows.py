@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from gaitopt.cli.gait import accuracy_rows
+from gaitopt.cli.gait_summary import accuracy_rows
 
 BASE: dict[str, Any] = {
     "collocation_error": {"single_support": 3.2e-4, "double_support": 2.8e-4},

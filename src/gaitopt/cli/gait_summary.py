@@ -1,0 +1,107 @@
+"""The summary ``gaitopt solve`` prints for a converged gait (a rich table), and its rows for
+the accuracy estimates and the phase shares."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from rich.table import Table
+
+from gaitopt.gait.contact_sequence import ContactSequence
+from gaitopt.gait.gait_file import Gait
+from gaitopt.units import format_speed
+
+
+def summary_table(gait: Gait, sequence_used: ContactSequence | None) -> Table:
+    """The table ``gaitopt solve`` prints for a converged gait: speed, step, shares, cost,
+    peak torques against their bounds, contact forces, clearance, friction, NLP size and the
+    accuracy estimates (:func:`accuracy_rows`)."""
+    from gaitopt.analysis.metrics import gait_metrics
+
+    metrics = gait_metrics(gait)
+    p = gait.parameters
+    table = Table(title="optimal gait", show_header=False)
+    table.add_column("quantity")
+    table.add_column("value")
+    table.add_row("speed", format_speed(p["speed"]))
+    table.add_row("step length", f"{p['step_length']:.4f} m")
+    table.add_row("step time", f"{p['step_time']:.4f} s (single support "
+                  f"{p['single_support_time']:.4f} s)")
+    if sequence_used is not None and len(sequence_used.phases) > 1:
+        table.add_row("phase fractions", phase_fractions_text(sequence_used, gait))
+    table.add_row("liftoff impulse", f"{p['liftoff_impulse']:.4f} N s")
+    if gait.options.get("cost", "paper") == "paper":
+        table.add_row("cost (energy per metre)", f"{gait.cost_value:.6g} N^2 m s")
+    else:
+        table.add_row(f"cost ({gait.options['cost']} cost of transport)",
+                      f"{gait.cost_value:.6g} (dimensionless)")
+    for name, peak in metrics.peak_torques.items():
+        bound = metrics.torque_bounds[name]
+        table.add_row(f"peak torque {name}", f"{peak:8.2f} / {bound:g} N m "
+                      f"({100 * peak / bound:5.1f} %)")
+    table.add_row("smallest normal force", f"{metrics.min_normal_force:.3f} N")
+    table.add_row("smallest normal impulse", f"{metrics.min_normal_impulse:.4f} N s")
+    table.add_row("swing clearance", f"{metrics.swing_clearance * 1000:.1f} mm (lowest "
+                  f"{metrics.swing_min_height * 1000:.2f} mm)")
+    table.add_row("friction needed", f"{metrics.friction_required:.3f} (|tangential|/normal)")
+    s = gait.solver
+    table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
+                  f"equality, {s['inequality_constraints']} inequality constraints")
+    table.add_row("iterations (last stage)", str(s["iterations"]))
+    for row in accuracy_rows(s["accuracy"], speed=gait.speed, step_length=gait.step_length):
+        table.add_row(*row)
+    table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
+    return table
+
+
+def phase_fractions_text(sequence: ContactSequence, gait: Gait) -> str:
+    """Each phase's solved share of the step time, ``(free)`` after those that were."""
+    solved = (gait.contact_sequence or {}).get("phases", [])
+    return ", ".join(f"{ph.name} {float(rec['fraction']):.4f}" + (" (free)" if ph.free else "")
+                     for ph, rec in zip(sequence.phases, solved, strict=True))
+
+
+def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
+                  step_length: float | None = None) -> list[tuple[str, str]]:
+    """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase,
+    the cost's discretization error estimate and how far speed and step length moved (with
+    their estimates relative to the gait's ``speed`` and ``step_length`` when given)."""
+    errors = ", ".join(f"{name} {'n/a' if e is None else f'{e:.1e}'} "
+                       f"({accuracy['knots'][name]} knots)"
+                       for name, e in accuracy["collocation_error"].items())
+    tol = accuracy["mesh_tol"]
+    if tol is not None:
+        errors += f"; mesh_tol {tol:g} {'met' if accuracy['mesh_converged'] else 'NOT met'}"
+    rows = [("collocation error (largest per interval)", errors)]
+    if accuracy["cost_error"] is None:
+        rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
+        return rows
+    check = accuracy.get("check_knots")
+    grid = "+".join(str(k) for k in (check or accuracy["previous_knots"]).values())
+    factor = accuracy.get("cost_error_factor") or 1.0
+    rel = accuracy.get("cost_error_relative")
+    if check is not None:
+        how = f"{factor:g} x the change to {grid} knots, J {accuracy['check_cost']:.6g}"
+        moved = f"change to {grid} knots"
+    else:
+        how = f"change from {grid} knots, J {accuracy['previous_cost']:.6g}"
+        moved = f"change from {grid} knots"
+    share = "" if rel is None else (
+        f" = {100 * rel:.2f} % of J: " + ("within 1 %" if rel <= 0.01 else
+                                          "above 1 % (a finer --knots or --mesh-tol 1e-4)"))
+    rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} ({how})"))
+    dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
+    if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
+        text = f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"
+        ev, el = accuracy.get("speed_error"), accuracy.get("step_length_error")
+        if check is not None and ev is not None and el is not None:
+            text += (f"; estimate {factor:g} x: speed {60 * ev:.3f} m/min{_share(ev, speed)}, "
+                     f"step length {el:.4f} m{_share(el, step_length)}")
+        rows.append((moved, text))
+    return rows
+
+
+def _share(error: float, value: float | None) -> str:
+    """`` (0.55 %)``: ``error`` relative to ``value`` (nothing without a value)."""
+    return "" if not value else f" ({100 * error / abs(value):.2f} %)"
