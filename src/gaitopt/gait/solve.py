@@ -1,6 +1,6 @@
 """Solving the walking problem robustly from a naive start: staged continuation.
 
-(One concept, kept whole at about 520 lines, a tenth of them this docstring: the stages are
+(One concept, kept whole at about 540 lines, a tenth of them this docstring: the stages are
 methods of one run that share its record of stages, results and grid costs.)
 
 The paper's authors climbed to the optimum by hand through sub-problems. gaitopt does it by
