@@ -13,6 +13,7 @@ from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait import cost
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.solve import smoothing_ladder
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import biped_of
 from tests.gait.conftest import Solved
@@ -91,3 +92,12 @@ def test_bad_cost_options_name_the_field(changes: dict[str, object], message: st
     legs = biped_of(load_model("five-link"))
     with pytest.raises(GaitOptionsError, match=message):
         validate_options(GaitOptions.paper().replace(**changes), legs)
+
+
+def test_smoothing_ladder_divides_by_ten_down_to_the_request() -> None:
+    """The stages before the requested smoothing: 1 W, then a tenth each, never the request
+    itself (the last stage solves it) and nothing when the request is at least 1 W."""
+    assert smoothing_ladder(0.01) == pytest.approx([1.0, 0.1])
+    assert smoothing_ladder(0.05) == pytest.approx([1.0, 0.1])
+    assert smoothing_ladder(0.1) == pytest.approx([1.0])
+    assert smoothing_ladder(1.0) == [] and smoothing_ladder(2.0) == []

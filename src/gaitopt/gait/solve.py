@@ -124,8 +124,10 @@ REFERENCE_SPEED = 0.2
 #: Largest speed change (m/s) between two continuation steps.
 SPEED_STEP = 0.1
 #: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
-#: cost's optimum, when the requested one is finer.
+#: cost's optimum, when the requested one is finer; each further stage divides it by
+#: :data:`COST_SMOOTHING_STEP` until the requested one (:func:`smoothing_ladder`).
 COST_SMOOTHING_START = 1.0
+COST_SMOOTHING_STEP = 10.0
 #: Most refinement rounds after the fixed-grid stages, and most knots per phase they may make
 #: (the bound of ``GaitOptions.knots``).
 MAX_REFINEMENTS = 6
@@ -412,8 +414,9 @@ class _Run:
     def other_cost(self) -> Result | None:
         """A cost other than the paper's, by continuation: the whole solve with the paper's
         cost first (its stages reported with the prefix ``paper cost:``), then the cost
-        asked for from that optimum, first with a coarse smoothing of the positive parts
-        (:data:`COST_SMOOTHING_START`) when it is finer. None if the paper solve fails."""
+        asked for from that optimum, first with coarser smoothings of the positive parts
+        (:func:`smoothing_ladder`), each stage from the last with its multipliers. None if
+        the paper solve fails."""
         o = self.options
         paper = o.replace(cost="paper", cost_regularization=0.0)
 
@@ -428,18 +431,18 @@ class _Run:
             self.results.append(start.result)
             return None
         guess: Guess | Result = result_guess(start.result)
-        if o.cost != "paper" and o.cost_smoothing < COST_SMOOTHING_START:
-            smooth = o.replace(cost_smoothing=COST_SMOOTHING_START)
-            guess = self.stage(f"{o.cost} cost, eps {COST_SMOOTHING_START:g} W",
-                               target_grid(self.model, o),
+        options = PRIMAL_WARM_OPTIONS
+        for eps in smoothing_ladder(o.cost_smoothing):
+            stage = self.stage(f"{o.cost} cost, eps {eps:g} W", target_grid(self.model, o),
                                Relaxation(), guess, parameter_bounds(o),
-                               solver_options=PRIMAL_WARM_OPTIONS, problem=smooth)
-            if not guess.success:
-                return guess
-            guess = result_guess(guess)
+                               solver_options=options, problem=o.replace(cost_smoothing=eps))
+            if not stage.success:
+                return stage
+            # The next smoothing starts from this optimum with its multipliers: the
+            # constraints are the same, only the kinks of the cost sharpen.
+            guess, options = stage, {}
         return self.stage(f"{o.cost} cost", target_grid(self.model, o), Relaxation(), guess,
-                          parameter_bounds(o),
-                          solver_options=PRIMAL_WARM_OPTIONS)
+                          parameter_bounds(o), solver_options=options)
 
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
@@ -450,6 +453,17 @@ class _Run:
                     return as_failed(result, self.results[-1])
                 return result
         return self.results[-1]
+
+
+def smoothing_ladder(target: float) -> list[float]:
+    """The smoothings (W) solved before ``target``: :data:`COST_SMOOTHING_START` divided by
+    :data:`COST_SMOOTHING_STEP` while still coarser than ``target`` (``[1, 0.1]`` for 0.01;
+    ``[]`` when ``target`` is at least the start)."""
+    out, eps = [], COST_SMOOTHING_START
+    while eps > target * (1 + 1e-9):
+        out.append(eps)
+        eps /= COST_SMOOTHING_STEP
+    return out
 
 
 def solve_walking(model: RobotModel, options: GaitOptions, *,
