@@ -55,6 +55,14 @@ Array = NDArray[np.float64]
 
 ParameterBounds = Mapping[str, float | tuple[float, float]]
 
+#: IPOPT options of a solve started with multipliers (``warm_start_multipliers``): the start
+#: is a solution of a neighbouring problem, so it is kept (tiny pushes off the bounds) and the
+#: barrier starts small. Options passed to :meth:`Transcription.solve` override these.
+WARM_START_OPTIONS: dict[str, Any] = {"ipopt.warm_start_init_point": "yes",
+                                      "ipopt.warm_start_bound_push": 1e-9,
+                                      "ipopt.warm_start_mult_bound_push": 1e-9,
+                                      "ipopt.mu_init": 1e-6}
+
 
 class Transcription:
     """The NLP of ``problem`` transcribed by ``method`` on ``mesh``, with cached solvers.
@@ -220,8 +228,9 @@ class Transcription:
         ``bounds`` replaces the statement's bounds; ``parameters`` then bounds parameters by
         name (a value fixes it, a pair bounds it). ``options`` are merged over the
         transcription's solver options. ``warm_start_multipliers`` passes a Result's
-        multipliers to IPOPT (with ``warm_start_init_point``) when its layout matches; a
-        :class:`WarmStart` must match (values and multipliers are taken as they are).
+        multipliers to IPOPT (with :data:`WARM_START_OPTIONS`, under ``options``) when its
+        layout matches; a :class:`WarmStart` must match (values and multipliers are taken as
+        they are).
         """
         b = bounds or self._bounds
         if b.layout.signature() != self.layout.signature() or b.lbg.size != self.nlp.lbg.size:
@@ -245,10 +254,9 @@ class Transcription:
             assert isinstance(guess, Result | WarmStart)
             args["lam_x0"] = guess.lam_x * d_w / s_j
             args["lam_g0"] = guess.lam_g * d_g / s_j
-            opts = merge_options(opts, {"ipopt.warm_start_init_point": "yes",
-                                        "ipopt.warm_start_bound_push": 1e-9,
-                                        "ipopt.warm_start_mult_bound_push": 1e-9,
-                                        "ipopt.mu_init": 1e-6})
+            # The warm-start defaults, under the caller's options (a stage that starts from
+            # a farther point may ask for a larger initial barrier).
+            opts = merge_options(self.options, WARM_START_OPTIONS, options)
         try:
             solver = self.solver(opts)
         except Exception as exc:  # noqa: BLE001 - bad options etc.: report, don't raise
