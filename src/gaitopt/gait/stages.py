@@ -78,20 +78,23 @@ ANKLES = "ankle torques"
 class StageSpec:
     """One continuation stage as data: its name, whether it runs for the options, the
     contact relaxation, the quantity it frees (:data:`ANKLES` or a parameter name; every
-    earlier stage holds it) and IPOPT options merged over the transcription's."""
+    earlier stage holds it), IPOPT options merged over the transcription's, and those merged
+    over the warm-start options when it starts from a solution's multipliers
+    (:meth:`gaitopt.ocp.Transcription.solve`)."""
 
     name: str
     runs: Callable[[GaitOptions], bool] = lambda options: True
     relax: Relaxation = Relaxation()
     frees: str | None = None
     solver_options: dict[str, Any] | None = None
+    warm_start_options: dict[str, Any] | None = None
 
 
 #: Stages 1-2, on the coarse grid from each naive guess, everything in :data:`RELEASES`
 #: held: the contact conditions relaxed, then enforced (the paper's two-stage process).
 CONTACT_STAGES: tuple[StageSpec, ...] = (
     StageSpec("relaxed contact", relax=RELAXED, solver_options=COLD_START_OPTIONS),
-    StageSpec("enforced contact", solver_options=ENFORCED_CONTACT_OPTIONS),
+    StageSpec("enforced contact", warm_start_options=ENFORCED_CONTACT_OPTIONS),
 )
 #: Stage 3: what the contact stages held, freed one at a time in this order (the impulse
 #: from the no-impulse gait keeps the impulse variants out of worse local minima).
