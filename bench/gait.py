@@ -39,7 +39,8 @@ with each revision's own defaults (what a user gets), for this branch's fast pat
 git revision (``--reference``, default ``main``: its sources extracted into a temporary
 folder and run by the same interpreter, on the paper's compressed form, main's default),
 each row measured for both one after the other in fresh processes (``bench/gait_child.py``),
-with the ratios.
+with the ratios; ``--reference-transcription hermite-simpson-separated`` runs the reference in
+this branch's form instead, so that the ratios isolate the branch's changes.
 
 Run: ``python bench/gait.py [--repeat 3] [--grids 8,5 40,10] [--formulation full]
 [--transcription hermite-simpson-separated]`` or ``python bench/gait.py --targets``
@@ -262,15 +263,17 @@ def run_cli(src: Path, transcription: str | None, knots: str | None, out: Path,
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
-    """Every row of the issue's table for the reference revision (the paper's compressed
-    form, as main solves it by default) and this branch (:data:`FAST`), each row measured
-    for both one after the other, and the ratios."""
+def targets(reference: str, repeat: int, formulation: str = "reduced",
+            reference_form: str = PAPER_FORM) -> None:
+    """Every row of the issue's table for the reference revision (by default the paper's
+    compressed form, as main solved it by default; ``reference_form`` another transcription,
+    e.g. :data:`FAST` to isolate this branch's changes) and this branch (:data:`FAST`), each
+    row measured for both one after the other, and the ratios."""
     here = REPO / "src"
     with tempfile.TemporaryDirectory(prefix="gaitopt-bench-") as tmp_name:
         tmp = Path(tmp_name)
         ref = reference_sources(reference, tmp)
-        variants = (("reference", ref, PAPER_FORM), ("this branch", here, FAST))
+        variants = (("reference", ref, reference_form), ("this branch", here, FAST))
         rows: dict[str, dict[str, float]] = {}
         cpu: dict[str, dict[str, float]] = {}
         notes: list[str] = []
@@ -342,7 +345,7 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
     }
     print()
     print(f"formulation: {formulation}")
-    print(f"| figure | reference ({reference}, {PAPER_FORM}) | this branch ({FAST}) | "
+    print(f"| figure | reference ({reference}, {reference_form}) | this branch ({FAST}) | "
           "this / reference | target | met | CPU s: reference, this branch |")
     print("| --- | ---: | ---: | ---: | ---: | :---: | ---: |")
     for row, label in labels.items():
@@ -374,10 +377,13 @@ def main(argv: list[str] | None = None) -> None:
                              "row measured in fresh processes in the same run")
     parser.add_argument("--reference", default="main",
                         help="git revision of the reference for --targets (default: main)")
+    parser.add_argument("--reference-transcription", default=PAPER_FORM,
+                        help="the reference's transcription for --targets (default: the "
+                             f"paper's {PAPER_FORM}; {FAST} isolates this branch's changes)")
     args = parser.parse_args(argv)
     if args.targets:
         print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
-        targets(args.reference, args.repeat, args.formulation)
+        targets(args.reference, args.repeat, args.formulation, args.reference_transcription)
         print(f"load average after: {load_average()}")
         return
     grids = [tuple(int(k) for k in g.split(",")) for g in args.grids]
