@@ -224,14 +224,11 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
     F, G = assembly.f, assembly.g
     sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
     lagrangian = sigma * F + ca.dot(lam, G)
+    L_w, L_Y = ca.gradient(lagrangian, w), ca.gradient(lagrangian, Y)
     outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), ca.jacobian(G, Y)])
-    # The outer Hessian in one symmetric derivation with respect to [w; Y] (its blocks and
-    # the gradient's Y part): a third faster to derive than two gradients and three Jacobians
-    # (0.11 against 0.15 s at 40 + 10 knots in full coordinates).
-    H_all, grad_all = ca.hessian(lagrangian, ca.vertcat(w, Y))
-    L_YY, L_Y = H_all[nw:, nw:], grad_all[nw:]
+    L_YY = ca.jacobian(L_Y, Y)
     outer_hess = ca.Function("outer_hess", [w, Y, sigma, lam],
-                             [H_all[:nw, :nw], H_all[:nw, nw:], L_YY, L_Y])
+                             [ca.jacobian(L_w, w), ca.jacobian(L_w, Y), L_YY, L_Y])
     nu = ca.SX.sym("nu", Z.shape[0])
     z_of_w = ca.Function("z_of_w", [w], [Z, ca.jacobian(Z, w)])
     z_hess = ca.Function("z_hess", [w, nu], [ca.hessian(ca.dot(nu, Z), w)[0]])
