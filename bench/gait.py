@@ -39,7 +39,8 @@ with each revision's own defaults (what a user gets), for this branch's fast pat
 git revision (``--reference``, default ``main``: its sources extracted into a temporary
 folder and run by the same interpreter, on the paper's compressed form, main's default),
 each row measured for both one after the other in fresh processes (``bench/gait_child.py``),
-with the ratios.
+with the ratios; ``--reference-transcription hermite-simpson-separated`` runs the reference in
+this branch's form instead, so that the ratios isolate the branch's changes.
 
 Run: ``python bench/gait.py [--repeat 3] [--grids 8,5 40,10] [--formulation full]
 [--transcription hermite-simpson-separated]`` or ``python bench/gait.py --targets``
@@ -229,10 +230,26 @@ def reference_sources(rev: str, into: Path) -> Path:
     return into / "src"
 
 
+#: With ``--bytecode``: the folder where the child processes keep the byte code of the sources
+#: they import (``PYTHONPYCACHEPREFIX``), as an installed package keeps its ``.pyc`` files.
+BYTECODE: dict[str, Path] = {}
+
+
+def child_env(src: Path) -> dict[str, str]:
+    """The environment of a measured process: ``src`` first on the path; with ``--bytecode``
+    byte code written and reused (``PYTHONDONTWRITEBYTECODE``, which this machine sets, makes
+    every process compile every imported source again: about 0.1 s of CPU per process)."""
+    env = dict(os.environ, PYTHONPATH=str(src))
+    if "dir" in BYTECODE:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+        env["PYTHONPYCACHEPREFIX"] = str(BYTECODE["dir"])
+    return env
+
+
 def run_child(src: Path, *args: str) -> tuple[dict[str, Any], float]:
     """``bench/gait_child.py args`` in a fresh process with ``src`` first on the path: its
     JSON output and the wall time of the whole process."""
-    env = dict(os.environ, PYTHONPATH=str(src))
+    env = child_env(src)
     start = time.perf_counter()
     proc = subprocess.run([sys.executable, str(REPO / "bench" / "gait_child.py"), *args],
                           env=env, capture_output=True, text=True)
@@ -247,7 +264,7 @@ def run_cli(src: Path, transcription: str | None, knots: str | None, out: Path,
     """Wall and CPU time (user + system) of a whole ``gaitopt solve`` process (12 m/min):
     on ``knots`` with the paper's control model in ``transcription``, or with ``knots``
     None the command's own defaults (``gaitopt solve -o FILE``, what a user gets)."""
-    env = dict(os.environ, PYTHONPATH=str(src))
+    env = child_env(src)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     chosen = ([] if knots is None else
@@ -262,15 +279,17 @@ def run_cli(src: Path, transcription: str | None, knots: str | None, out: Path,
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
-    """Every row of the issue's table for the reference revision (the paper's compressed
-    form, as main solves it by default) and this branch (:data:`FAST`), each row measured
-    for both one after the other, and the ratios."""
+def targets(reference: str, repeat: int, formulation: str = "reduced",
+            reference_form: str = PAPER_FORM) -> None:
+    """Every row of the issue's table for the reference revision (by default the paper's
+    compressed form, as main solved it by default; ``reference_form`` another transcription,
+    e.g. :data:`FAST` to isolate this branch's changes) and this branch (:data:`FAST`), each
+    row measured for both one after the other, and the ratios."""
     here = REPO / "src"
     with tempfile.TemporaryDirectory(prefix="gaitopt-bench-") as tmp_name:
         tmp = Path(tmp_name)
         ref = reference_sources(reference, tmp)
-        variants = (("reference", ref, PAPER_FORM), ("this branch", here, FAST))
+        variants = (("reference", ref, reference_form), ("this branch", here, FAST))
         rows: dict[str, dict[str, float]] = {}
         cpu: dict[str, dict[str, float]] = {}
         notes: list[str] = []
@@ -342,7 +361,7 @@ def targets(reference: str, repeat: int, formulation: str = "reduced") -> None:
     }
     print()
     print(f"formulation: {formulation}")
-    print(f"| figure | reference ({reference}, {PAPER_FORM}) | this branch ({FAST}) | "
+    print(f"| figure | reference ({reference}, {reference_form}) | this branch ({FAST}) | "
           "this / reference | target | met | CPU s: reference, this branch |")
     print("| --- | ---: | ---: | ---: | ---: | :---: | ---: |")
     for row, label in labels.items():
@@ -374,10 +393,21 @@ def main(argv: list[str] | None = None) -> None:
                              "row measured in fresh processes in the same run")
     parser.add_argument("--reference", default="main",
                         help="git revision of the reference for --targets (default: main)")
+    parser.add_argument("--bytecode", action="store_true",
+                        help="--targets: the measured processes write and reuse byte code (in a "
+                             "temporary folder), as an installed package does, even where "
+                             "PYTHONDONTWRITEBYTECODE is set")
+    parser.add_argument("--reference-transcription", default=PAPER_FORM,
+                        help="the reference's transcription for --targets (default: the "
+                             f"paper's {PAPER_FORM}; {FAST} isolates this branch's changes)")
     args = parser.parse_args(argv)
     if args.targets:
         print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
-        targets(args.reference, args.repeat, args.formulation)
+        with tempfile.TemporaryDirectory(prefix="gaitopt-bytecode-") as bytecode:
+            if args.bytecode:
+                BYTECODE["dir"] = Path(bytecode)
+                print("byte code written and reused by the measured processes")
+            targets(args.reference, args.repeat, args.formulation, args.reference_transcription)
         print(f"load average after: {load_average()}")
         return
     grids = [tuple(int(k) for k in g.split(",")) for g in args.grids]

@@ -8,6 +8,7 @@ import pytest
 
 from gaitopt.ocp import Guess, PhaseGuess, transcribe
 from gaitopt.ocp.solver import merge_options
+from gaitopt.ocp.transcription import WARM_START_OPTIONS
 
 
 def test_resolve_with_changed_parameter_bounds_does_not_rebuild() -> None:
@@ -64,6 +65,31 @@ def test_warm_start_multipliers_on_the_same_mesh() -> None:
     assert again.success and again.iterations <= 2
     assert again.objective == pytest.approx(res.objective, rel=1e-9)
     assert tr.builds["nlp"] == 1
+
+
+def test_warm_start_options_override_its_defaults_which_override_options(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    tr = transcribe(P.brachistochrone(intervals=20))
+    res = tr.solve(P.brachistochrone_guess())
+    seen: list[dict[str, object]] = []
+    solver = tr.solver
+
+    def spy(options: dict[str, object]) -> object:
+        seen.append(dict(options))
+        return solver(options)
+
+    monkeypatch.setattr(tr, "solver", spy)
+    plain = tr.solve(res, warm_start_multipliers=True, options={"ipopt.mu_init": 1e-2})
+    asked = tr.solve(res, warm_start_multipliers=True, options={"ipopt.mu_init": 1e-2},
+                     warm_start_options={"ipopt.mu_init": 1e-3})
+    cold = tr.solve(P.brachistochrone_guess(), warm_start_multipliers=True,
+                    warm_start_options={"ipopt.mu_init": 1e-3})
+    assert plain.success and asked.success and cold.success
+    assert seen[0] == merge_options(tr.options, WARM_START_OPTIONS)
+    assert seen[1]["ipopt.mu_init"] == 1e-3
+    assert seen[1]["ipopt.warm_start_init_point"] == "yes"
+    assert seen[2] == tr.options  # no multipliers to start from: no warm-start options
+    assert asked.objective == pytest.approx(res.objective, rel=1e-8)
 
 
 def test_user_guess_on_normalised_times() -> None:

@@ -157,11 +157,13 @@ class _Run:
     def stage(self, name: str, knots: Grid, relax: Relaxation,
               guess: Guess | Result | WarmStart, bounds: dict[str, Any], *,
               hold_ankles: bool = False, solver_options: dict[str, Any] | None = None,
-              problem: GaitOptions | None = None) -> Result:
+              problem: GaitOptions | None = None,
+              warm_start_options: dict[str, Any] | None = None) -> Result:
         """Solve one stage; a Result guess also passes its multipliers to IPOPT.
         ``hold_ankles`` bounds the ankle torques to zero (the no-ankle gait);
-        ``solver_options`` are merged over the transcription's; ``problem`` replaces the
-        run's options for this stage's NLP (another cost, say)."""
+        ``solver_options`` are merged over the transcription's (``warm_start_options`` over
+        its warm-start options); ``problem`` replaces the run's options for this stage's NLP
+        (another cost, say)."""
         tr = transcription_for(self.model, problem or self.options, knots,
                                compiled=self.compiled)
         start = time.perf_counter()
@@ -169,7 +171,8 @@ class _Run:
         if hold_ankles:
             nlp_bounds = held_ankles(self.model, tr, nlp_bounds)
         result = tr.solve(guess, bounds=nlp_bounds, parameters=bounds, options=solver_options,
-                          warm_start_multipliers=isinstance(guess, Result | WarmStart))
+                          warm_start_multipliers=isinstance(guess, Result | WarmStart),
+                          warm_start_options=warm_start_options)
         result = converged_or_failed(result)
         full = (relax == Relaxation() and not hold_ankles and problem in (None, self.options)
                 and dict(bounds) == dict(parameter_bounds(self.options)))
@@ -247,6 +250,7 @@ class _Run:
                 result = self.stage(spec.name, coarse, spec.relax, result, bounds,
                                     hold_ankles=ANKLES in held,
                                     solver_options=spec.solver_options,
+                                    warm_start_options=spec.warm_start_options,
                                     problem=self.cold_options)
                 if not result.success:
                     break
@@ -307,7 +311,8 @@ class _Run:
             result = self.stage(spec.title(o), coarse, spec.relax, guess,
                                 held_bounds(o, held, start.parameters[SPEED], start,
                                             self.fractions),
-                                hold_ankles=ANKLES in held, solver_options=spec.solver_options)
+                                hold_ankles=ANKLES in held, solver_options=spec.solver_options,
+                                warm_start_options=spec.warm_start_options)
             if not result.success:
                 return result
             if spec.values_only:

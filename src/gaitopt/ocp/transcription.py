@@ -55,6 +55,15 @@ Array = NDArray[np.float64]
 
 ParameterBounds = Mapping[str, float | tuple[float, float]]
 
+#: IPOPT options of a solve started with multipliers (``warm_start_multipliers``): the start
+#: is a solution of a neighbouring problem, so it is kept (tiny pushes off the bounds) and the
+#: barrier starts small. They override the ``options`` of :meth:`Transcription.solve`;
+#: its ``warm_start_options`` override them.
+WARM_START_OPTIONS: dict[str, Any] = {"ipopt.warm_start_init_point": "yes",
+                                      "ipopt.warm_start_bound_push": 1e-9,
+                                      "ipopt.warm_start_mult_bound_push": 1e-9,
+                                      "ipopt.mu_init": 1e-6}
+
 
 class Transcription:
     """The NLP of ``problem`` transcribed by ``method`` on ``mesh``, with cached solvers.
@@ -214,15 +223,16 @@ class Transcription:
               bounds: Bounds | None = None,
               parameters: ParameterBounds | None = None,
               options: Mapping[str, Any] | None = None,
-              warm_start_multipliers: bool = False) -> Result:
+              warm_start_multipliers: bool = False,
+              warm_start_options: Mapping[str, Any] | None = None) -> Result:
         """Solve the NLP from ``guess``; never raises for solver failures.
 
         ``bounds`` replaces the statement's bounds; ``parameters`` then bounds parameters by
         name (a value fixes it, a pair bounds it). ``options`` are merged over the
         transcription's solver options. ``warm_start_multipliers`` passes a Result's
-        multipliers to IPOPT (with ``warm_start_init_point``) when its layout matches; a
-        :class:`WarmStart` must match (values and multipliers are taken as they are).
-        """
+        multipliers to IPOPT when its layout matches (a :class:`WarmStart` must match; values
+        and multipliers are taken as they are), and then :data:`WARM_START_OPTIONS` with
+        ``warm_start_options`` merged over them apply, over ``options``."""
         b = bounds or self._bounds
         if b.layout.signature() != self.layout.signature() or b.lbg.size != self.nlp.lbg.size:
             raise ProblemError("bounds: made for another transcription (layout differs)")
@@ -245,10 +255,7 @@ class Transcription:
             assert isinstance(guess, Result | WarmStart)
             args["lam_x0"] = guess.lam_x * d_w / s_j
             args["lam_g0"] = guess.lam_g * d_g / s_j
-            opts = merge_options(opts, {"ipopt.warm_start_init_point": "yes",
-                                        "ipopt.warm_start_bound_push": 1e-9,
-                                        "ipopt.warm_start_mult_bound_push": 1e-9,
-                                        "ipopt.mu_init": 1e-6})
+            opts = merge_options(opts, WARM_START_OPTIONS, warm_start_options)
         try:
             solver = self.solver(opts)
         except Exception as exc:  # noqa: BLE001 - bad options etc.: report, don't raise
