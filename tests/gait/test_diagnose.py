@@ -71,6 +71,11 @@ def test_a_step_too_fast_for_the_legs_says_which_torques_saturate(tmp_path) -> N
     reported = float(re.search(r"Largest constraint violation at that point (\S+)",
                                text).group(1))  # type: ignore[union-attr]
     assert reported == pytest.approx(stage_violation, rel=0.05)
+    # Each piece of advice once, however many phases show the same kind of violation.
+    lines = result.output.splitlines()
+    first = next(i for i, ln in enumerate(lines) if ln.startswith("What you can change"))
+    advice = [ln for ln in lines[first + 1:] if ln.startswith("  - ")]
+    assert advice and len(advice) == len(set(advice))
 
 
 def _failed_at(solution: WalkingSolution, state: str, value: float) -> WalkingSolution:

@@ -311,7 +311,9 @@ CAUSES = {
 
 
 def _advice(kinds: list[str], options: GaitOptions) -> list[str]:
-    out = [ADVICE[k] for k in kinds if k in ADVICE]
+    # One line per kind of constraint, in the order of the findings (a kind found in two
+    # phases gives its advice once).
+    out = list(dict.fromkeys(ADVICE[k] for k in kinds if k in ADVICE))
     if not options.multistart:
         out.append("--multistart tries every naive start and the continuation in speed")
     return out

@@ -36,7 +36,10 @@ COLD_START_OPTIONS = {"ipopt.mu_strategy": "adaptive"}
 #: :data:`gaitopt.ocp.transcription.WARM_START_OPTIONS`' 1e-6). At 8 + 5 knots, 3-60 m/min
 #: (six speeds, both formulations) the stage took 160 instead of 311 iterations in full
 #: coordinates and 212 instead of 264 in reduced ones, to the same optima (the final costs
-#: equal to 8 digits).
+#: equal to 8 digits). Used in full coordinates only: in reduced ones an infeasible request
+#: (80 m/min with 0.75 m steps) then ended in a restoration failure at a far worse point
+#: (contact forces violated by 611 N) instead of IPOPT's infeasibility verdict with every
+#: torque at its bound, and the failure's diagnosis named the wrong cause.
 ENFORCED_CONTACT_OPTIONS = {"ipopt.mu_init": 1e-4}
 #: IPOPT options of a stage started from the values of a solution without its multipliers
 #: (a coarse solution interpolated onto the target grid, a neighbouring gait): the start is
@@ -96,7 +99,15 @@ class StageSpec:
     frees: str | None = None
     solver_options: dict[str, Any] | None = None
     warm_start_options: dict[str, Any] | None = None
+    warm_start_formulations: tuple[str, ...] = ("reduced", "full")
     values_only: bool = False
+
+    def warm_start(self, options: GaitOptions) -> dict[str, Any] | None:
+        """The stage's warm-start options for ``options``' formulation (None: the
+        transcription's own)."""
+        if options.formulation in self.warm_start_formulations:
+            return self.warm_start_options
+        return None
 
     def title(self, options: GaitOptions) -> str:
         """The stage's name for ``options`` (as printed and kept in the solution)."""
@@ -107,7 +118,8 @@ class StageSpec:
 #: held: the contact conditions relaxed, then enforced (the paper's two-stage process).
 CONTACT_STAGES: tuple[StageSpec, ...] = (
     StageSpec("relaxed contact", relax=RELAXED, solver_options=COLD_START_OPTIONS),
-    StageSpec("enforced contact", warm_start_options=ENFORCED_CONTACT_OPTIONS),
+    StageSpec("enforced contact", warm_start_options=ENFORCED_CONTACT_OPTIONS,
+              warm_start_formulations=("full",)),
 )
 #: Stage 3: what the contact stages held, freed one at a time in this order (the impulse
 #: from the no-impulse gait keeps the impulse variants out of worse local minima).
