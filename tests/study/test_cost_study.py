@@ -87,6 +87,11 @@ def test_cases_and_their_sweeps(five_link: RobotModel) -> None:
     assert [s.spec.base.swing_clearance for s in clear.sweeps()] == [0.02]
     assert clear.sweeps()[0].direct_task().options.swing_clearance == 0.02
     assert clear.sweeps()[0].direct_task().options.speed is None
+    # A model that walks fast starts its cases near its own optimum.
+    fast = CostStudySpec(models=(five_link,), costs=("metabolic",), resting_powers=(1.2,),
+                         start_speed=1.25)
+    assert fast.sweeps()[0].spec.speeds == (1.25,)
+    assert fast.settings()["start_speed_m_min"] == pytest.approx(75.0)
 
 
 def test_formulation_auto_is_reduced_only_for_the_five_link_shape(five_link: RobotModel) -> None:
@@ -128,6 +133,8 @@ def test_gait_auto_is_heel_toe_for_a_model_with_feet(five_link: RobotModel) -> N
     ({"formulation": "polar"}, "formulation"),
     ({"variant": "both"}, "variant"),
     ({"gait": "hop"}, "gait"),
+    ({"start_speed": 0.0}, "start_speed"),
+    ({"start_speed": float("nan")}, "start_speed"),
 ])
 def test_bad_requests_name_the_setting(five_link: RobotModel, kwargs: dict[str, Any],
                                        words: str) -> None:
@@ -295,6 +302,8 @@ def test_case_labels() -> None:
     (["--costs", "--resting-powers", "1.2,-1"], "resting powers: -1"),
     (["--costs", "--resting-powers", "1.2,rest"], "--resting-powers: 'rest'"),
     (["--costs", "--regularization", "-0.1"], "regularization"),
+    (["--costs", "--start-speed", "fast"], "--start-speed: speed 'fast'"),
+    (["--costs", "--start-speed", "75"], "start_speed = 75"),
     (["--model", "five-link", "--model", "five-link"], "one model"),
     (["--costs", "--model", "five-link", "--model", "five-link"], "share a name"),
 ])

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -30,17 +29,15 @@ from gaitopt.cli.base import (
     min_knee_flexion_option,
     model_option,
     paper_grid_option,
-    parse_knots,
     resting_power_option,
 )
+from gaitopt.cli.cost_study import run_cost_study
 from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.cli.sweep_grid import make_spec, parse_speeds, parse_variants
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.gait.formulation import default_formulation
 from gaitopt.gait.options import GAITS, KNOT_SPACINGS
-from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import default_workers
-from gaitopt.study.executors import BackendError
 from gaitopt.study.grid_error import (
     CHECK_DIR,
     MAX_REFINE_LEVELS,
@@ -50,9 +47,8 @@ from gaitopt.study.grid_error import (
     grid_error,
     refine_dir_name,
 )
-from gaitopt.study.plan import START_SPEED, SweepSpecError
+from gaitopt.study.plan import START_SPEED
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
-from gaitopt.study.worker import PointOutcome
 
 #: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
 DEFAULT_SPEEDS = "3:60:3"
@@ -169,6 +165,10 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="With --costs: weight of the torque regularisation added to the work and "
                    "metabolic costs.")
+@click.option("--start-speed", default="12m/min", show_default=True,
+              help="With --costs: the speed of each case's cold start, from which its "
+                   "speed-free optimum is warm-started (near the paper cost's optimum: "
+                   "75m/min for the seven-link model with feet).")
 @click.option("--clearance", type=float, default=None,
               help="With --costs: least mid-swing height of the swing tip in m, every case "
                    "(the work cost's optimum drags the swing tip otherwise).")
@@ -191,7 +191,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                   paper_grid: bool, knots: str | None, knot_spacing: str, cost_study: bool,
                   costs: tuple[str, ...],
                   resting_powers: str,
-                  regularization: float, clearance: float | None, gait_kind: str,
+                  regularization: float, start_speed: str, clearance: float | None,
+                  gait_kind: str,
                   formulation: str, workers: int | None, scheduler: str | None) -> None:
     """The paper's study: the four variants over the speed grid plus each speed-free
     optimum (cosine-spaced 16+6 knots), the same on a finer grid (DIR/check-grid) for the
@@ -206,7 +207,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
         run_cost_study(console, directory or COSTS_DIR, model_names or ("five-link",),
                        costs=costs or ("paper", "work", "metabolic"),
                        resting_powers=resting_powers, regularization=regularization,
-                       clearance=clearance, gait=gait_kind, formulation=formulation,
+                       start_speed=start_speed, clearance=clearance, gait=gait_kind,
+                       formulation=formulation,
                        knots=knots, workers=workers, scheduler=scheduler)
         return
     if len(model_names) > 1:
@@ -305,95 +307,6 @@ def refine_points(console: Console, directory: Path, model_name: str, grid: dict
         if errors is None:
             return
         previous = folder
-
-
-def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
-                   costs: Sequence[str], resting_powers: str, regularization: float,
-                   formulation: str, clearance: float | None = None, gait: str = "auto",
-                   knots: str | None = None, workers: int | None,
-                   scheduler: str | None) -> None:
-    """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
-    processes keep their built problems), then ``costs.csv``, the report and the findings."""
-    from gaitopt.gait.api import as_model
-    from gaitopt.study.cost_study import (
-        CostStudyError,
-        CostStudySpec,
-        CostSweep,
-        collect_rows,
-        run_direct_solves,
-        write_settings,
-    )
-    from gaitopt.study.cost_table import write_cost_table
-    from gaitopt.study.driver import make_backend
-
-    start = time.perf_counter()
-    powers: list[float] = []
-    for item in (i.strip() for i in resting_powers.split(",") if i.strip()):
-        try:
-            powers.append(float(item))
-        except ValueError:
-            raise UserError(f"--resting-powers: {item!r} is not a number (W/kg, >= 0)") from None
-    try:
-        spec = CostStudySpec(models=tuple(as_model(m) for m in model_names),
-                             costs=tuple(dict.fromkeys(costs)),
-                             resting_powers=tuple(powers), regularization=regularization,
-                             swing_clearance=clearance, gait=gait,
-                             formulation=formulation,  # type: ignore[arg-type]
-                             knots=(8, 5) if knots is None else parse_knots(knots))
-        sweeps = spec.sweeps()
-    except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
-        raise UserError(str(exc)) from None
-    write_settings(spec, directory)
-    console.print(f"cost study {directory}: {len(sweeps)} cases "
-                  f"({', '.join(m.name for m in spec.models)} x "
-                  f"{', '.join(c.tag for c in spec.cases)})", soft_wrap=True)
-    backend = None
-    try:
-        for k, sweep in enumerate(sweeps, start=1):
-            console.print(f"[{k}/{len(sweeps)}] {sweep.model} ({sweep.formulation}): "
-                          f"{sweep.case.label}", soft_wrap=True)
-            if backend is None:
-                try:
-                    backend = make_backend(workers=workers, scheduler=scheduler)
-                except BackendError as exc:
-                    raise UserError(str(exc)) from None
-            run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
-                              scheduler=scheduler, backend=backend)
-        if backend is not None:
-            def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
-                what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
-                        f" m  cost {outcome.row.cost:.4g}" if path is not None and outcome
-                        else (outcome.row.status if outcome else "the worker died"))
-                console.print(f"{'ok  ' if path else 'FAIL'} direct {sweep.model} "
-                              f"{sweep.case.tag}: {what}", soft_wrap=True)
-
-            console.print("direct (staged) solves of each case's speed-free optimum, the "
-                          "lower of the two optima is kept:", soft_wrap=True)
-            try:
-                kept, solved, failed = run_direct_solves(spec, directory, backend, done)
-            except KeyboardInterrupt:
-                backend.close(wait=False)
-                backend = None
-                console.print("interrupted: every finished solve is saved; rerun the same "
-                              "command to resume", soft_wrap=True)
-                sys.exit(130)
-            console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
-                          soft_wrap=True)
-    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
-        if backend is not None:
-            backend.close(wait=False)
-            backend = None
-        raise
-    finally:
-        if backend is not None:
-            backend.close()
-    table = write_cost_table(directory, collect_rows(spec, directory))
-    console.print(f"table: {table}", soft_wrap=True)
-    from gaitopt.cli.report import write_cost_reports
-
-    page = write_cost_reports(console, directory, directory / "report")
-    console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",
-                  soft_wrap=True)
 
 
 __all__ = ["make_spec", "parse_speeds", "parse_variants", "run_cost_study", "run_with_progress",

@@ -1,0 +1,119 @@
+"""``gaitopt study --costs``: the cost study's command body (the sweeps of every model and
+case on one backend, the direct solves, ``costs.csv``, the report and the findings;
+docs/costs.md)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from rich.console import Console
+
+from gaitopt.cli.base import UserError, parse_knots
+from gaitopt.cli.report import write_cost_reports
+from gaitopt.cli.sweep_progress import run_with_progress
+from gaitopt.robot.biped import BipedStructureError
+from gaitopt.study.executors import BackendError
+from gaitopt.study.plan import SweepSpecError
+from gaitopt.study.worker import PointOutcome
+from gaitopt.units import parse_speed
+
+
+def parse_start_speed(text: str) -> float:
+    """``--start-speed`` in m/s (``75m/min``, ``1.25m/s``; a bare number is m/s)."""
+    try:
+        return parse_speed(text)
+    except ValueError as exc:
+        raise UserError(f"--start-speed: {exc}") from None
+
+
+def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
+                   costs: Sequence[str], resting_powers: str, regularization: float,
+                   formulation: str, start_speed: str = "12m/min",
+                   clearance: float | None = None, gait: str = "auto",
+                   knots: str | None = None, workers: int | None,
+                   scheduler: str | None) -> None:
+    """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
+    processes keep their built problems), then ``costs.csv``, the report and the findings."""
+    from gaitopt.gait.api import as_model
+    from gaitopt.study.cost_study import (
+        CostStudyError,
+        CostStudySpec,
+        CostSweep,
+        collect_rows,
+        run_direct_solves,
+        write_settings,
+    )
+    from gaitopt.study.cost_table import write_cost_table
+    from gaitopt.study.driver import make_backend
+
+    start = time.perf_counter()
+    powers: list[float] = []
+    for item in (i.strip() for i in resting_powers.split(",") if i.strip()):
+        try:
+            powers.append(float(item))
+        except ValueError:
+            raise UserError(f"--resting-powers: {item!r} is not a number (W/kg, >= 0)") from None
+    try:
+        spec = CostStudySpec(models=tuple(as_model(m) for m in model_names),
+                             costs=tuple(dict.fromkeys(costs)),
+                             resting_powers=tuple(powers), regularization=regularization,
+                             swing_clearance=clearance, gait=gait,
+                             formulation=formulation,  # type: ignore[arg-type]
+                             knots=(8, 5) if knots is None else parse_knots(knots),
+                             start_speed=parse_start_speed(start_speed))
+        sweeps = spec.sweeps()
+    except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
+        raise UserError(str(exc)) from None
+    write_settings(spec, directory)
+    console.print(f"cost study {directory}: {len(sweeps)} cases "
+                  f"({', '.join(m.name for m in spec.models)} x "
+                  f"{', '.join(c.tag for c in spec.cases)})", soft_wrap=True)
+    backend = None
+    try:
+        for k, sweep in enumerate(sweeps, start=1):
+            console.print(f"[{k}/{len(sweeps)}] {sweep.model} ({sweep.formulation}): "
+                          f"{sweep.case.label}", soft_wrap=True)
+            if backend is None:
+                try:
+                    backend = make_backend(workers=workers, scheduler=scheduler)
+                except BackendError as exc:
+                    raise UserError(str(exc)) from None
+            run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
+                              scheduler=scheduler, backend=backend)
+        if backend is not None:
+            def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
+                what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
+                        f" m  cost {outcome.row.cost:.4g}" if path is not None and outcome
+                        else (outcome.row.status if outcome else "the worker died"))
+                console.print(f"{'ok  ' if path else 'FAIL'} direct {sweep.model} "
+                              f"{sweep.case.tag}: {what}", soft_wrap=True)
+
+            console.print("direct (staged) solves of each case's speed-free optimum, the "
+                          "lower of the two optima is kept:", soft_wrap=True)
+            try:
+                kept, solved, failed = run_direct_solves(spec, directory, backend, done)
+            except KeyboardInterrupt:
+                backend.close(wait=False)
+                backend = None
+                console.print("interrupted: every finished solve is saved; rerun the same "
+                              "command to resume", soft_wrap=True)
+                sys.exit(130)
+            console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
+                          soft_wrap=True)
+    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
+        if backend is not None:
+            backend.close(wait=False)
+            backend = None
+        raise
+    finally:
+        if backend is not None:
+            backend.close()
+    table = write_cost_table(directory, collect_rows(spec, directory))
+    console.print(f"table: {table}", soft_wrap=True)
+
+    page = write_cost_reports(console, directory, directory / "report")
+    console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",
+                  soft_wrap=True)
