@@ -92,6 +92,9 @@ def test_cases_and_their_sweeps(five_link: RobotModel) -> None:
                          start_speed=1.25)
     assert fast.sweeps()[0].spec.speeds == (1.25,)
     assert fast.settings()["start_speed_m_min"] == pytest.approx(75.0)
+    even = CostStudySpec(models=(five_link,), costs=("paper",), knot_spacing="uniform")
+    assert even.sweeps()[0].spec.base.knot_spacing == "uniform"
+    assert even.sweeps()[0].direct_task().options.knot_spacing == "uniform"
 
 
 def test_formulation_auto_is_reduced_only_for_the_five_link_shape(five_link: RobotModel) -> None:
@@ -134,6 +137,7 @@ def test_gait_auto_is_heel_toe_for_a_model_with_feet(five_link: RobotModel) -> N
     ({"variant": "both"}, "variant"),
     ({"gait": "hop"}, "gait"),
     ({"start_speed": 0.0}, "start_speed"),
+    ({"knot_spacing": "random"}, "knot_spacing"),
     ({"start_speed": float("nan")}, "start_speed"),
 ])
 def test_bad_requests_name_the_setting(five_link: RobotModel, kwargs: dict[str, Any],

@@ -33,6 +33,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                    costs: Sequence[str], resting_powers: str, regularization: float,
                    formulation: str, start_speed: str = "12m/min",
                    clearance: float | None = None, gait: str = "auto",
+                   knot_spacing: str = "cosine",
                    knots: str | None = None, workers: int | None,
                    scheduler: str | None) -> None:
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
@@ -63,7 +64,8 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                              swing_clearance=clearance, gait=gait,
                              formulation=formulation,  # type: ignore[arg-type]
                              knots=(8, 5) if knots is None else parse_knots(knots),
-                             start_speed=parse_start_speed(start_speed))
+                             start_speed=parse_start_speed(start_speed),
+                             knot_spacing=knot_spacing)  # type: ignore[arg-type]
         sweeps = spec.sweeps()
     except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None

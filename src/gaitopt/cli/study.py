@@ -183,9 +183,9 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
               help="The paper's setting: 8+5 knots and its control model (continuous, "
                    "periodic controls); checked against 16+6 knots.")
 @knots_option
-@_spacing_option("cosine", "The knots of each phase of the paper's study: cosine-spaced "
-                           "(clustered at the events, the default) or uniform (always with "
-                           "--paper-grid).")
+@_spacing_option("cosine", "The knots of each phase of the paper's study (and of the cost "
+                           "study): cosine-spaced (clustered at the events, the default) or "
+                           "uniform (always with --paper-grid).")
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
                   paper_grid: bool, knots: str | None, knot_spacing: str, cost_study: bool,
@@ -208,7 +208,7 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                        costs=costs or ("paper", "work", "metabolic"),
                        resting_powers=resting_powers, regularization=regularization,
                        start_speed=start_speed, clearance=clearance, gait=gait_kind,
-                       formulation=formulation,
+                       formulation=formulation, knot_spacing=knot_spacing,
                        knots=knots, workers=workers, scheduler=scheduler)
         return
     if len(model_names) > 1:

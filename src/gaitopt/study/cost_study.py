@@ -48,7 +48,7 @@ from typing import Any, Literal
 from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import Formulation, GaitOptions
+from gaitopt.gait.options import KNOT_SPACINGS, Formulation, GaitOptions, KnotSpacing
 from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.cost_table import CostRow
@@ -141,7 +141,8 @@ class CostStudySpec:
     ``costs`` a subset of paper, work, metabolic (the metabolic cost once per resting power);
     ``regularization`` the weight of ``int sum (u / u_max)^2 dt / T`` added to the work and
     metabolic costs (``GaitOptions.cost_regularization``); ``gait`` ``auto`` (see
-    :meth:`gait_of`), ``walk`` or ``heel-toe``; ``start_speed`` (m/s) the speed of each case's
+    :meth:`gait_of`), ``walk`` or ``heel-toe``; ``knot_spacing`` that of every solve
+    (``cosine`` or ``uniform``); ``start_speed`` (m/s) the speed of each case's
     cold start, from which its speed-free optimum is warm-started (12 m/min, the paper's
     optimum, by default; near the paper cost's optimum of a model that walks faster, such as
     75 m/min for the seven-link model with feet); ``swing_clearance`` (m) the least
@@ -161,10 +162,14 @@ class CostStudySpec:
     variant: str = "ankle+impulse"
     knots: tuple[int, int] = (8, 5)
     start_speed: float = START_SPEED
+    knot_spacing: KnotSpacing = "cosine"
 
     def __post_init__(self) -> None:
         if not self.models:
             raise CostStudyError("models: at least one model is needed")
+        if self.knot_spacing not in KNOT_SPACINGS:
+            raise CostStudyError(f"knot_spacing = {self.knot_spacing!r}: must be one of "
+                                 f"{', '.join(KNOT_SPACINGS)}")
         if not (math.isfinite(self.start_speed) and 0.0 < self.start_speed <= 5.0):
             raise CostStudyError(f"start_speed = {self.start_speed!r} m/s: must lie in "
                                  "(0, 5] m/s (0-300 m/min)")
@@ -238,8 +243,9 @@ class CostStudySpec:
                     extra["swing_clearance"] = self.swing_clearance
                 if self.gait_of(model) != "walk":
                     extra["gait"] = self.gait_of(model)
-                base = GaitOptions(knots=self.knots, formulation=formulation, **case.options(),
-                                   **extra)
+                base = GaitOptions(knots=self.knots, formulation=formulation,
+                                   knot_spacing=self.knot_spacing,
+                                   **case.options(), **extra)
                 spec = SweepSpec(model=model, speeds=(self.start_speed,),
                                  variants=(self.variant,),
                                  free_speed=True, base=base)
@@ -257,6 +263,7 @@ class CostStudySpec:
                 "swing_clearance": self.swing_clearance,
                 "variant": self.variant, "knots": list(self.knots),
                 "start_speed_m_min": self.start_speed * 60.0,
+                "knot_spacing": self.knot_spacing,
                 "human": {"speed_m_min": HUMAN_OPTIMAL_SPEED_M_MIN,
                           "step_length": HUMAN_STEP_LENGTH,
                           "resting_power_w_kg": list(HUMAN_RESTING_POWER)}}
