@@ -328,7 +328,7 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     (``duration`` None, or ``guard=True``). Returns ``(tau_end, y, Phi)``."""
     n = 2 * spec.nq
     point = phase.guard or spec.swing
-    swing = _tip(spec, point)
+    tip = _tip(spec, point)
 
     def rhs(tau: float, z: Array) -> Array:
         if not variational:
@@ -339,10 +339,10 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     def ahead(tau: float, z: Array) -> float:
         # From the origin, where the stance tip stands at the start of the step (and, held,
         # all through a walk's single support; a run's flight holds no tip).
-        return float(_eval(swing, z[:n])[0][0, 0] - spec.arm_distance)
+        return float(_eval(tip, z[:n])[0][0, 0] - spec.arm_distance)
 
     def height(tau: float, z: Array) -> float:
-        return float(_eval(swing, z[:n])[0][1, 0])
+        return float(_eval(tip, z[:n])[0][1, 0])
 
     ahead.terminal, ahead.direction = True, 1.0  # type: ignore[attr-defined]
     height.terminal, height.direction = True, -1.0  # type: ignore[attr-defined]

@@ -211,8 +211,8 @@ def _step_from_sequence(gait: Gait, pd: tuple[float, float] | None, rtol: float)
     (as the transcription's event map does); a release is a liftoff with the gait's
     impulse (0 without one, or after a touchdown at the same instant: then it only projects
     the velocity onto the held points' constraints, which the state already meets); the
-    section holds
-    the first phase's points at rest, the stance point the first of them held on both axes.
+    section holds the first phase's points at rest, the stance point the first of them held
+    on both axes, the swing point the first that touches down.
     """
     try:
         seq = sequence_from_dict(dict(gait.contact_sequence or {}))
@@ -229,12 +229,9 @@ def _step_from_sequence(gait: Gait, pd: tuple[float, float] | None, rtol: float)
         raise StabilityError(f"contact_sequence.phases[0].held = {list(seq.phases[0].held)}: "
                              "the step must start with a point pinned on the ground (the "
                              "Poincare section holds it at the origin)")
-    touchdowns = [ev.touchdown[0] for ev in seq.events if ev.touchdown]
-    if not touchdowns:
-        raise StabilityError("contact_sequence.events: no touchdown, so no guard ends a phase")
     events: list[tuple[StepEvent, ...]] = []
-    guards: dict[int, str] = {}
-    released = {e.leg: e for e in gait.events}  # the recorded events, by the point they move
+    guards: dict[int, str] = {}  # phase index -> the point whose touchdown ends it
+    recorded = {e.leg: e for e in gait.events}  # the gait's events, by the point they move
     for i, ev in enumerate(seq.events):
         after = seq.holds_after(i, swap)
         jumps = []
@@ -242,11 +239,12 @@ def _step_from_sequence(gait: Gait, pd: tuple[float, float] | None, rtol: float)
             guards[i] = ev.touchdown[0]
             jumps.append(StepEvent("strike", ev.touchdown[0], after))
         for point in ev.release:
-            recorded = released.get(point)
-            impulse = None if recorded is None else recorded.impulses.get(point)
+            impulse = recorded[point].impulses.get(point) if point in recorded else None
             magnitude = 0.0 if impulse is None or ev.touchdown else float(np.hypot(*impulse))
             jumps.append(StepEvent("liftoff", point, after, magnitude))
         events.append(tuple(jumps))
+    if not guards:
+        raise StabilityError("contact_sequence.events: no touchdown, so no guard ends a phase")
 
     def profile(i: int) -> PhaseProfile:
         ph = phases[i]
@@ -256,7 +254,7 @@ def _step_from_sequence(gait: Gait, pd: tuple[float, float] | None, rtol: float)
                             qd=np.array(ph.qd), qdd=np.array(ph.qdd),
                             nominal_duration=ph.duration, guard=guards.get(i))
 
-    return StepSpec(model=model, stance=pinned[0], swing=touchdowns[0],
+    return StepSpec(model=model, stance=pinned[0], swing=guards[min(guards)],
                     phases=tuple(profile(i) for i in range(len(phases))),
                     events=tuple(events), arm_distance=ARM_FRACTION * gait.step_length,
                     pd=pd, rtol=rtol, atol=rtol, section_holds=seq.phases[0].held)

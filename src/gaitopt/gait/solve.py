@@ -250,7 +250,7 @@ class _Run:
                 result = self.stage(spec.name, coarse, spec.relax, result, bounds,
                                     hold_ankles=ANKLES in held,
                                     solver_options=spec.solver_options,
-                                    warm_start_options=spec.warm_start(o),
+                                    warm_start_options=spec.warm_start_options(o),
                                     problem=self.cold_options)
                 if not result.success:
                     break
@@ -312,7 +312,7 @@ class _Run:
                                 held_bounds(o, held, start.parameters[SPEED], start,
                                             self.fractions),
                                 hold_ankles=ANKLES in held, solver_options=spec.solver_options,
-                                warm_start_options=spec.warm_start(o))
+                                warm_start_options=spec.warm_start_options(o))
             if not result.success:
                 return result
             if spec.values_only:

@@ -87,8 +87,9 @@ class StageSpec:
     """One continuation stage as data: its name (``{control_model}`` stands for the
     requested one), whether it runs for the options, the contact relaxation, the quantity it
     frees (:data:`ANKLES` or a parameter name; every earlier stage holds it), IPOPT options
-    merged over the transcription's, those merged over the warm-start options when it
-    starts from a solution's multipliers (:meth:`gaitopt.ocp.Transcription.solve`), and what
+    merged over the transcription's, those (for the options) merged over the warm-start
+    options when it starts from a solution's multipliers
+    (:meth:`gaitopt.ocp.Transcription.solve`; None: the transcription's own), and what
     it starts from: the previous stage's solution with its multipliers, or
     (``values_only``) its values alone, for a stage whose NLP differs from the previous
     one's (the later stages then hold at this stage's values)."""
@@ -98,16 +99,8 @@ class StageSpec:
     relax: Relaxation = Relaxation()
     frees: str | None = None
     solver_options: dict[str, Any] | None = None
-    warm_start_options: dict[str, Any] | None = None
-    warm_start_formulations: tuple[str, ...] = ("reduced", "full")
+    warm_start_options: Callable[[GaitOptions], dict[str, Any] | None] = lambda options: None
     values_only: bool = False
-
-    def warm_start(self, options: GaitOptions) -> dict[str, Any] | None:
-        """The stage's warm-start options for ``options``' formulation (None: the
-        transcription's own)."""
-        if options.formulation in self.warm_start_formulations:
-            return self.warm_start_options
-        return None
 
     def title(self, options: GaitOptions) -> str:
         """The stage's name for ``options`` (as printed and kept in the solution)."""
@@ -118,8 +111,8 @@ class StageSpec:
 #: held: the contact conditions relaxed, then enforced (the paper's two-stage process).
 CONTACT_STAGES: tuple[StageSpec, ...] = (
     StageSpec("relaxed contact", relax=RELAXED, solver_options=COLD_START_OPTIONS),
-    StageSpec("enforced contact", warm_start_options=ENFORCED_CONTACT_OPTIONS,
-              warm_start_formulations=("full",)),
+    StageSpec("enforced contact", warm_start_options=lambda o: (
+        ENFORCED_CONTACT_OPTIONS if o.formulation == "full" else None)),
 )
 #: Stage 3: what the contact stages held, freed one at a time in this order (the impulse
 #: from the no-impulse gait keeps the impulse variants out of worse local minima).
