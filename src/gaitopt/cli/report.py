@@ -64,7 +64,8 @@ def write_reports(console: Console, directory: Path, out: Path,
 @click.option("--compare", "compare", multiple=True,
               type=click.Path(file_okay=False, path_type=Path),
               help="Another sweep folder to draw beside this one (energy and step length "
-                   "against speed, optima, people's walk); repeatable.")
+                   "against speed, optima, people's walk); for a cost study, another cost "
+                   "study (its models beside this one's); repeatable.")
 def report_command(directory: Path, output: Path | None, compare: tuple[Path, ...]) -> None:
     """Write the figures and the HTML report of a sweep (or of a cost study), and print the
     findings."""
@@ -73,22 +74,27 @@ def report_command(directory: Path, output: Path | None, compare: tuple[Path, ..
     if not directory.is_dir():
         raise UserError(f"{directory}: no such directory")
     if (directory / COST_STUDY_FILE).exists():
-        if compare:
-            raise UserError("--compare: a cost study's report compares costs; give sweeps")
-        write_cost_reports(make_console(), directory, output or directory / "report")
+        write_cost_reports(make_console(), directory, output or directory / "report", compare)
         return
     write_reports(make_console(), directory, output or directory / "report", compare)
 
 
-def write_cost_reports(console: Console, directory: Path, out: Path) -> Path:
-    """Write a cost study's report from its ``costs.csv``; print the answer and findings."""
+def write_cost_reports(console: Console, directory: Path, out: Path,
+                       compare: tuple[Path, ...] = ()) -> Path:
+    """Write a cost study's report from its ``costs.csv`` (and those of the cost studies in
+    ``compare``, drawn beside it); print the answer and findings."""
     from gaitopt.study.cost_findings import cost_findings_text
-    from gaitopt.study.cost_table import COST_TABLE_FILE, CostStudyError, read_cost_table
-    from gaitopt.viz.cost_report import answer_text, write_cost_report
+    from gaitopt.study.cost_study import COST_STUDY_FILE
+    from gaitopt.study.cost_table import CostStudyError
+    from gaitopt.viz.cost_report import answer_text, study_rows, write_cost_report
 
+    for other in compare:
+        if not (other / COST_STUDY_FILE).exists():
+            raise UserError(f"--compare {other}: no cost study here (no {COST_STUDY_FILE}); "
+                            "a cost study's report compares cost studies")
     try:
-        info = write_cost_report(directory, out)
-        rows = read_cost_table(directory / COST_TABLE_FILE)
+        info = write_cost_report(directory, out, compare=compare)
+        rows = study_rows(directory, compare)
     except CostStudyError as exc:
         raise UserError(f"{exc}; rerun `gaitopt study --costs -o {directory}` to finish the "
                         "study") from None

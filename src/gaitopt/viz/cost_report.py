@@ -1,7 +1,9 @@
 """The cost study's figure and report (docs/costs.md; the study is
 :mod:`gaitopt.study.cost_study`).
 
-``write_cost_report(study_dir, out_dir)`` reads ``costs.csv`` and writes to ``out_dir``:
+``write_cost_report(study_dir, out_dir, compare=())`` reads ``costs.csv`` (and that of each
+other cost study in ``compare``: their models drawn beside this study's, for example a model
+with feet solved on another grid) and writes to ``out_dir``:
 
 * ``report.html``: the answer (the case nearest to people's walk, per model), the figure, the
   table of every (model, case) optimum ranked by its distance from people's walk, and the
@@ -25,7 +27,12 @@ from matplotlib.figure import Figure
 from gaitopt.fileio import write_text_atomic
 from gaitopt.study.cost_findings import assess_cost_findings, physiological, ranked
 from gaitopt.study.cost_study import HUMAN_RESTING_POWER
-from gaitopt.study.cost_table import COST_TABLE_FILE, CostRow, read_cost_table
+from gaitopt.study.cost_table import (
+    COST_TABLE_FILE,
+    CostRow,
+    CostStudyError,
+    read_cost_table,
+)
 from gaitopt.study.findings import (
     HUMAN_OPTIMAL_SPEED_M_MIN,
     HUMAN_STEP_LENGTH,
@@ -137,13 +144,33 @@ def _where(r: CostRow) -> str:
             f"{r.step_length / HUMAN_STEP_LENGTH:.0%} of their step)")
 
 
-def write_cost_report(study_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
-                      svg: bool = True) -> CostReportInfo:
-    """Write the cost study's report (module docstring) from ``study_dir/costs.csv``.
+def study_rows(study_dir: str | os.PathLike[str],
+               compare: Sequence[str | os.PathLike[str]] = ()) -> list[CostRow]:
+    """The rows of ``study_dir/costs.csv`` followed by those of each study in ``compare``.
 
-    Raises :class:`gaitopt.study.cost_table.CostStudyError` if the table is missing or
-    invalid."""
+    Raises :class:`gaitopt.study.cost_table.CostStudyError` if a table is missing or invalid,
+    or if a model's name appears in two of the studies (its rows could not be told apart)."""
     rows = read_cost_table(Path(study_dir) / COST_TABLE_FILE)
+    for other in compare:
+        more = read_cost_table(Path(other) / COST_TABLE_FILE)
+        seen = {r.model for r in rows}
+        twice = sorted({r.model for r in more} & seen)
+        if twice:
+            raise CostStudyError(f"{other}: model {', '.join(twice)} is in two of the compared "
+                                 "cost studies; compare studies of different models")
+        rows += more
+    return rows
+
+
+def write_cost_report(study_dir: str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
+                      compare: Sequence[str | os.PathLike[str]] = (),
+                      svg: bool = True) -> CostReportInfo:
+    """Write the cost study's report (module docstring) from ``study_dir/costs.csv`` and
+    those of ``compare``.
+
+    Raises :class:`gaitopt.study.cost_table.CostStudyError` if a table is missing or
+    invalid, or if two studies hold the same model."""
+    rows = study_rows(study_dir, compare)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     findings = dict(assess_cost_findings(rows))
