@@ -17,12 +17,18 @@ what a smaller or sparser KKT system would shorten:
 * ``step length split``: one copy of the step length per interval of the defects, chained by
   equalities, so no column of the Jacobian and no row of the Hessian is dense; the same
   problem;
+* ``base eliminated`` (with ``--stated`` only): the base's ``x, y`` and rates at the knots
+  after a phase's first solved from the first held point's rows, which are removed: what
+  ``full_problem`` does by default since 2026-12-02 (``place_base``); the same problem;
 * ``step length fixed``: the step length held at its start (not the same problem; what
   removing its dense column could gain at most);
 * ``no projection``: the held-point rows removed and the projection controls fixed at 0 (not
   the same problem; what the projection costs).
 
-    python bench/full_nlp.py [--knots 40,10] [--repeat 6] [--gait FILE]
+    python bench/full_nlp.py [--knots 40,10] [--repeat 6] [--gait FILE] [--stated]
+
+``--stated`` solves and measures the statement with every held-point row
+(``full_problem(..., place_base=False)``, as before 2026-12-02) instead of the default.
 
 The machine's load moves the absolute figures; the ratios to ``base`` in the same run are
 the result.
@@ -46,6 +52,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import gaitopt.ocp.transcription as transcription  # noqa: E402
+from gaitopt.gait import full_coordinates as full  # noqa: E402
 from gaitopt.gait.api import solve_gait_solution  # noqa: E402
 from gaitopt.gait.full_coordinates import HELD, STEP_LENGTH  # noqa: E402
 from gaitopt.gait.gait_file import Gait  # noqa: E402
@@ -217,8 +224,9 @@ def variants(tr: Transcription, args: dict[str, np.ndarray]) -> list[Variant]:
     i_l = np.array([tr.layout.parameter(STEP_LENGTH)])
     no_projection = fixed(without_rows(base, held, "", False), projection,
                           np.zeros(projection.size), "no projection")
+    placed = [] if tr.nlp.dependent.size else [base_eliminated(base, tr)]
     return [base, without_rows(base, free, "free rows removed", True),
-            split_step_length(base, tr), base_eliminated(base, tr),
+            split_step_length(base, tr), *placed,
             fixed(base, i_l, args["x0"][i_l], "step length fixed"), no_projection]
 
 
@@ -238,7 +246,13 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--knots", default="40,10", help="knots per phase, single,double")
     parser.add_argument("--repeat", type=int, default=6, help="interleaved rounds (best kept)")
     parser.add_argument("--gait", type=Path, help="a saved full-coordinate gait (default: solve)")
+    parser.add_argument("--stated", action="store_true",
+                        help="every held-point row stated (place_base=False)")
     a = parser.parse_args(argv)
+    if a.stated:
+        original = full.full_problem
+        full.full_problem = (  # type: ignore[assignment]
+            lambda m, o, s: original(m, o, s, place_base=False))
     k = [int(v) for v in a.knots.split(",")]
     if len(k) != 2 or min(k) < 2:
         parser.error(f"--knots: two integers >= 2, e.g. 40,10, got {a.knots!r}")

@@ -212,6 +212,7 @@ class Transcription:
         """Variables and constraints counted in the paper's terms (see :class:`NlpSize`)."""
         b = bounds or self._bounds
         fixed = b.lbw == b.ubw
+        fixed[self.nlp.dependent] = True  # given by KnotStates: no unknowns
         boxed = (~fixed) & (np.isfinite(b.lbw) | np.isfinite(b.ubw))
         eq = b.lbg == b.ubg
         ineq = (~eq) & (np.isfinite(b.lbg) | np.isfinite(b.ubg))
