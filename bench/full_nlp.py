@@ -22,8 +22,8 @@ what a smaller or sparser KKT system would shorten:
   ``full_problem`` does by default since 2026-12-02 (``place_base``); the same problem;
 * ``step length fixed``: the step length held at its start (not the same problem; what
   removing its dense column could gain at most);
-* ``no projection``: the held-point rows removed and the projection controls fixed at 0 (not
-  the same problem; what the projection costs).
+* ``no projection`` (with ``--stated`` only): the held-point rows removed and the projection
+  controls fixed at 0 (not the same problem; what the projection costs).
 
     python bench/full_nlp.py [--knots 40,10] [--repeat 6] [--gait FILE] [--stated]
 
@@ -53,6 +53,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import gaitopt.ocp.transcription as transcription  # noqa: E402
 from gaitopt.gait import full_coordinates as full  # noqa: E402
+from gaitopt.gait import transcriptions  # noqa: E402
 from gaitopt.gait.api import solve_gait_solution  # noqa: E402
 from gaitopt.gait.full_coordinates import HELD, STEP_LENGTH  # noqa: E402
 from gaitopt.gait.gait_file import Gait  # noqa: E402
@@ -224,10 +225,11 @@ def variants(tr: Transcription, args: dict[str, np.ndarray]) -> list[Variant]:
     i_l = np.array([tr.layout.parameter(STEP_LENGTH)])
     no_projection = fixed(without_rows(base, held, "", False), projection,
                           np.zeros(projection.size), "no projection")
-    placed = [] if tr.nlp.dependent.size else [base_eliminated(base, tr)]
+    # With the base placed, the stance point's projection cannot be removed alone.
+    stated = [] if tr.nlp.dependent.size else [base_eliminated(base, tr), no_projection]
     return [base, without_rows(base, free, "free rows removed", True),
-            split_step_length(base, tr), *placed,
-            fixed(base, i_l, args["x0"][i_l], "step length fixed"), no_projection]
+            split_step_length(base, tr), fixed(base, i_l, args["x0"][i_l], "step length fixed"),
+            *stated]
 
 
 def capture(knots: tuple[int, int], gait_file: Path) -> Captured:
@@ -249,10 +251,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--stated", action="store_true",
                         help="every held-point row stated (place_base=False)")
     a = parser.parse_args(argv)
+    cache = tempfile.TemporaryDirectory()
     if a.stated:
         original = full.full_problem
         full.full_problem = (  # type: ignore[assignment]
             lambda m, o, s: original(m, o, s, place_base=False))
+        # The problem's symbolic functions are cached on disk by options, not by statement.
+        transcriptions.functions_file = (  # type: ignore[assignment]
+            lambda key: Path(cache.name) / f"{abs(hash(key))}.pickle")
     k = [int(v) for v in a.knots.split(",")]
     if len(k) != 2 or min(k) < 2:
         parser.error(f"--knots: two integers >= 2, e.g. 40,10, got {a.knots!r}")

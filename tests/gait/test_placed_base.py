@@ -83,7 +83,8 @@ def test_cold_solves_reach_the_same_optimum(model: RobotModel, ankle: bool, tmp_
     placed = solve_walking(model, options)
     # The same solve with the held-point rows stated (new transcriptions, not the cached).
     monkeypatch.setattr(transcriptions, "_CACHE", {})
-    monkeypatch.setattr(transcriptions, "functions_file", lambda key: tmp_path / "f.pickle")
+    monkeypatch.setattr(transcriptions, "functions_file",
+                        lambda key: tmp_path / f"{abs(hash(key))}.pickle")
     original = full.full_problem
     monkeypatch.setattr(full, "full_problem",
                         lambda m, o, s: original(m, o, s, place_base=False))
