@@ -22,7 +22,11 @@ works for any planar tree with contact points and any :class:`ContactSequence`:
   for a normal-only hold) and velocities ``J qd = 0`` are enforced at every knot after the
   first (at the first they follow from the event map and the previous phase, so they are not
   stated twice), and
-  ``gamma = nu = 0`` at the first knot. This makes the NLP square in the constraint
+  ``gamma = nu = 0`` at the first knot. The first pinned point of a phase states them by
+  construction instead (:func:`base_point`): at those knots the base's ``x, y`` and their
+  rates are not variables but its position and velocity solved for the base
+  (:class:`~gaitopt.ocp.problem.KnotStates`), the same optimum with 4 fewer unknowns and
+  rows per knot. This makes the NLP square in the constraint
   directions: the projection is the discrete correction of the collocation's drift (as in
   Posa, Kuindersma and Tedrake 2016) and vanishes as the grid is refined. The contact points
   stay put to the solver's tolerance at every knot;
@@ -81,6 +85,7 @@ from gaitopt.ocp.problem import (
     BoundaryConstraint,
     ControlLinkage,
     Duration,
+    KnotStates,
     Linkage,
     Parameter,
     PathConstraint,
@@ -93,6 +98,8 @@ from gaitopt.robot.symmetry import LegSwap, leg_swap
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 _L, _V, _P, _F = range(4)
+#: The floating base's translation (m) and its rates (m/s), placed by a pinned point.
+BASE_STATES = ("x", "y", "x_rate", "y_rate")
 
 #: Path constraint of the held points' positions and velocities (knots only).
 HELD = "held points: position and velocity"
@@ -140,8 +147,55 @@ def stance_knees(model: RobotModel) -> dict[str, str]:
     return {leg.contact: leg.knee for leg in legs}
 
 
-def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) -> Problem:
-    """The OCP of one periodic step of ``seq`` in full coordinates (module docstring)."""
+def base_point(model: RobotModel, held: Sequence[str]) -> str | None:
+    """The first point of ``held`` pinned on the ground (``name``, not ``name:y``) if the
+    model's first two coordinates ``x, y`` translate the whole tree (then every point's
+    position is ``(x, y)`` plus a function of the other coordinates, and its velocity
+    ``(x_rate, y_rate)`` plus one of the others: checked at a random state), else None."""
+    pinned = [c for c in held if ":" not in c]
+    if not pinned or tuple(model.coordinate_names[:2]) != ("x", "y"):
+        return None
+    nq = model.nq
+    q, qd = ca.SX.sym("q", nq), ca.SX.sym("qd", nq)
+    fn = ca.Function("point", [q, qd], [contact_position(model, vector(as_scalars(q, nq, "q")),
+                                                          pinned[0]),
+                                        contact_velocity(model, vector(as_scalars(q, nq, "q")),
+                                                         vector(as_scalars(qd, nq, "qd")),
+                                                         pinned[0])])
+    rng = np.random.default_rng(0)
+    q0, qd0, shift = rng.normal(size=nq), rng.normal(size=nq), np.zeros(nq)
+    shift[:2] = rng.normal(size=2)
+    p0, v0 = (np.asarray(v).ravel() for v in fn(q0, qd0))
+    p1, v1 = (np.asarray(v).ravel() for v in fn(q0 + shift, qd0 + shift))
+    translates = np.allclose(p1 - p0, shift[:2], atol=1e-12) and np.allclose(
+        v1 - v0, shift[:2], atol=1e-12)
+    return pinned[0] if translates else None
+
+
+def _placed_base(model: RobotModel, seq: ContactSequence, point: str
+                 ) -> Callable[[Any, Any], Any]:
+    """``(x, p) -> (x, y, x_rate, y_rate)`` of the base that puts ``point`` at its ground
+    point ``(a L + b, 0)`` at rest: minus its position and velocity with the base at 0."""
+    nq = model.nq
+
+    def fn(x: Any, p: Any) -> Any:
+        xs = as_scalars(x, 2 * nq, "x")
+        q = vector([0.0, 0.0] + list(xs[2:nq]))
+        qd = vector([0.0, 0.0] + list(xs[nq + 2:]))
+        pos = as_scalars(contact_position(model, q, point), 2, "p")
+        vel = as_scalars(contact_velocity(model, q, qd, point), 2, "v")
+        return vector([seq.ground_x(point, p[_L]) - pos[0], -pos[1], -vel[0], -vel[1]])
+
+    return fn
+
+
+def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, *,
+                 place_base: bool = True) -> Problem:
+    """The OCP of one periodic step of ``seq`` in full coordinates (module docstring).
+
+    ``place_base`` (default): the first pinned point of each phase places the base at the
+    knots after the first (:func:`base_point`) instead of its held-point rows; False states
+    those rows (the same optimum, a larger NLP)."""
     symmetry = leg_swap(model)
     check_sequence(model, seq, dict(symmetry.contacts))
     nq = model.nq
@@ -177,7 +231,6 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
         acts = actuator_names(model, held, ankle=options.ankle)
         actuators_of[ph.name] = acts
         proj = projection_names(held)
-        n_rows = len(hold_axes(held))
         controls = acts + proj
         cache: dict[str, Any] = {}
 
@@ -190,18 +243,25 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
             return cache["value"]
 
         path: list[PathConstraint] = []
-        if held:
-            def held_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held) -> Any:
+        placed = base_point(model, held) if place_base else None
+        stated = [(c, a) for c, a in hold_axes(held) if c != placed]
+        n_rows = len(stated)
+        if stated:
+            def held_rows(x: Any, u: Any, p: Any, t: Any,
+                          stated: list[tuple[str, int]] = stated) -> Any:
                 xs = as_scalars(x, 2 * nq, "x")
                 q, qd = vector(xs[:nq]), vector(xs[nq:])
                 rows, speeds = [], []
-                for c, a in hold_axes(held):
+                for c, a in stated:
                     pos = as_scalars(contact_position(model, q, c), 2, "p")
                     vel = as_scalars(contact_velocity(model, q, qd, c), 2, "v")
                     rows.append(pos[a] - seq.ground_x(c, p[_L]) if a == 0 else pos[a])
                     speeds.append(vel[a])
                 return vector(rows + speeds)
 
+            path.append(PathConstraint(HELD, held_rows, lower=0.0, upper=0.0, at="knots",
+                                       scale=[0.1] * n_rows + [1.0] * n_rows))
+        if held:
             def force_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held,
                            point: Any = point) -> Any:
                 f = as_scalars(point(x, u).forces, 2 * len(held), "forces")
@@ -212,8 +272,6 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
                             rows += [mu * f[2 * k + 1] - f[2 * k], mu * f[2 * k + 1] + f[2 * k]]
                 return vector(rows)
 
-            path.append(PathConstraint(HELD, held_rows, lower=0.0, upper=0.0, at="knots",
-                                       scale=[0.1] * n_rows + [1.0] * n_rows))
             path.append(PathConstraint(FORCES, force_rows, lower=0.0, upper=ca.inf,
                                        scale=weight))
         landing = seq.events[len(phases)].touchdown
@@ -256,7 +314,9 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence) 
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
             control_scales={n: PROJECTION_SCALE for n in proj},
-            intervals=counts[len(phases)] - 1))
+            intervals=counts[len(phases)] - 1,
+            knot_states=None if placed is None else KnotStates(
+                BASE_STATES, _placed_base(model, seq, placed))))
 
     linkages: list[Linkage | ControlLinkage] = []
     events: list[BoundaryConstraint] = []

@@ -12,6 +12,9 @@ the knots and the midpoints. One more function evaluates everything at the phase
     durations(p) -> (T_i(p) for each phase; 0 where the duration is not an expression)
 
 where ``E`` stacks ``[t0, tf, x0 (n), xf (n), u0 (m), uf (m)]`` of every phase in order.
+A phase with :class:`~gaitopt.ocp.problem.KnotStates` also has
+``knot_states(x (n,1), p (n_p,1)) -> (values (d,1))``, the d states it gives at the knots
+after the first, and their positions in ``x`` (``PhaseFunction.knot_state_rows``).
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import casadi as ca
@@ -119,6 +122,9 @@ class PhaseFunction:
     path_upper: Array
     path_scale: Array
     midpoint_rows: NDArray[np.int64]
+    knot_states: ca.Function | None = None
+    knot_state_rows: NDArray[np.int64] = field(
+        default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     @property
     def n_path(self) -> int:
@@ -170,8 +176,34 @@ def build_phase_function(phase: Phase, n_p: int, *, cse: bool = True) -> PhaseFu
                         ["x", "u", "p", "t"], ["xdot", "path", "lagrange"])
     mid = [i for pr in rows if pr.at == "knots+midpoints"
            for i in range(pr.rows.start, pr.rows.stop)]
+    knot_fn, knot_rows = _knot_states(phase, x, p)
     return PhaseFunction(point, tuple(rows), cat(lowers), cat(uppers), cat(scales),
-                         np.asarray(mid, dtype=np.int64))
+                         np.asarray(mid, dtype=np.int64), knot_fn, knot_rows)
+
+
+def _knot_states(phase: Phase, x: ca.SX, p: ca.SX
+                 ) -> tuple[ca.Function | None, NDArray[np.int64]]:
+    """The phase's :class:`~gaitopt.ocp.problem.KnotStates` as ``(x, p) -> values`` and the
+    positions of its states in ``x`` (None and no rows without one)."""
+    spec = phase.knot_states
+    if spec is None:
+        return None, np.zeros(0, dtype=np.int64)
+    where = f"phase {phase.name!r} knot_states"
+    unknown = [n for n in spec.names if n not in phase.states]
+    if unknown or not spec.names or len(set(spec.names)) != len(spec.names):
+        raise ProblemError(f"{where}: names must be distinct states of the phase, got "
+                           f"{list(spec.names)} (states: {list(phase.states)})")
+    index = np.asarray([list(phase.states).index(n) for n in spec.names], dtype=np.int64)
+    val = call_user(spec.fn, (x, p), where)
+    if val.shape[0] != index.size:
+        raise ProblemError(f"{where}: returned {val.shape[0]} values for {index.size} states "
+                           f"{list(spec.names)}")
+    if any(ca.depends_on(val, x[int(i)]) for i in index):
+        raise ProblemError(f"{where}: the values of {list(spec.names)} must not depend on "
+                           "those states")
+    fn = ca.Function(c_name(f"knot_states_{phase.name}"), [x, p], [val], ["x", "p"],
+                     ["values"])
+    return fn, index
 
 
 @dataclass(frozen=True)

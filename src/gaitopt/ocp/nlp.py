@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.ocp.functions import EndsFunction, PhaseFunction
-from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout
+from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.mesh import Mesh
 from gaitopt.ocp.method import Method, midpoint_control
 from gaitopt.ocp.problem import Problem
@@ -41,7 +41,10 @@ class Nlp:
     """The symbolic NLP and everything needed to scale and name it.
 
     ``w_hat`` (layout.size, 1) MX symbol; ``f`` scaled objective; ``g`` scaled constraints;
-    ``evaluate`` maps unscaled w to ``(g unscaled, numerator, denominator, phase durations)``.
+    ``evaluate`` maps unscaled w to ``(g unscaled, numerator, denominator, phase durations)``;
+    ``dependent`` are the indices in w of the states given by
+    :class:`~gaitopt.ocp.problem.KnotStates` (variables the NLP does not use) and
+    ``knot_states`` maps unscaled w to their values.
     """
 
     w_hat: ca.MX
@@ -55,6 +58,8 @@ class Nlp:
     ubg: Array
     objective_scale: float
     evaluate: ca.Function
+    dependent: NDArray[np.int64]
+    knot_states: ca.Function
 
 
 class _Rows:
@@ -118,6 +123,10 @@ class Assembly:
     numerator: Any
     denominator: Any
     durations: Any
+    dependent_index: NDArray[np.int64]
+    """Indices in w of the states given by :class:`~gaitopt.ocp.problem.KnotStates`."""
+    dependent_values: Any
+    """Their values (unscaled), an expression of ``w_hat``."""
 
 
 def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
@@ -134,9 +143,13 @@ def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
     evaluate = ca.Function("evaluate_unscaled", [w_plain],
                            evaluate.call([w_plain / ca.DM(d_w)]),
                            ["w"], ["g", "numerator", "denominator", "durations"])
+    knot_states = ca.Function("knot_states", [a.w_hat], [a.dependent_values])
+    knot_states = ca.Function("knot_states_unscaled", [w_plain],
+                              knot_states.call([w_plain / ca.DM(d_w)]), ["w"], ["values"])
     return Nlp(a.w_hat, a.f, a.g, layout,
                ConstraintLayout(tuple(rows.blocks), rows.size), d_w, d_g,
-               rows.cat(rows.lower), rows.cat(rows.upper), problem.objective_scale, evaluate)
+               rows.cat(rows.lower), rows.cat(rows.upper), problem.objective_scale, evaluate,
+               a.dependent_index, knot_states)
 
 
 def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
@@ -155,6 +168,8 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
     numerator = sym(0.0)
     ends_parts: list[Any] = []
     durations: list[Any] = []
+    dependent_index: list[int] = []
+    dependent_values: list[Any] = []
     t_start = sym(problem.t0)
     for i, (ph, pl, pf, tau) in enumerate(zip(problem.phases, layout.phases, phase_fns, mesh,
                                               strict=True)):
@@ -169,6 +184,10 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
         durations.append(T)
         Z = ca.reshape(w[pl.knot_block()], pl.stride, K)
         X, U = Z[:n, :], Z[n:, :]
+        if pf.knot_states is not None and K > 1:
+            X, index, values = _knot_states(pf, pl, X, p)
+            dependent_index.extend(index)
+            dependent_values.append(values)
         tk = t_start + T * ca.DM(tau).T
         tm = t_start + T * ca.DM(0.5 * (tau[:-1] + tau[1:])).T
         dtau = ca.DM(np.diff(tau)).T
@@ -236,4 +255,22 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
     f_scaled = J / problem.objective_scale
     g_scaled = g / ca.DM(d_g) if rows.size else g
     return Assembly(w_hat, f_scaled, g_scaled, g, rows, numerator, den,
-                    ca.vertcat(*durations))
+                    ca.vertcat(*durations), np.asarray(dependent_index, dtype=np.int64),
+                    ca.vertcat(*dependent_values) if dependent_values else sym(0, 1))
+
+
+def _knot_states(pf: PhaseFunction, pl: PhaseLayout, X: Any, p: Any
+                 ) -> tuple[Any, list[int], Any]:
+    """``X`` (n, K) with the phase's knot states (``pf.knot_states``) in place of their
+    variables at knots 1..K-1, the indices in w of those variables and their values (a
+    column, knot by knot)."""
+    assert pf.knot_states is not None
+    K = int(X.shape[1])
+    values = pf.knot_states.map(K - 1)(X[:, 1:], p)
+    replaced = dict(zip((int(r) for r in pf.knot_state_rows), range(values.shape[0]),
+                        strict=True))
+    X = ca.vertcat(*[ca.horzcat(X[r, 0], values[replaced[r], :]) if r in replaced else X[r, :]
+                     for r in range(int(X.shape[0]))])
+    names = [pl.states[int(r)] for r in pf.knot_state_rows]
+    index = [pl.index("state", name, k) for k in range(1, K) for name in names]
+    return X, index, ca.vec(values)

@@ -71,6 +71,24 @@ class PhaseEnds:
 
 
 @dataclass(frozen=True)
+class KnotStates:
+    """States given by the others at every knot of a phase after the first (not variables).
+
+    At knot ``k >= 1`` the states ``names`` are ``fn(x_k, p)`` (``len(names)`` values): an
+    explicit solution of equality constraints the problem would otherwise state there, e.g. a
+    floating base placed by a contact point held on the ground. ``fn`` must not read the
+    entries ``names`` of ``x``. The NLP then has neither those variables (they stay in ``w``,
+    fixed, and a result holds their values from ``fn``) nor the constraints they solve: the
+    same optimum with fewer unknowns and rows, provided the box bounds of ``names``, which the
+    NLP no longer imposes at those knots, are inactive (a result reports their violation).
+    The first knot keeps its variables (linkages and initial bounds set them).
+    """
+
+    names: tuple[str, ...]
+    fn: Callable[[ca.SX, ca.SX], Any]
+
+
+@dataclass(frozen=True)
 class Parameter:
     """A static decision parameter shared by all phases, ``lower <= p <= upper``.
 
@@ -206,6 +224,8 @@ class Phase:
         lagrange: integrand ``L(x, u, p, t) -> SX scalar`` of the running cost.
         state_scales / control_scales: variable scales by name (default from bounds).
         intervals: default number of mesh intervals (a transcription may override it).
+        knot_states: states given by the others at every knot after the first
+            (:class:`KnotStates`), or None.
     """
 
     name: str
@@ -224,6 +244,7 @@ class Phase:
     state_scales: Mapping[str, float] = field(default_factory=dict)
     control_scales: Mapping[str, float] = field(default_factory=dict)
     intervals: int = 20
+    knot_states: KnotStates | None = None
 
     @property
     def n_states(self) -> int:

@@ -212,6 +212,7 @@ class Transcription:
         """Variables and constraints counted in the paper's terms (see :class:`NlpSize`)."""
         b = bounds or self._bounds
         fixed = b.lbw == b.ubw
+        fixed[self.nlp.dependent] = True  # given by KnotStates: no unknowns
         boxed = (~fixed) & (np.isfinite(b.lbw) | np.isfinite(b.ubw))
         eq = b.lbg == b.ubg
         ineq = (~eq) & (np.isfinite(b.lbg) | np.isfinite(b.ubg))
@@ -248,6 +249,15 @@ class Transcription:
         d_w, d_g, s_j = self.nlp.d_w, self.nlp.d_g, self.nlp.objective_scale
         args: dict[str, Any] = dict(x0=w0 / d_w, lbx=b.lbw / d_w, ubx=b.ubw / d_w,
                                     lbg=b.lbg / d_g, ubg=b.ubg / d_g)
+        dep = self.nlp.dependent
+        if dep.size:
+            # Variables the NLP does not read (KnotStates give their values): fixed, so
+            # IPOPT removes them; their bounds are checked on the result instead.
+            held = np.nan_to_num(args["x0"][dep], nan=0.0, posinf=0.0, neginf=0.0)
+            args["x0"] = args["x0"].copy()
+            args["x0"][dep] = held
+            args["lbx"], args["ubx"] = args["lbx"].copy(), args["ubx"].copy()
+            args["lbx"][dep] = args["ubx"][dep] = held
         restart = isinstance(guess, WarmStart) or (
             isinstance(guess, Result) and guess.layout_signature == self.layout.signature()
             and guess.method == self.method and guess.lam_g.size == d_g.size)
@@ -268,6 +278,8 @@ class Transcription:
     def _result(self, out: SolverOutput, b: Bounds) -> Result:
         nlp = self.nlp
         w = out.x * nlp.d_w
+        if nlp.dependent.size:
+            w[nlp.dependent] = np.asarray(nlp.knot_states(w), dtype=float).ravel()
         lam_x = out.lam_x * nlp.objective_scale / nlp.d_w
         lam_g = out.lam_g * nlp.objective_scale / nlp.d_g
         g, num, den, durs = (np.asarray(v, dtype=float).ravel() for v in nlp.evaluate(w))
