@@ -77,7 +77,8 @@ def _rows(start_m_min: float, free_m_min: float | None, step: float = 0.3) -> li
 # -- the rule -------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize(("paper_m_min", "start_m_min"), [
-    (11.1, 12.0),    # the five-link biped on 8 + 5 knots: the start it always had
+    (11.1, 12.0),    # the five-link biped on uniform 8 + 5 knots: the start it always had
+    (13.6, 15.0),    # ... on cosine 8 + 5 knots
     (13.27, 12.0),   # ... on the converged grid
     (73.53, 75.0),   # the seven-link model with feet, cosine 24 + 16 knots
     (74.75, 75.0),   # ... uniform 24 + 16 knots
