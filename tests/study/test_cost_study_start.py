@@ -27,6 +27,7 @@ from gaitopt.study.cost_start import (
 from gaitopt.study.cost_study import (
     COST_STUDY_FILE,
     DEFAULT_KNOTS,
+    STUDY_MAX_ITER,
     CostCase,
     CostStudyError,
     CostStudySpec,
@@ -185,6 +186,10 @@ def test_knots_by_gait(five_link: RobotModel, seven_link: RobotModel) -> None:
     five, seven = spec.sweeps()
     assert (five.spec.base.knots, seven.spec.base.knots) == ((8, 5), (24, 16))
     assert seven.spec.base.gait == "heel-toe" and seven.formulation == "full"
+    # every solve of the study, sweep points and direct solves, has the study's iteration limit
+    assert {s.spec.base.max_iter for s in (five, seven)} == {STUDY_MAX_ITER}
+    assert seven.direct_task().options.max_iter == STUDY_MAX_ITER
+    assert spec.settings()["max_iter"] == STUDY_MAX_ITER
     assert [m["knots"] for m in spec.settings()["models"]] == [[8, 5], [24, 16]]
     fixed = CostStudySpec(models=(five_link, seven_link), costs=("paper",), knots=(16, 6))
     assert {s.spec.base.knots for s in fixed.sweeps()} == {(16, 6)}

@@ -3,9 +3,12 @@
 For every model asked for, the speed-free optimal walk of each *case*: the paper's cost, the
 mechanical cost of transport (``work``) and the metabolic cost at each resting power
 ``P_rest`` (W/kg) of a list (the human value, about 1.2-1.5 W/kg, among them). Each case is a
-small sweep (:mod:`gaitopt.study.plan`: the 12 m/min walk solved cold, the speed-free optimum
-warm-started from it) in its own folder, so everything the sweeps do holds here too: points
-written atomically as they finish, resumable, refused when the folder holds other settings.
+small sweep (:mod:`gaitopt.study.plan`: the walk at the case's start speed solved cold, the
+speed-free optimum warm-started from it) in its own folder, so everything the sweeps do holds
+here too: points written atomically as they finish, resumable, refused when the folder holds
+other settings. The start speed is given, or by default each model's paper case starts at
+12 m/min and its other cases at the speed of the paper case's optimum rounded to 3 m/min
+(:mod:`gaitopt.study.cost_start`).
 
 The problems have several local optima, and the speed-free optimum reached from the 12 m/min
 walk is not always the lowest (metabolic cost, 4.8 W/kg: 42.2 m/min with 0.39 m steps, 1.8 %
@@ -78,6 +81,12 @@ HUMAN_RESTING_POWER: tuple[float, float] = (1.2, 1.5)
 #: for the heel-toe walk 24 + 16 (phase 0, the others at least; docs/feet.md's grid, on which
 #: the seven-link model's costs were measured).
 DEFAULT_KNOTS: dict[str, tuple[int, int]] = {"walk": (8, 5), "heel-toe": (24, 16)}
+#: IPOPT's iteration limit per stage of every solve of the study (``GaitOptions.max_iter``,
+#: 1000 elsewhere). The smoothing stages of the costs of transport take hundreds to thousands
+#: of iterations on the model with feet (bang-bang torques): at 75 m/min on cosine 24 + 16
+#: knots the metabolic cost's last stage stopped at 1000 and converged in 2071 (docs/feet.md).
+#: A solve that converges within 1000 iterations is the same with this limit.
+STUDY_MAX_ITER = 3000
 COST_STUDY_FILE = "cost_study.json"
 COST_STUDY_FORMAT = "gaitopt.cost-study"
 DIRECT_FILE = "direct.gait.json"
@@ -260,7 +269,8 @@ class CostStudySpec:
             extra["gait"] = self.gait_of(model)
         formulation = self.formulation_of(model)
         base = GaitOptions(knots=self.knots_of(model), formulation=formulation,
-                           knot_spacing=self.knot_spacing, **case.options(), **extra)
+                           knot_spacing=self.knot_spacing, max_iter=STUDY_MAX_ITER,
+                           **case.options(), **extra)
         spec = SweepSpec(model=model, speeds=(start_speed,), variants=(self.variant,),
                          free_speed=True, base=base)
         return CostSweep(model=model.name, case=case, formulation=formulation,
@@ -309,7 +319,7 @@ class CostStudySpec:
                 "models": models,
                 "cases": [c.tag for c in self.cases], "regularization": self.regularization,
                 "swing_clearance": self.swing_clearance,
-                "variant": self.variant,
+                "variant": self.variant, "max_iter": STUDY_MAX_ITER,
                 "knots": None if self.knots is None else list(self.knots),
                 "start_rule": AUTO_START if self.auto_start else "given",
                 "start_speed_m_min": (None if self.auto_start
