@@ -19,6 +19,7 @@ from gaitopt.gait.gait_file import Gait
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.loader import model_from_dict
 from gaitopt.study.cost_findings import COST_FINDING_IDS, assess_cost_findings, ranked
+from gaitopt.study.cost_start import given_start
 from gaitopt.study.cost_study import (
     COST_STUDY_FILE,
     DIRECT_FILE,
@@ -71,7 +72,7 @@ def test_cases_and_their_sweeps(five_link: RobotModel) -> None:
                          regularization=0.01)
     assert [c.tag for c in spec.cases] == ["paper", "work", "metabolic-rest-0",
                                           "metabolic-rest-1.2", "metabolic-rest-2.4"]
-    sweeps = spec.sweeps()
+    sweeps = spec.sweeps({"five-link": given_start(START_SPEED)})
     assert [s.subdir for s in sweeps] == [f"five-link/{c.tag}" for c in spec.cases]
     for s in sweeps:
         base = s.spec.base
@@ -83,7 +84,8 @@ def test_cases_and_their_sweeps(five_link: RobotModel) -> None:
         assert s.spec.variants == ("ankle+impulse",)
     assert [s.spec.base.resting_power for s in sweeps[2:]] == [0.0, 1.2, 2.4]
     assert all(s.spec.base.swing_clearance is None for s in sweeps)
-    clear = CostStudySpec(models=(five_link,), costs=("work",), swing_clearance=0.02)
+    clear = CostStudySpec(models=(five_link,), costs=("work",), swing_clearance=0.02,
+                          start_speed=START_SPEED)
     assert [s.spec.base.swing_clearance for s in clear.sweeps()] == [0.02]
     assert clear.sweeps()[0].direct_task().options.swing_clearance == 0.02
     assert clear.sweeps()[0].direct_task().options.speed is None
@@ -92,6 +94,7 @@ def test_cases_and_their_sweeps(five_link: RobotModel) -> None:
                          start_speed=1.25)
     assert fast.sweeps()[0].spec.speeds == (1.25,)
     assert fast.settings()["start_speed_m_min"] == pytest.approx(75.0)
+    assert fast.settings()["models"][0]["start"]["rule"] == "given"
     even = CostStudySpec(models=(five_link,), costs=("paper",), knot_spacing="uniform")
     assert even.sweeps()[0].spec.base.knot_spacing == "uniform"
     assert even.sweeps()[0].direct_task().options.knot_spacing == "uniform"

@@ -16,35 +16,45 @@ from gaitopt.cli.report import write_cost_reports
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.executors import BackendError
-from gaitopt.study.plan import SweepSpecError
+from gaitopt.study.plan import START_SPEED, SweepSpecError
 from gaitopt.study.worker import PointOutcome
 from gaitopt.units import parse_speed
 
 
-def parse_start_speed(text: str) -> float:
-    """``--start-speed`` in m/s (``75m/min``, ``1.25m/s``; a bare number is m/s)."""
+def parse_start_speed(text: str) -> float | str:
+    """``--start-speed``: ``auto`` or a speed in m/s (``75m/min``, ``1.25m/s``; a bare number
+    is m/s)."""
+    from gaitopt.study.cost_start import AUTO_START
+
+    if text.strip().lower() == AUTO_START:
+        return AUTO_START
     try:
         return parse_speed(text)
     except ValueError as exc:
-        raise UserError(f"--start-speed: {exc}") from None
+        raise UserError(f"--start-speed: {exc} (or {AUTO_START!r}: each model's other cases "
+                        "start at its paper optimum's speed)") from None
 
 
 def run_cost_study(console: Console, directory: Path, model_names: Sequence[str], *,
                    costs: Sequence[str], resting_powers: str, regularization: float,
-                   formulation: str, start_speed: str = "12m/min",
+                   formulation: str, start_speed: str = "auto",
                    clearance: float | None = None, gait: str = "auto",
                    knot_spacing: str = "cosine",
                    knots: str | None = None, workers: int | None,
                    scheduler: str | None) -> None:
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
-    processes keep their built problems), then ``costs.csv``, the report and the findings."""
+    processes keep their built problems; with ``--start-speed auto`` each model's paper case
+    first, whose optimum sets the start of the model's other cases), then the direct solves,
+    ``costs.csv``, the report and the findings."""
     from gaitopt.gait.api import as_model
+    from gaitopt.study.cost_start import StartChoice
     from gaitopt.study.cost_study import (
         CostStudyError,
         CostStudySpec,
         CostSweep,
         collect_rows,
         run_direct_solves,
+        start_choice,
         write_settings,
     )
     from gaitopt.study.cost_table import write_cost_table
@@ -63,28 +73,53 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                              resting_powers=tuple(powers), regularization=regularization,
                              swing_clearance=clearance, gait=gait,
                              formulation=formulation,  # type: ignore[arg-type]
-                             knots=(8, 5) if knots is None else parse_knots(knots),
+                             knots=None if knots is None else parse_knots(knots),
                              start_speed=parse_start_speed(start_speed),
                              knot_spacing=knot_spacing)  # type: ignore[arg-type]
-        sweeps = spec.sweeps()
+        # Every sweep's settings checked before anything is solved (the automatic start's
+        # speed is not known yet: 12 m/min stands in for it here).
+        spec.sweeps({m.name: StartChoice(speed=START_SPEED, rule="auto", reason="")
+                     for m in spec.models})
     except (CostStudyError, SweepSpecError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
-    write_settings(spec, directory)
-    console.print(f"cost study {directory}: {len(sweeps)} cases "
+    starts = {m.name: start_choice(spec, m, directory) for m in spec.models
+              if not spec.auto_start}
+    write_settings(spec, directory, starts)
+    n_cases = len(spec.models) * len(spec.cases)
+    console.print(f"cost study {directory}: {n_cases} cases "
                   f"({', '.join(m.name for m in spec.models)} x "
                   f"{', '.join(c.tag for c in spec.cases)})", soft_wrap=True)
     backend = None
+    counted = 0
+
+    def run_sweep(sweep: CostSweep, count: str) -> None:
+        nonlocal backend
+        console.print(f"{count} {sweep.model} ({sweep.formulation}): {sweep.case.label}, "
+                      f"from {sweep.spec.speeds[0] * 60.0:g} m/min", soft_wrap=True)
+        if backend is None:
+            try:
+                backend = make_backend(workers=workers, scheduler=scheduler)
+            except BackendError as exc:
+                raise UserError(str(exc)) from None
+        run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
+                          scheduler=scheduler, backend=backend)
+
     try:
-        for k, sweep in enumerate(sweeps, start=1):
-            console.print(f"[{k}/{len(sweeps)}] {sweep.model} ({sweep.formulation}): "
-                          f"{sweep.case.label}", soft_wrap=True)
-            if backend is None:
-                try:
-                    backend = make_backend(workers=workers, scheduler=scheduler)
-                except BackendError as exc:
-                    raise UserError(str(exc)) from None
-            run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
-                              scheduler=scheduler, backend=backend)
+        for model in spec.models:
+            if spec.auto_start:  # the paper case first: its optimum sets the others' start
+                counted += "paper" in spec.costs
+                run_sweep(spec.reference_sweep(model),
+                          f"[{counted}/{n_cases}]" if "paper" in spec.costs else "[start]")
+                starts[model.name] = start_choice(spec, model, directory)
+                write_settings(spec, directory, starts)
+                console.print(f"{model.name}: its other cases start at "
+                              f"{starts[model.name].reason}", soft_wrap=True)
+            for case in spec.cases:
+                if spec.auto_start and case.cost == "paper":
+                    continue
+                counted += 1
+                run_sweep(spec.sweep_of(model, case, spec.start_of(model, case, starts)),
+                          f"[{counted}/{n_cases}]")
         if backend is not None:
             def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
                 what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"

@@ -165,10 +165,11 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="With --costs: weight of the torque regularisation added to the work and "
                    "metabolic costs.")
-@click.option("--start-speed", default="12m/min", show_default=True,
+@click.option("--start-speed", default="auto", show_default=True,
               help="With --costs: the speed of each case's cold start, from which its "
-                   "speed-free optimum is warm-started (near the paper cost's optimum: "
-                   "75m/min for the seven-link model with feet).")
+                   "speed-free optimum is warm-started (e.g. 75m/min); auto: each model's "
+                   "paper case starts at 12 m/min, its other cases at the speed of the paper "
+                   "case's optimum rounded to 3 m/min.")
 @click.option("--clearance", type=float, default=None,
               help="With --costs: least mid-swing height of the swing tip in m, every case "
                    "(the work cost's optimum drags the swing tip otherwise).")

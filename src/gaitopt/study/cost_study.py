@@ -3,9 +3,12 @@
 For every model asked for, the speed-free optimal walk of each *case*: the paper's cost, the
 mechanical cost of transport (``work``) and the metabolic cost at each resting power
 ``P_rest`` (W/kg) of a list (the human value, about 1.2-1.5 W/kg, among them). Each case is a
-small sweep (:mod:`gaitopt.study.plan`: the 12 m/min walk solved cold, the speed-free optimum
-warm-started from it) in its own folder, so everything the sweeps do holds here too: points
-written atomically as they finish, resumable, refused when the folder holds other settings.
+small sweep (:mod:`gaitopt.study.plan`: the walk at the case's start speed solved cold, the
+speed-free optimum warm-started from it) in its own folder, so everything the sweeps do holds
+here too: points written atomically as they finish, resumable, refused when the folder holds
+other settings. The start speed is given, or by default each model's paper case starts at
+12 m/min and its other cases at the speed of the paper case's optimum rounded to 3 m/min
+(:mod:`gaitopt.study.cost_start`).
 
 The problems have several local optima, and the speed-free optimum reached from the 12 m/min
 walk is not always the lowest (metabolic cost, 4.8 W/kg: 42.2 m/min with 0.39 m steps, 1.8 %
@@ -40,7 +43,7 @@ import json
 import math
 import os
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -51,6 +54,7 @@ from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import KNOT_SPACINGS, Formulation, GaitOptions, KnotSpacing
 from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
+from gaitopt.study.cost_start import AUTO_START, StartChoice, auto_start_speed, given_start
 from gaitopt.study.cost_table import CostRow
 from gaitopt.study.cost_table import CostStudyError as CostStudyError
 from gaitopt.study.executors import Backend
@@ -73,11 +77,21 @@ DEFAULT_RESTING_POWERS: tuple[float, ...] = (0.0, 0.6, 1.2, 2.4, 4.8)
 #: People's resting metabolic power (W/kg): the band marked in the figure and used by the
 #: findings (docs/costs.md gives the sources).
 HUMAN_RESTING_POWER: tuple[float, float] = (1.2, 1.5)
+#: Knots per phase of each case by gait (``knots=None``): the paper's 8 + 5 for its walk;
+#: for the heel-toe walk 24 + 16 (phase 0, the others at least; docs/feet.md's grid, on which
+#: the seven-link model's costs were measured).
+DEFAULT_KNOTS: dict[str, tuple[int, int]] = {"walk": (8, 5), "heel-toe": (24, 16)}
+#: IPOPT's iteration limit per stage of every solve of the study (``GaitOptions.max_iter``,
+#: 1000 elsewhere). The smoothing stages of the costs of transport take hundreds to thousands
+#: of iterations on the model with feet (bang-bang torques): at 75 m/min on cosine 24 + 16
+#: knots the metabolic cost's last stage stopped at 1000 and converged in 2071 (docs/feet.md).
+#: A solve that converges within 1000 iterations is the same with this limit.
+STUDY_MAX_ITER = 3000
 COST_STUDY_FILE = "cost_study.json"
 COST_STUDY_FORMAT = "gaitopt.cost-study"
 DIRECT_FILE = "direct.gait.json"
 #: How a case's optimum was reached (the ``start`` column): warm from the sweep's cold start
-#: (``from {speed} m/min``, the study's start speed) or by the direct staged solve.
+#: (``from {speed} m/min``, the case's start speed) or by the direct staged solve.
 STARTS = ("from {speed:g} m/min", "direct")
 
 
@@ -143,13 +157,15 @@ class CostStudySpec:
     metabolic costs (``GaitOptions.cost_regularization``); ``gait`` ``auto`` (see
     :meth:`gait_of`), ``walk`` or ``heel-toe``; ``knot_spacing`` that of every solve
     (``cosine`` or ``uniform``); ``start_speed`` (m/s) the speed of each case's
-    cold start, from which its speed-free optimum is warm-started (12 m/min, the paper's
-    optimum, by default; near the paper cost's optimum of a model that walks faster, such as
-    75 m/min for the seven-link model with feet); ``swing_clearance`` (m) the least
-    mid-swing height of the swing tip in every case (``GaitOptions.swing_clearance``; None: no
-    such constraint); ``formulation`` ``auto`` (see the
-    module docstring), ``reduced`` or ``full``; ``variant`` one of
-    :data:`gaitopt.study.summary.VARIANTS`; ``knots`` per phase.
+    cold start, from which its speed-free optimum is warm-started, or ``"auto"`` (the
+    default): each model's paper case starts at 12 m/min and its other cases at the speed of
+    the paper case's optimum rounded to 3 m/min (:mod:`gaitopt.study.cost_start`; 12 m/min
+    for the five-link biped, 75 m/min for the seven-link model with feet);
+    ``swing_clearance`` (m) the least mid-swing height of the swing tip in every case
+    (``GaitOptions.swing_clearance``; None: no such constraint); ``formulation`` ``auto``
+    (see the module docstring), ``reduced`` or ``full``; ``variant`` one of
+    :data:`gaitopt.study.summary.VARIANTS`; ``knots`` per phase, or None: by each model's
+    gait (:data:`DEFAULT_KNOTS`, :meth:`knots_of`).
     """
 
     models: tuple[RobotModel, ...]
@@ -160,8 +176,8 @@ class CostStudySpec:
     formulation: CostStudyFormulation = "auto"
     gait: str = "auto"
     variant: str = "ankle+impulse"
-    knots: tuple[int, int] = (8, 5)
-    start_speed: float = START_SPEED
+    knots: tuple[int, int] | None = None
+    start_speed: float | str = AUTO_START
     knot_spacing: KnotSpacing = "cosine"
 
     def __post_init__(self) -> None:
@@ -170,9 +186,12 @@ class CostStudySpec:
         if self.knot_spacing not in KNOT_SPACINGS:
             raise CostStudyError(f"knot_spacing = {self.knot_spacing!r}: must be one of "
                                  f"{', '.join(KNOT_SPACINGS)}")
-        if not (math.isfinite(self.start_speed) and 0.0 < self.start_speed <= 5.0):
-            raise CostStudyError(f"start_speed = {self.start_speed!r} m/s: must lie in "
-                                 "(0, 5] m/s (0-300 m/min)")
+        if self.start_speed != AUTO_START and not (
+                isinstance(self.start_speed, float | int)
+                and not isinstance(self.start_speed, bool)
+                and math.isfinite(self.start_speed) and 0.0 < self.start_speed <= 5.0):
+            raise CostStudyError(f"start_speed = {self.start_speed!r} m/s: must be "
+                                 f"{AUTO_START!r} or lie in (0, 5] m/s (0-300 m/min)")
         names = [m.name for m in self.models]
         if len(set(names)) != len(names):
             raise CostStudyError(f"models: two models share a name ({', '.join(names)}); "
@@ -230,51 +249,116 @@ class CostStudySpec:
         on_link = [c for c in model.contacts if c.link == link]
         return "heel-toe" if len(on_link) == 2 else "walk"
 
-    def sweeps(self) -> tuple[CostSweep, ...]:
-        """Every (model, case) sweep: the walk at ``start_speed`` and the speed-free
-        optimum."""
-        out = []
-        for model in self.models:
-            formulation = self.formulation_of(model)
-            for case in self.cases:
-                extra: dict[str, Any] = ({"cost_regularization": self.regularization}
-                         if self.regularization > 0.0 and case.cost != "paper" else {})
-                if self.swing_clearance is not None:
-                    extra["swing_clearance"] = self.swing_clearance
-                if self.gait_of(model) != "walk":
-                    extra["gait"] = self.gait_of(model)
-                base = GaitOptions(knots=self.knots, formulation=formulation,
-                                   knot_spacing=self.knot_spacing,
-                                   **case.options(), **extra)
-                spec = SweepSpec(model=model, speeds=(self.start_speed,),
-                                 variants=(self.variant,),
-                                 free_speed=True, base=base)
-                out.append(CostSweep(model=model.name, case=case, formulation=formulation,
-                                     subdir=f"{model.name}/{case.tag}", spec=spec))
-        return tuple(out)
+    def knots_of(self, model: RobotModel) -> tuple[int, int]:
+        """The knots of ``model``'s cases: ``knots``, or by its gait (:data:`DEFAULT_KNOTS`)."""
+        return self.knots if self.knots is not None else DEFAULT_KNOTS[self.gait_of(model)]
 
-    def settings(self) -> dict[str, Any]:
-        """The study's settings (``cost_study.json``)."""
+    @property
+    def auto_start(self) -> bool:
+        """Whether each model's start speed comes from its paper case's optimum."""
+        return self.start_speed == AUTO_START
+
+    def sweep_of(self, model: RobotModel, case: CostCase, start_speed: float) -> CostSweep:
+        """The sweep of one (model, case): the walk at ``start_speed`` (m/s), solved cold, and
+        the speed-free optimum warm-started from it."""
+        extra: dict[str, Any] = ({"cost_regularization": self.regularization}
+                                 if self.regularization > 0.0 and case.cost != "paper" else {})
+        if self.swing_clearance is not None:
+            extra["swing_clearance"] = self.swing_clearance
+        if self.gait_of(model) != "walk":
+            extra["gait"] = self.gait_of(model)
+        formulation = self.formulation_of(model)
+        base = GaitOptions(knots=self.knots_of(model), formulation=formulation,
+                           knot_spacing=self.knot_spacing, max_iter=STUDY_MAX_ITER,
+                           **case.options(), **extra)
+        spec = SweepSpec(model=model, speeds=(start_speed,), variants=(self.variant,),
+                         free_speed=True, base=base)
+        return CostSweep(model=model.name, case=case, formulation=formulation,
+                         subdir=f"{model.name}/{case.tag}", spec=spec)
+
+    def reference_sweep(self, model: RobotModel) -> CostSweep:
+        """With the automatic start: the paper case's sweep of ``model`` from 12 m/min, whose
+        speed-free optimum sets the start of the model's other cases (solved first, also when
+        the paper case is not among ``costs``; its row is then not in the table)."""
+        return self.sweep_of(model, CostCase("paper"), START_SPEED)
+
+    def start_of(self, model: RobotModel, case: CostCase,
+                 starts: Mapping[str, StartChoice] | None) -> float:
+        """The start speed (m/s) of one (model, case): ``start_speed``; with the automatic
+        start 12 m/min for the paper case and ``starts[model.name]`` for the others."""
+        if not self.auto_start:
+            return float(self.start_speed)
+        if case.cost == "paper":
+            return START_SPEED
+        if starts is None or model.name not in starts:
+            raise CostStudyError(f"start_speed = {AUTO_START!r}: the start speed of model "
+                                 f"{model.name!r} comes from its paper case, not solved yet")
+        return starts[model.name].speed
+
+    def sweeps(self, starts: Mapping[str, StartChoice] | None = None
+               ) -> tuple[CostSweep, ...]:
+        """Every (model, case) sweep (:meth:`sweep_of`) at its start speed (:meth:`start_of`;
+        ``starts`` the automatic start of each model, :func:`start_choices`)."""
+        return tuple(self.sweep_of(model, case, self.start_of(model, case, starts))
+                     for model in self.models for case in self.cases)
+
+    def settings(self, starts: Mapping[str, StartChoice] | None = None) -> dict[str, Any]:
+        """The study's settings (``cost_study.json``). ``start_rule`` is ``auto`` or
+        ``given`` (then ``start_speed_m_min``); ``starts`` the start speed each model's
+        non-paper cases used, as far as known (:class:`StartChoice`), under
+        ``models[i].start`` (None while unknown)."""
+        models = []
+        for m in self.models:
+            choice = (given_start(float(self.start_speed)) if not self.auto_start
+                      else None if starts is None else starts.get(m.name))
+            models.append({"name": m.name, "content_hash": m.content_hash(),
+                           "formulation": self.formulation_of(m), "gait": self.gait_of(m),
+                           "knots": list(self.knots_of(m)),
+                           "start": None if choice is None else choice.to_dict()})
         return {"format": COST_STUDY_FORMAT, "version": 1, "gaitopt_version": __version__,
-                "models": [{"name": m.name, "content_hash": m.content_hash(),
-                            "formulation": self.formulation_of(m), "gait": self.gait_of(m)}
-                           for m in self.models],
+                "models": models,
                 "cases": [c.tag for c in self.cases], "regularization": self.regularization,
                 "swing_clearance": self.swing_clearance,
-                "variant": self.variant, "knots": list(self.knots),
-                "start_speed_m_min": self.start_speed * 60.0,
+                "variant": self.variant, "max_iter": STUDY_MAX_ITER,
+                "knots": None if self.knots is None else list(self.knots),
+                "start_rule": AUTO_START if self.auto_start else "given",
+                "start_speed_m_min": (None if self.auto_start
+                                      else float(self.start_speed) * 60.0),
                 "knot_spacing": self.knot_spacing,
                 "human": {"speed_m_min": HUMAN_OPTIMAL_SPEED_M_MIN,
                           "step_length": HUMAN_STEP_LENGTH,
                           "resting_power_w_kg": list(HUMAN_RESTING_POWER)}}
 
 
-def write_settings(spec: CostStudySpec, directory: str | os.PathLike[str]) -> Path:
-    """Write ``cost_study.json`` atomically (it marks the folder as a cost study)."""
+def write_settings(spec: CostStudySpec, directory: str | os.PathLike[str],
+                   starts: Mapping[str, StartChoice] | None = None) -> Path:
+    """Write ``cost_study.json`` atomically (it marks the folder as a cost study); ``starts``
+    the start speeds known so far (:meth:`CostStudySpec.settings`)."""
     path = Path(directory) / COST_STUDY_FILE
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(path, json.dumps(spec.settings(), indent=2) + "\n")
+    write_text_atomic(path, json.dumps(spec.settings(starts), indent=2) + "\n")
     return path
+
+
+def start_choice(spec: CostStudySpec, model: RobotModel,
+                 directory: str | os.PathLike[str]) -> StartChoice:
+    """The start speed of ``model``'s non-paper cases: the given one, or with the automatic
+    start the one :func:`~gaitopt.study.cost_start.auto_start_speed` takes from the paper
+    case's sweep in ``directory`` (its ``summary.csv``; 12 m/min if it is not there)."""
+    if not spec.auto_start:
+        return given_start(float(spec.start_speed))
+    ref = spec.reference_sweep(model)
+    try:
+        rows = read_summary(Path(directory) / ref.subdir / SUMMARY_FILE)
+    except SummaryError:
+        rows = []
+    return auto_start_speed(rows, spec.variant, ref.spec.base.speed_bounds[1])
+
+
+def start_choices(spec: CostStudySpec,
+                  directory: str | os.PathLike[str]) -> dict[str, StartChoice]:
+    """:func:`start_choice` of every model, by name."""
+    return {m.name: start_choice(spec, m, directory) for m in spec.models}
 
 
 def direct_gait(sweep: CostSweep, directory: str | os.PathLike[str]) -> Gait | None:
@@ -310,7 +394,7 @@ def run_direct_solves(spec: CostStudySpec, directory: str | os.PathLike[str],
     ``backend`` (its workers write nothing; each gait file is written here, atomically, as it
     arrives). ``on_done(sweep, outcome, path)`` after each (``outcome`` None if the worker
     raised; ``path`` None if nothing was written). Returns ``(kept, solved, failed)``."""
-    sweeps = spec.sweeps()
+    sweeps = spec.sweeps(start_choices(spec, directory))
     todo = [s for s in sweeps if direct_gait(s, directory) is None]
     pending = {backend.submit(solve_point, s.direct_task()): s for s in todo}
     solved = failed = 0
@@ -336,7 +420,7 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
     gives a failed row."""
     top = Path(directory)
     rows = []
-    for sweep in spec.sweeps():
+    for sweep in spec.sweeps(start_choices(spec, top)):
         rest = sweep.case.resting_power if sweep.case.resting_power is not None else math.nan
         common: dict[str, Any] = {"model": sweep.model, "formulation": sweep.formulation,
                                   "case": sweep.case.tag, "cost": sweep.case.cost,
@@ -349,7 +433,7 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
         candidates: list[tuple[float, str, dict[str, Any]]] = []
         if free and free[0].success:
             r = free[0]
-            start = STARTS[0].format(speed=round(spec.start_speed * 60.0, 2))
+            start = STARTS[0].format(speed=round(sweep.spec.speeds[0] * 60.0, 2))
             candidates.append((r.cost, start, {
                 "status": r.status, "speed_m_min": r.speed_m_min, "step_length": r.step_length,
                 "step_time": r.step_time, "file": f"{sweep.subdir}/{r.file}"}))
