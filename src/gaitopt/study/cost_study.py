@@ -414,6 +414,21 @@ def run_direct_solves(spec: CostStudySpec, directory: str | os.PathLike[str],
     return len(sweeps) - len(todo), solved, failed
 
 
+#: How a row's status says that its speed-free optimum ended on a bound of the speed (an
+#: optimum of the bounded problem only: the unbounded one lies at or beyond it).
+SPEED_BOUND_NOTE = "at the speed bound {bound:g} m/min"
+
+
+def speed_bound_reached(speed_m_min: float, bounds: tuple[float, float], *,
+                        rtol: float = 1e-5) -> float | None:
+    """The bound (m/min) of ``bounds`` (m/s, ``GaitOptions.speed_bounds``) that the speed
+    ``speed_m_min`` lies on, within ``rtol`` relative; None when it lies inside them."""
+    for bound in (b * 60.0 for b in bounds):
+        if math.isfinite(speed_m_min) and abs(speed_m_min - bound) <= rtol * bound:
+            return bound
+    return None
+
+
 def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list[CostRow]:
     """The speed-free optimum of every (model, case): the lower of the sweep's speed-free point
     (its ``summary.csv``) and the direct solve (``direct.gait.json``); a case with neither
@@ -452,6 +467,9 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
         candidates.sort(key=lambda c: c[0])
         value, start, fields = candidates[0]
         other = candidates[1][0] if len(candidates) > 1 else math.nan
+        bound = speed_bound_reached(fields["speed_m_min"], sweep.spec.base.speed_bounds)
+        if bound is not None:
+            fields["status"] = f"{fields['status']}; {SPEED_BOUND_NOTE.format(bound=bound)}"
         rows.append(CostRow(**common, success=True, cost_value=value, start=start,
                             other_cost_value=other, **fields))
     return rows

@@ -139,8 +139,9 @@ def answer_text(rows: Sequence[CostRow]) -> list[str]:
 
 
 def _where(r: CostRow) -> str:
-    return (f"the {r.case} cost, {r.speed_m_min:.1f} m/min with {r.step_length:.3f} m steps "
-            f"({r.speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN:.0%} of people's speed, "
+    bound = " (at its speed bound)" if "speed bound" in r.status else ""
+    return (f"the {r.case} cost, {r.speed_m_min:.1f} m/min{bound} with {r.step_length:.3f} m "
+            f"steps ({r.speed_m_min / HUMAN_OPTIMAL_SPEED_M_MIN:.0%} of people's speed, "
             f"{r.step_length / HUMAN_STEP_LENGTH:.0%} of their step)")
 
 
