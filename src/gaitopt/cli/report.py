@@ -86,7 +86,7 @@ def write_cost_reports(console: Console, directory: Path, out: Path,
     from gaitopt.study.cost_findings import cost_findings_text
     from gaitopt.study.cost_study import COST_STUDY_FILE
     from gaitopt.study.cost_table import CostStudyError
-    from gaitopt.viz.cost_report import answer_text, study_rows, write_cost_report
+    from gaitopt.viz.cost_report import answer_text, write_cost_report
 
     for other in compare:
         if not (other / COST_STUDY_FILE).exists():
@@ -94,12 +94,11 @@ def write_cost_reports(console: Console, directory: Path, out: Path,
                             "a cost study's report compares cost studies")
     try:
         info = write_cost_report(directory, out, compare=compare)
-        rows = study_rows(directory, compare)
     except CostStudyError as exc:
         raise UserError(f"{exc}; rerun `gaitopt study --costs -o {directory}` to finish the "
                         "study") from None
     console.print(f"report: {info.html}", soft_wrap=True)
-    console.print("\n".join(answer_text(rows)), soft_wrap=True)
+    console.print("\n".join(answer_text(info.rows)), soft_wrap=True)
     console.print(cost_findings_text(info.findings), soft_wrap=True)
     return info.html
 

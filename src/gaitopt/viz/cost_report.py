@@ -48,11 +48,13 @@ _TIME_FREE_STYLES = {"paper": (0, (1, 1.5)), "work": (0, (4, 2))}
 
 @dataclass(frozen=True)
 class CostReportInfo:
-    """What :func:`write_cost_report` wrote and the findings of each model."""
+    """What :func:`write_cost_report` wrote, the rows it read and the findings of each
+    model."""
 
     html: Path
     figures: tuple[Path, ...]
     findings: dict[str, Findings]
+    rows: tuple[CostRow, ...] = ()
 
 
 def resting_power_figure(rows: Sequence[CostRow]) -> Figure:
@@ -199,4 +201,5 @@ def write_cost_report(study_dir: str | os.PathLike[str], out_dir: str | os.PathL
     page = html_page("gaitopt cost study", intro, sections)
     path = out / "report.html"
     write_text_atomic(path, page)
-    return CostReportInfo(html=path, figures=tuple(paths), findings=findings)
+    return CostReportInfo(html=path, figures=tuple(paths), findings=findings,
+                          rows=tuple(rows))
