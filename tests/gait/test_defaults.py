@@ -116,6 +116,8 @@ def test_the_default_is_within_its_estimate_of_a_much_finer_grid(
     ["solve", "--paper-grid", "--control-model", "jumps"],
     ["sweep", "--paper-grid", "--knots", "16,6"],
     ["sweep", "--paper-grid", "--control-model", "paper"],
+    ["solve", "--paper-grid", "--knot-spacing", "cosine"],
+    ["sweep", "--paper-grid", "--knot-spacing", "cosine"],
 ])
 def test_paper_grid_with_knots_or_control_model_is_a_usage_error(command: list[str],
                                                                   tmp_path: Path) -> None:
@@ -137,6 +139,22 @@ def test_solve_paper_grid_writes_the_papers_gait(tmp_path: Path) -> None:
     assert gait.options["knots"] == [8, 5] and gait.options["control_model"] == "paper"
     assert gait.options["transcription"] == "hermite-simpson"
     assert gait.cost_value == pytest.approx(487.94, abs=0.02)
+
+
+def test_solve_knot_spacing_uniform_solves_the_coarse_grid_only(tmp_path: Path) -> None:
+    """``--knots 8,5 --knot-spacing uniform`` is the cold stages' own grid: no target-grid
+    or check-grid stage, and the gait file records the spacing (cosine 8 + 5 knots would
+    be solved again on their grid and checked on 16 + 6)."""
+    out = tmp_path / "uniform.gait.json"
+    result = CliRunner(env={"COLUMNS": "200"}).invoke(
+        cli, ["solve", "--knots", "8,5", "--knot-spacing", "uniform", "--control-model",
+              "paper", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    gait = Gait.load(out)
+    assert gait.options["knot_spacing"] == "uniform" and gait.options["knots"] == [8, 5]
+    stages = [s["name"] for s in gait.solver["stages"]]
+    assert not any("grid" in name for name in stages), stages
+    assert gait.solver["stages"][-1]["success"]
 
 
 class _Stop(Exception):

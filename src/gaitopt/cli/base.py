@@ -130,6 +130,15 @@ def paper_grid_option(f: F) -> F:
                              "one.")(f)
 
 
+def knot_spacing_option(help: str, default: str | None = "cosine") -> Callable[[F], F]:
+    """``--knot-spacing uniform|cosine`` with this help text (``default`` None: the
+    :class:`~gaitopt.gait.options.GaitOptions` default, see :func:`grid_choice`)."""
+    from gaitopt.gait.options import KNOT_SPACINGS
+
+    return click.option("--knot-spacing", type=click.Choice(list(KNOT_SPACINGS)),
+                        default=default, show_default=default is not None, help=help)
+
+
 def resting_power_option(f: F) -> F:
     """``--resting-power`` in W/kg (None: the metabolic cost's default)."""
     return click.option("--resting-power", type=float, default=None,
@@ -167,24 +176,29 @@ def control_model_option(help: str) -> Callable[[F], F]:
 
 
 def grid_choice(knots: str | None, control_model: str | None,
-                paper_grid: bool) -> dict[str, Any]:
-    """The ``knots`` and ``control_model`` of ``--knots``, ``--control-model`` and
-    ``--paper-grid`` (the paper's 8 + 5 knots, control model and compressed transcription,
-    ``GaitOptions.paper``); unset ones keep the :class:`~gaitopt.gait.options.GaitOptions`
-    defaults. ``--paper-grid`` with either of the others is a usage error."""
+                paper_grid: bool, knot_spacing: str | None = None) -> dict[str, Any]:
+    """The ``knots``, ``control_model`` and ``knot_spacing`` of ``--knots``,
+    ``--control-model``, ``--knot-spacing`` and ``--paper-grid`` (the paper's 8 + 5 uniform
+    knots, control model and compressed transcription, ``GaitOptions.paper``); unset ones
+    keep the :class:`~gaitopt.gait.options.GaitOptions` defaults. ``--paper-grid`` with
+    ``--knots``, ``--control-model`` or cosine knots is a usage error."""
     from gaitopt.gait.options import PAPER_GRID
 
     if paper_grid:
         given = [o for o, v in (("--knots", knots), ("--control-model", control_model)) if v]
+        if knot_spacing is not None and knot_spacing != PAPER_GRID["knot_spacing"]:
+            given.append(f"--knot-spacing {knot_spacing}")
         if given:
-            raise UserError(f"--paper-grid sets the knots (8,5) and the control model "
-                            f"(paper); do not combine it with {' or '.join(given)}")
+            raise UserError(f"--paper-grid sets the knots (8,5, uniform) and the control "
+                            f"model (paper); do not combine it with {' or '.join(given)}")
         return dict(PAPER_GRID)
     out: dict[str, Any] = {}
     if knots is not None:
         out["knots"] = parse_knots(knots)
     if control_model is not None:
         out["control_model"] = control_model
+    if knot_spacing is not None:
+        out["knot_spacing"] = knot_spacing
     return out
 
 

@@ -18,6 +18,7 @@ from gaitopt.cli.base import (
     cost_option,
     formulation_option,
     grid_choice,
+    knot_spacing_option,
     knots_option,
     make_console,
     min_knee_flexion_option,
@@ -115,6 +116,10 @@ def _step_time(text: str) -> float | None:
               help="Every phase's share of the step free, within half to twice its given "
                    "share (at most 0.95), starting from it (needs --formulation full).")
 @knots_option
+@knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events; "
+                     "docs/walking.md section 6) or uniform [default: "
+                     f"{GaitOptions().knot_spacing}; uniform with --paper-grid].",
+                     default=None)
 @paper_grid_option
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)), default=None,
               help="hermite-simpson: DIRCOL's compressed form, the paper's NLP; "
@@ -177,7 +182,8 @@ def _step_time(text: str) -> float | None:
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
                   impulse: bool,
-                  single_support: float, knots: str | None, paper_grid: bool,
+                  single_support: float, knots: str | None, knot_spacing: str | None,
+                  paper_grid: bool,
                   transcription: str | None,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
@@ -210,7 +216,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
         single_support_fraction=single_support,
-        **{**grid_choice(knots, control_model, paper_grid),
+        **{**grid_choice(knots, control_model, paper_grid, knot_spacing),
            **({"transcription": transcription} if transcription else {})},
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses,

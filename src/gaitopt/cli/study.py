@@ -24,6 +24,7 @@ from gaitopt.cli.base import (
     cost_option,
     formulation_option,
     grid_choice,
+    knot_spacing_option,
     knots_option,
     make_console,
     min_knee_flexion_option,
@@ -36,7 +37,7 @@ from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.cli.sweep_grid import make_spec, parse_speeds, parse_variants
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.gait.formulation import default_formulation
-from gaitopt.gait.options import GAITS, KNOT_SPACINGS
+from gaitopt.gait.options import GAITS, GaitOptions
 from gaitopt.study.driver import default_workers
 from gaitopt.study.grid_error import (
     CHECK_DIR,
@@ -58,11 +59,6 @@ STUDY_DIR = Path("out/study")
 #: Default directory and resting powers (W/kg) of ``gaitopt study --costs``.
 COSTS_DIR = Path("out/costs")
 DEFAULT_RESTING_POWERS_TEXT = "0,0.6,1.2,2.4,4.8"
-
-
-def _spacing_option(default: str, help_: str) -> Any:
-    return click.option("--knot-spacing", type=click.Choice(list(KNOT_SPACINGS)),
-                        default=default, show_default=True, help=help_)
 
 
 def _workers_option(f: Any) -> Any:
@@ -104,14 +100,15 @@ def _workers_option(f: Any) -> Any:
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
                                       "jump at the events.")
 @min_knee_flexion_option
-@_spacing_option("cosine", "The knots of each phase: cosine-spaced (clustered at the events, "
-                           "the default of every solve since 2026-12-02; docs/walking.md "
-                           "section 6) or uniform (always with --paper-grid).")
+@knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events, the "
+                     "default of every solve since 2026-12-02; docs/walking.md section 6) or "
+                     "uniform [default: cosine; uniform with --paper-grid].", default=None)
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
                   paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
-                  resting_power: float | None, control_model: str | None, knot_spacing: str,
+                  resting_power: float | None, control_model: str | None,
+                  knot_spacing: str | None,
                   min_knee_flexion: float | None, workers: int | None,
                   scheduler: str | None) -> None:
     """Solve a grid of walking problems in parallel, by continuation in speed.
@@ -128,9 +125,9 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
             formulation = default_formulation(as_model(model_name), gait_kind, False)
         except ValueError as exc:
             raise UserError(str(exc)) from None
-    problem: dict[str, Any] = {"formulation": formulation, "cost": cost,
-                               "gait": gait_kind, "knot_spacing": knot_spacing,
-                               **grid_choice(knots, control_model, paper_grid)}
+    problem: dict[str, Any] = {"formulation": formulation, "cost": cost, "gait": gait_kind,
+                               "knot_spacing": GaitOptions().knot_spacing,
+                               **grid_choice(knots, control_model, paper_grid, knot_spacing)}
     if resting_power is not None:
         problem["resting_power"] = resting_power
     if min_knee_flexion is not None:
@@ -184,12 +181,13 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
               help="The paper's setting: 8+5 knots and its control model (continuous, "
                    "periodic controls); checked against 16+6 knots.")
 @knots_option
-@_spacing_option("cosine", "The knots of each phase of the paper's study (and of the cost "
-                           "study): cosine-spaced (clustered at the events, the default) or "
-                           "uniform (always with --paper-grid).")
+@knot_spacing_option("The knots of each phase of the paper's study (and of the cost study): "
+                     "cosine-spaced (clustered at the events) or uniform [default: cosine; "
+                     "uniform with --paper-grid].", default=None)
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
-                  paper_grid: bool, knots: str | None, knot_spacing: str, cost_study: bool,
+                  paper_grid: bool, knots: str | None, knot_spacing: str | None,
+                  cost_study: bool,
                   costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, start_speed: str, clearance: float | None,
@@ -209,7 +207,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                        costs=costs or ("paper", "work", "metabolic"),
                        resting_powers=resting_powers, regularization=regularization,
                        start_speed=start_speed, clearance=clearance, gait=gait_kind,
-                       formulation=formulation, knot_spacing=knot_spacing,
+                       formulation=formulation,
+                       knot_spacing=knot_spacing or GaitOptions().knot_spacing,
                        knots=knots, workers=workers, scheduler=scheduler)
         return
     if len(model_names) > 1:
@@ -217,8 +216,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                         "--costs)")
     directory = directory or STUDY_DIR
     start = time.perf_counter()
-    grid = {**grid_choice(knots, None, paper_grid),
-            "knot_spacing": "uniform" if paper_grid else knot_spacing}
+    grid = {"knot_spacing": GaitOptions().knot_spacing,
+            **grid_choice(knots, None, paper_grid, knot_spacing)}
     model_name = model_names[0] if model_names else "five-link"
     spec = make_spec(model_name=model_name, speeds=speeds,
                      variants="all", free=True, step_length="free", single_support="0.85",
