@@ -116,7 +116,8 @@ def lowest_force_by_phase(gait: Gait) -> float:
 
 
 def solve_point(variant: str, speed_m_min: float, *, check: bool,
-                transcription: str = "hermite-simpson", knot_spacing: str = "uniform") -> Point:
+                transcription: str = "hermite-simpson",
+                knot_spacing: str = GaitOptions().knot_spacing) -> Point:
     options = GaitOptions(speed=speed_m_min / 60.0, transcription=transcription,  # type: ignore[arg-type]
                           knot_spacing=knot_spacing,  # type: ignore[arg-type]
                           **VARIANTS[variant])
@@ -179,8 +180,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--transcription", default=GaitOptions().transcription,
                         choices=TRANSCRIPTIONS,
                         help="GaitOptions.transcription of every point (default: the default)")
-    parser.add_argument("--knot-spacing", default="uniform", choices=KNOT_SPACINGS,
-                        help="GaitOptions.knot_spacing of every point (cosine: the study's)")
+    parser.add_argument("--knot-spacing", default=GaitOptions().knot_spacing,
+                        choices=KNOT_SPACINGS,
+                        help="GaitOptions.knot_spacing of every point (default: the default)")
     args = parser.parse_args(argv)
 
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")

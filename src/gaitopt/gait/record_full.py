@@ -10,10 +10,7 @@ event maps of the contact sequence applied to the end states.
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import hashlib
-import pickle
 from pathlib import Path
 from typing import Any
 
@@ -21,32 +18,27 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from gaitopt import codegen
 from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.tree import hold_name
-from gaitopt.fileio import write_bytes_atomic
 from gaitopt.gait import full_physics as full
 from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.gait_file import GaitEvent, GaitPhase, GaitSamples
-from gaitopt.gait.transcriptions import cached_functions, source_hash
+from gaitopt.gait.transcriptions import disk_cached, function_file
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
 
 
 #: Version of the disk cache of :func:`_phase_function` (part of its key).
-RECORD_FORMAT = "gaitopt-record-full-1"
+RECORD_FORMAT = "record-full-1"
 
 
 def phase_function_file(model: RobotModel, held: tuple[str, ...], actuators: tuple[str, ...]
                         ) -> Path:
     """Where :func:`_phase_function` of a phase is cached on disk: keyed by the model, the
-    held points, the actuators, the gaitopt sources and CasADi's version (as the walking
-    problem's functions, :func:`gaitopt.gait.transcriptions.functions_file`)."""
-    text = repr((RECORD_FORMAT, source_hash(), ca.CasadiMeta.version(), model.content_hash(),
-                 held, actuators))
-    name = hashlib.sha256(text.encode()).hexdigest()[:24]
-    return codegen.cache_dir() / f"record-full-{name}.pickle"
+    held points, the actuators, the gaitopt sources and CasADi's version
+    (:func:`gaitopt.gait.transcriptions.function_file`)."""
+    return function_file(RECORD_FORMAT, (model.content_hash(), held, actuators))
 
 
 @functools.lru_cache(maxsize=32)
@@ -55,14 +47,8 @@ def _phase_function(model: RobotModel, held: tuple[str, ...], actuators: tuple[s
     """``(x, u) -> (qdd, forces, u_full)`` of a phase as one SX function, from the disk cache
     (:func:`phase_function_file`) or built and saved there: building it (the Contact
     Algorithm in symbols) took 0.15 s per phase, a fifth of a whole 8 + 5 solve."""
-    path = phase_function_file(model, held, actuators)
-    cached = cached_functions(path)
-    if isinstance(cached, ca.Function):
-        return cached
-    fn = _build_phase_function(model, held, actuators)
-    with contextlib.suppress(OSError):  # a read-only cache: build again next time
-        write_bytes_atomic(path, pickle.dumps(fn))
-    return fn
+    return disk_cached(phase_function_file(model, held, actuators),
+                       lambda: _build_phase_function(model, held, actuators))
 
 
 def _build_phase_function(model: RobotModel, held: tuple[str, ...],

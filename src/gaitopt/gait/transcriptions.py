@@ -17,6 +17,7 @@ import dataclasses
 import functools
 import hashlib
 import pickle
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -130,10 +131,8 @@ def functions_file(key: NlpStructure) -> Path:
     """Where the symbolic functions (``Transcription.functions``) of the problem of the
     structure ``key`` are cached on disk: keyed by the model, every shaping option, the
     gaitopt sources and CasADi's version, not the grid or the evaluation mode."""
-    text = repr((FUNCTIONS_FORMAT, source_hash(), ca.CasadiMeta.version(), key.model_hash,
-                 key.step_time_row, key.options))
-    name = hashlib.sha256(text.encode()).hexdigest()[:24]
-    return codegen.cache_dir() / f"walking-functions-{name}.pickle"
+    return function_file("walking-functions",
+                         (FUNCTIONS_FORMAT, key.model_hash, key.step_time_row, key.options))
 
 
 def cached_functions(path: Path) -> Any:
@@ -142,6 +141,27 @@ def cached_functions(path: Path) -> Any:
         return pickle.loads(path.read_bytes())
     except Exception:  # noqa: BLE001 - any unreadable cache file is rebuilt and replaced
         return None
+
+
+def function_file(kind: str, key: tuple[Any, ...]) -> Path:
+    """Where a symbolic function of ``kind`` (a file-name prefix) built from ``key`` is cached
+    on disk: keyed by ``kind``, ``key`` (its repr: model hashes, names), the gaitopt sources
+    and CasADi's version, as the walking problem's functions (:func:`functions_file`)."""
+    text = repr((kind, source_hash(), ca.CasadiMeta.version(), key))
+    name = hashlib.sha256(text.encode()).hexdigest()[:24]
+    return codegen.cache_dir() / f"{kind}-{name}.pickle"
+
+
+def disk_cached(path: Path, build: Callable[[], ca.Function]) -> ca.Function:
+    """The CasADi function pickled at ``path`` (:func:`function_file`), or ``build()``
+    saved there atomically (a read-only or full cache only costs the build next time)."""
+    cached = cached_functions(path)
+    if isinstance(cached, ca.Function):
+        return cached
+    fn = build()
+    with contextlib.suppress(OSError):
+        write_bytes_atomic(path, pickle.dumps(fn))
+    return fn
 
 
 def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
