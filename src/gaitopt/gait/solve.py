@@ -101,6 +101,7 @@ from gaitopt.gait.stages import (
     CONTACT_STAGES,
     PRIMAL_WARM_OPTIONS,
     RELEASES,
+    check_grid_options,
     coarse_knots,
     fine_stage_options,
     held_ankles,
@@ -345,7 +346,7 @@ class _Run:
         finer = o.replace(knots=check_knots(o.knots))
         self.stage("check grid", target_grid(self.model, finer), Relaxation(), result,
                    parameter_bounds(o),
-                   solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
+                   solver_options=check_grid_options(o))
 
     def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
         """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
