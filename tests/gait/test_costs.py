@@ -10,15 +10,13 @@ import numpy as np
 import pytest
 
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.dynamics.functions import liftoff_function
 from gaitopt.gait import cost
-from gaitopt.gait.full_physics import per_point
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.solve import smoothing_ladder
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import biped_of
-from tests.gait.conftest import Reference, Solved
+from tests.gait.conftest import Solved
 
 SolveFn = Callable[..., Solved]
 
@@ -103,55 +101,3 @@ def test_smoothing_ladder_divides_by_ten_down_to_the_request() -> None:
     assert smoothing_ladder(0.05) == pytest.approx([1.0, 0.1])
     assert smoothing_ladder(0.1) == pytest.approx([1.0])
     assert smoothing_ladder(1.0) == [] and smoothing_ladder(2.0) == []
-
-
-def _metabolic_with_impulse(gait: Gait, magnitude: float, name: str, *,
-                            sequence: bool = True
-                            ) -> tuple[Gait, np.ndarray, np.ndarray, np.ndarray]:
-    """The gait as a metabolic-cost file whose liftoff applies the impulse ``magnitude`` (N s),
-    its ``qd_after`` and impulses by the liftoff map from ``qd_before``, the event renamed
-    ``name`` (in the events and the contact sequence; ``sequence=False`` drops the sequence, as
-    in a file written before gait files had one); and the event's ``q``, ``qd_before`` and
-    ``qd_after`` (nq,)."""
-    data = gait.to_dict()
-    data["options"]["cost"] = "metabolic"
-    data["parameters"]["liftoff_impulse"] = magnitude
-    i = next(j for j, e in enumerate(gait.events) if e.name == "liftoff")
-    event = gait.events[i]
-    phase = next(ph for ph in gait.phases if ph.t[-1] == event.t)
-    held = tuple(c for c in phase.contacts if c != event.leg)
-    qd, lifting, on_held = (np.asarray(v, dtype=float).ravel() for v in liftoff_function(
-        gait.model, event.leg, held)(phase.q[-1], event.qd_before, magnitude))
-    impulses = {event.leg: lifting.tolist()} | {
-        c: np.asarray(v, dtype=float).ravel().tolist() for c, v in per_point(held, on_held).items()}
-    data["events"][i].update(name=name, qd_after=qd.tolist(), impulses=impulses)
-    if sequence:
-        assert data["contact_sequence"]["events"][i]["impulse"]
-        data["contact_sequence"]["events"][i]["name"] = name
-    else:
-        del data["contact_sequence"]
-    return Gait.from_dict(data), phase.q[-1], event.qd_before, qd
-
-
-@pytest.mark.parametrize(("name", "sequence"), [
-    ("liftoff", True), ("toe_off", True), ("liftoff", False)])
-def test_the_liftoff_impulse_work_counts_whatever_the_event_is_called(
-        default_gait: Gait, reference: Callable[..., Reference], name: str,
-        sequence: bool) -> None:
-    """The costs of transport charge the liftoff impulse's work ``E_P / eta_pos``. With the
-    tip at rest before and the held tip at rest throughout, ``E_P`` is the kinetic energy the
-    event adds, ``(qd+' M qd+ - qd-' M qd-) / 2`` with Pinocchio's mass matrix. The event that
-    applies the impulse is the one the file's contact sequence marks, whatever its name (a
-    heel-toe walk's ``toe_off``; by its name ``liftoff`` only in a file without a sequence):
-    recognising it by the name ``liftoff`` alone dropped this term from the heel-toe walks."""
-    base, *_ = _metabolic_with_impulse(default_gait, 0.0, name, sequence=sequence)
-    pushed, q, qd_before, qd_after = _metabolic_with_impulse(default_gait, 2.0, name,
-                                                             sequence=sequence)
-    m = reference(default_gait.model).mass_matrix(q)
-    kinetic = 0.5 * (qd_after @ m @ qd_after - qd_before @ m @ qd_before)
-    assert kinetic > 0.01  # the impulse does work that the cost must see
-    model, options = default_gait.model, GaitOptions.paper(cost="metabolic")
-    expected = kinetic / options.efficiency_positive / (cost.weight(model)
-                                                       * default_gait.step_length)
-    assert cost.recompute_cost(pushed) - cost.recompute_cost(base) == pytest.approx(
-        expected, rel=1e-7)
