@@ -19,7 +19,9 @@ The checks (stable ids, see :data:`CHECKS` and ``docs/outputs.md``, section "Ver
   kinematics, normal forces between knots, torque bounds, joint limits, swing clearance;
 * the cost recomputed from the file (:func:`gaitopt.gait.cost.recompute_cost`): for the
   paper's cost the exact integral of the squared piecewise-linear controls plus the impulse
-  squared, over the step length; the costs of transport by the transcription's quadrature.
+  squared, over the step length; the costs of transport by the transcription's quadrature,
+  with the liftoff impulse's work at the event the file's contact sequence marks impulsive
+  (:func:`gaitopt.gait.cost.impulse_events`: ``toe_off`` in a heel-toe walk).
 
 What the transcription imposes exactly (knots, events, periodicity, cost) is checked to about
 1e-6 (relative where it says so); what it cannot impose between knots against the accuracy of

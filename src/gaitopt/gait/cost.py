@@ -27,11 +27,16 @@ Everything here runs on numbers and CasADi symbols alike.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gaitopt.dynamics.backend import Scalar, as_scalars, sqrt
+from gaitopt.gait.contact_sequence import sequence_from_dict
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot.model import RobotModel
+
+if TYPE_CHECKING:
+    from gaitopt.gait.gait_file import Gait
+    from gaitopt.gait.gait_parts import GaitEvent
 
 COSTS: tuple[str, ...] = ("paper", "work", "metabolic")
 
@@ -153,7 +158,9 @@ def recompute_cost(gait: Any) -> float:
     Simpson's rule per interval on the knots and the interval midpoints (states from the
     phase's cubic Hermite interpolant, controls linear), plus the impulse and resting terms,
     over the denominator. For the paper's cost this is the exact integral of the squared
-    piecewise-linear torques."""
+    piecewise-linear torques. The impulse term of the costs of transport is the work of every
+    event that applies the liftoff impulse (:func:`impulse_events`: by the file's contact
+    sequence, not by the event's name; a heel-toe walk's impulse acts at ``toe_off``)."""
     import numpy as np
 
     from gaitopt.dynamics.kinematics import contact_velocity
@@ -192,11 +199,30 @@ def recompute_cost(gait: Any) -> float:
     if options.cost == "paper":
         total += impulse * impulse
     else:
-        for ev in gait.events:
+        for ev in impulse_events(gait):
             lift = ev.impulses.get(ev.leg)
-            if ev.name == "liftoff" and lift is not None and impulse > 0.0:
+            if lift is not None:
                 phase = next(ph for ph in gait.phases if abs(ph.t[-1] - ev.t) < 1e-12)
                 v_after = contact_velocity(model, phase.q[-1], ev.qd_after, ev.leg)
                 total += impulse_cost(model, options, lift, v_after, impulse)
         total += parameter_cost(model, options, p)
     return float(total / denominator(model, options, p))
+
+
+def impulse_events(gait: Gait) -> list[GaitEvent]:
+    """The events of a saved gait that apply the liftoff impulse on their ``leg`` (the NLP's
+    Mayer term sums their work, :func:`impulse_cost`): with the file's contact sequence, event
+    ``i`` when the sequence's event ``i`` has the same name and ``impulse`` set (the paper's
+    walk's ``liftoff``, the heel-toe walk's ``toe_off``); an event the sequence does not
+    describe (a file without one, the single-support walk's extra ``liftoff``) by its name,
+    ``liftoff``. The rule of the event checks (:mod:`gaitopt.analysis.checks.events`)."""
+    specs = (() if gait.contact_sequence is None
+             else sequence_from_dict(dict(gait.contact_sequence)).events)
+    out: list[GaitEvent] = []
+    for i, ev in enumerate(gait.events):
+        if i < len(specs) and specs[i].name == ev.name:
+            if specs[i].impulse:
+                out.append(ev)
+        elif ev.name == "liftoff":
+            out.append(ev)
+    return out

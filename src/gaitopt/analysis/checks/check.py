@@ -67,7 +67,7 @@ _SPECS = (
     CheckSpec("bounds.joints_samples", "joint limits between knots (excess)", "rad", 5e-2),
     CheckSpec("swing.clearance", "swing tip above ground (penetration)", "m", 5e-3),
     # The objective.
-    CheckSpec("cost.recomputed", "cost recomputed from the controls (relative)", "", 1e-6),
+    CheckSpec("cost.recomputed", "cost recomputed from the file (relative)", "", 1e-6),
 )
 
 #: Every check by id, in report order.

@@ -15,6 +15,11 @@ At each knot of a phase with the contacts ``C`` held (``phase.contacts``), from 
   ``|f_x| <= mu f_y`` (also for the events' impulses on held tips);
 * the parameters: speed x step time = step length, the single-support time is the first
   phase's duration, the liftoff impulse is the magnitude of the impulse on the lifting tip.
+
+The events that apply the liftoff impulse (whose lifting tip is exempt from friction and
+carries the parameter's magnitude) are those the file's contact sequence marks
+(:func:`gaitopt.gait.cost.impulse_events`: ``liftoff`` in the walk, ``toe_off`` in the
+heel-toe walk), by the name ``liftoff`` only in a file without a sequence.
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from gaitopt.dynamics.reduced import N_DOUBLE, double_support_state
 from gaitopt.dynamics.rnea import rnea
 from gaitopt.gait import walking
 from gaitopt.gait.contact_sequence import phase_holds, sequence_from_dict
+from gaitopt.gait.cost import impulse_events
 from gaitopt.gait.gait_file import Gait, GaitPhase
 from gaitopt.robot.biped import biped_of
 from gaitopt.robot.model import RobotModel
@@ -247,9 +253,10 @@ def _friction_check(gait: Gait, lim: dict[str, float]) -> Check | None:
             excess = np.abs(f[:, 0]) - mu * f[:, 1]
             k = int(np.argmax(excess))
             worst = worst.update(excess[k], f"phases[{i}] ({ph.name}) knot {k} {c}")
+    lifting = impulse_events(gait)  # their lifting tips' pushes are not held by friction
     for j, e in enumerate(gait.events):
         for c, imp in e.impulses.items():
-            if not (e.name == "liftoff" and c == e.leg):
+            if not (e in lifting and c == e.leg):
                 worst = worst.update(abs(float(imp[0])) - mu * float(imp[1]),
                                      f"events[{j}] ({e.name}) {c}")
     return Check("contacts.friction", max(0.0, worst.value), lim["contacts.friction"],
@@ -264,7 +271,7 @@ def _parameter_check(gait: Gait, lim: dict[str, float]) -> Check:
     t1 = gait.phases[0].duration
     worst = worst.update(abs(p["single_support_time"] - t1) / step_time,
                          "parameters.single_support_time")
-    lifts = [e for e in gait.events if e.name == "liftoff"]
+    lifts = impulse_events(gait)
     if len(gait.phases) > 1 and lifts:
         imp = lifts[-1].impulses.get(lifts[-1].leg, np.zeros(2))
         magnitude = float(np.hypot(*imp))
