@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from gaitopt.analysis.metrics import gait_metrics
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.dynamics.functions import liftoff_function
 from gaitopt.gait import cost
@@ -106,3 +107,16 @@ def test_the_lifting_tip_is_exempt_from_friction_whatever_the_event_is_called(
                           ).check("contacts.friction").value
               for lifting in ((0.0, 0.0), (1000.0, 0.0))]
     assert values[1] == values[0] < 1000.0
+
+
+@pytest.mark.parametrize(("name", "sequence"), NAMINGS)
+def test_the_summary_leaves_out_the_lifting_push_whatever_the_event_is_called(
+        default_gait: Gait, name: str, sequence: bool) -> None:
+    """The summary's smallest normal impulse and friction needed are of the tips held on the
+    ground: a horizontal 1000 N s push of the lifting tip, or one pulling it into the ground,
+    changes neither."""
+    metrics = [gait_metrics(_with_impulse(default_gait, 2.0, name, sequence=sequence,
+                                          lifting=lifting)[0])
+               for lifting in ((0.0, 0.0), (1000.0, -5.0))]
+    assert metrics[1].friction_required == metrics[0].friction_required
+    assert metrics[1].min_normal_impulse == metrics[0].min_normal_impulse > -5.0

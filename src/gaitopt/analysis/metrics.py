@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from gaitopt.gait.cost import impulse_events
 from gaitopt.gait.gait_file import Gait
 
 #: Normal forces/impulses below this (N, N s) are treated as zero in friction ratios.
@@ -66,8 +67,9 @@ def gait_metrics(gait: Gait) -> GaitMetrics:
     bounds = {a.name: float(max(abs(a.limits[0]), abs(a.limits[1]))) for a in model.actuators}
     forces = [f for ph in gait.phases for f in ph.contact_forces.values()]
     min_force = float(min(np.min(f[:, 1]) for f in forces))
+    lifting = impulse_events(gait)  # their lifting tips' pushes are not contact impulses
     impulses = [i for e in gait.events for c, i in e.impulses.items()
-                if not (e.name == "liftoff" and c == e.leg)]
+                if not (e in lifting and c == e.leg)]
     min_impulse = float(min((i[1] for i in impulses), default=0.0))
     ratios = [np.abs(f[:, 0]) / np.maximum(f[:, 1], NORMAL_FLOOR) for f in forces]
     ratios += [np.array([abs(i[0]) / max(i[1], NORMAL_FLOOR)]) for i in impulses
