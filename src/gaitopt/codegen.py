@@ -4,21 +4,38 @@ The cache is content-addressed: the key is a hash of the generated C source and 
 command, so a changed model, problem or compiler flag gives a new library and an unchanged one
 is loaded from disk without compiling. The cache folder is ``$GAITOPT_CACHE`` if set, else
 ``$XDG_CACHE_HOME/gaitopt`` (``~/.cache/gaitopt``).
+
+The folder also holds the pickled symbolic functions of :mod:`gaitopt.gait.transcriptions`,
+keyed by the gaitopt sources among others, so every new version (or edit) of gaitopt adds
+files and never reuses the old ones. :func:`prune_cache` bounds the folder's size: whenever a
+file is added and the folder holds more than ``$GAITOPT_CACHE_MAX_MB`` megabytes
+(:data:`CACHE_LIMIT_MB` by default), the least recently used files are deleted until it holds
+at most 80 % of that; a file counts as used when it is written or loaded (:func:`mark_used`
+sets its modification time).
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import math
 import os
 import shutil
 import subprocess
 import tempfile
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
 import casadi as ca
 
 DEFAULT_FLAGS: tuple[str, ...] = ("-O2", "-fPIC", "-shared")
+#: Size limit of the disk cache (MB) when ``$GAITOPT_CACHE_MAX_MB`` is not set: one model and
+#: problem's libraries and functions take a few MB to a few tens of MB.
+CACHE_LIMIT_MB = 500.0
+#: :func:`prune_cache` deletes down to this share of the limit, so it does not run after
+#: every write once the folder is full.
+PRUNE_TO = 0.8
 
 
 class CompileError(RuntimeError):
@@ -35,6 +52,61 @@ def cache_dir() -> Path:
         path = Path(base) / "gaitopt"
     path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def cache_limit_bytes() -> int:
+    """The disk cache's size limit in bytes: ``$GAITOPT_CACHE_MAX_MB`` megabytes, or
+    :data:`CACHE_LIMIT_MB`. A value that is not a number > 0 is ignored with a warning
+    that names the variable (a solve never fails for its cache)."""
+    text = os.environ.get("GAITOPT_CACHE_MAX_MB", "").strip()
+    if not text:
+        return int(CACHE_LIMIT_MB * 1e6)
+    try:
+        mb = float(text)
+    except ValueError:
+        mb = math.nan
+    if not (math.isfinite(mb) and mb > 0):
+        warnings.warn(f"GAITOPT_CACHE_MAX_MB = {text!r}: must be a number of megabytes > 0; "
+                      f"using {CACHE_LIMIT_MB:g}", RuntimeWarning, stacklevel=2)
+        return int(CACHE_LIMIT_MB * 1e6)
+    return int(mb * 1e6)
+
+
+def mark_used(path: Path) -> None:
+    """Record that the cache file ``path`` was just used (its modification time), so
+    :func:`prune_cache` keeps it over older ones. A file that vanished is ignored."""
+    with contextlib.suppress(OSError):
+        os.utime(path)
+
+
+def prune_cache(limit: int | None = None) -> list[Path]:
+    """Delete the least recently used files of :func:`cache_dir` (oldest modification time
+    first) while it holds more than ``limit`` bytes (:func:`cache_limit_bytes`), down to
+    :data:`PRUNE_TO` of it; return the deleted paths. Hidden files (another process's files
+    being written) are neither counted nor deleted; a file another process deleted first is
+    skipped. A library this process has loaded stays usable (Linux keeps a deleted file's
+    mapping); it is compiled again only by a later process that needs it."""
+    limit = cache_limit_bytes() if limit is None else limit
+    entries: list[tuple[float, int, Path]] = []
+    for path in cache_dir().iterdir():
+        if path.name.startswith("."):
+            continue
+        with contextlib.suppress(OSError):
+            st = path.stat()
+            if path.is_file():
+                entries.append((st.st_mtime, st.st_size, path))
+    total = sum(size for _, size, _ in entries)
+    if total <= limit:
+        return []
+    removed = []
+    for _, size, path in sorted(entries, key=lambda e: e[0]):
+        if total <= PRUNE_TO * limit:
+            break
+        with contextlib.suppress(OSError):
+            path.unlink()
+            total -= size
+            removed.append(path)
+    return removed
 
 
 def compiler() -> str:
@@ -92,6 +164,9 @@ def compile_libraries(sources: dict[str, str], *, flags: Sequence[str] = DEFAULT
         targets = {name: library_path(src, name, flags_of[name])
                    for name, src in sources.items()}
     todo = [name for name, path in targets.items() if not path.exists()]
+    for name, path in targets.items():
+        if name not in todo:
+            mark_used(path)
     if not todo:
         return targets
     with tempfile.TemporaryDirectory(prefix="gaitopt-cc-") as tmp:
@@ -118,6 +193,7 @@ def compile_libraries(sources: dict[str, str], *, flags: Sequence[str] = DEFAULT
             os.replace(staged, target)
         if failed:
             raise CompileError("\n".join(failed))
+    prune_cache()
     return targets
 
 

@@ -138,9 +138,20 @@ def functions_file(key: NlpStructure) -> Path:
 def cached_functions(path: Path) -> Any:
     """The functions pickled at ``path``, or None (missing, unreadable or stale: rebuilt)."""
     try:
-        return pickle.loads(path.read_bytes())
+        functions = pickle.loads(path.read_bytes())
     except Exception:  # noqa: BLE001 - any unreadable cache file is rebuilt and replaced
         return None
+    codegen.mark_used(path)
+    return functions
+
+
+def save_functions(path: Path, functions: Any) -> None:
+    """Pickle ``functions`` to the cache file ``path`` atomically, then bound the cache's
+    size (:func:`gaitopt.codegen.prune_cache`); a read-only or full disk only costs the
+    build next time."""
+    with contextlib.suppress(OSError):
+        write_bytes_atomic(path, pickle.dumps(functions))
+        codegen.prune_cache()
 
 
 def function_file(kind: str, key: tuple[Any, ...]) -> Path:
@@ -159,8 +170,7 @@ def disk_cached(path: Path, build: Callable[[], ca.Function]) -> ca.Function:
     if isinstance(cached, ca.Function):
         return cached
     fn = build()
-    with contextlib.suppress(OSError):
-        write_bytes_atomic(path, pickle.dumps(fn))
+    save_functions(path, fn)
     return fn
 
 
@@ -189,8 +199,7 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
                      "show_eval_warnings": False},
             build_solver=False, functions=functions)
         if functions is None:
-            with contextlib.suppress(OSError):  # a read-only cache: build again next time
-                write_bytes_atomic(path, pickle.dumps(_CACHE[key].functions))
+            save_functions(path, _CACHE[key].functions)
     return _CACHE[key]
 
 

@@ -147,6 +147,9 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
     paths = {lib: codegen.cache_dir() / f"{lib}-{library_key(p, flags[lib])}.so"
              for lib, p in libs.items()}
     missing = [lib for lib, path in paths.items() if not path.exists()]
+    for lib, path in paths.items():
+        if lib not in missing:
+            codegen.mark_used(path)
     if missing:
         sources = {lib: codegen.generate_source(PointDerivatives.derive(libs[lib]), lib)
                    for lib in missing}

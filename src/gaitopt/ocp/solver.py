@@ -110,6 +110,7 @@ def _codegen_solver(name: str, nlp: NlpFunctions, options: dict[str, Any],
     cached = sorted(codegen.cache_dir().glob(f"{lib_name}-*.so"))
     if cached:
         path = cached[-1]
+        codegen.mark_used(path)
     else:
         base = ca.nlpsol(f"{name}_base", "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g},
                          options)
