@@ -58,3 +58,4 @@ def test_every_command_is_listed_and_found() -> None:
 def test_an_unknown_command_is_a_usage_error() -> None:
     result = CliRunner().invoke(cli, ["solv"])
     assert result.exit_code == 2 and "No such command 'solv'" in result.output
+
