@@ -31,6 +31,12 @@ class GaitMetrics:
         swing_min_height: smallest height of the swing tip over the dense samples of single
             support (m); negative values are penetration between collocation points.
         friction_required: largest |tangential| / normal over forces and impulses.
+        friction_where: where that ratio is largest: ``"<contact>, knot k of <phase>"`` or
+            ``"<contact>, <event> impulse"`` ("" without contacts).
+        friction_tangential, friction_normal: the tangential and normal force (N) or impulse
+            (N s) there; a normal part near 0 with a tangential part that is not (a tip
+            unloading while the frictionless ground still pushes it sideways) makes the ratio
+            unbounded.
     """
 
     peak_torques: dict[str, float]
@@ -40,6 +46,9 @@ class GaitMetrics:
     swing_clearance: float
     swing_min_height: float
     friction_required: float
+    friction_where: str = ""
+    friction_tangential: float = 0.0
+    friction_normal: float = 0.0
 
 
 def swing_heights(gait: Gait) -> NDArray[np.float64]:
@@ -68,15 +77,27 @@ def gait_metrics(gait: Gait) -> GaitMetrics:
     forces = [f for ph in gait.phases for f in ph.contact_forces.values()]
     min_force = float(min(np.min(f[:, 1]) for f in forces))
     lifting = impulse_events(gait)  # their lifting tips' pushes are not contact impulses
-    impulses = [i for e in gait.events for c, i in e.impulses.items()
+    impulses = [(e, c, i) for e in gait.events for c, i in e.impulses.items()
                 if not (e in lifting and c == e.leg)]
-    min_impulse = float(min((i[1] for i in impulses), default=0.0))
-    ratios = [np.abs(f[:, 0]) / np.maximum(f[:, 1], NORMAL_FLOOR) for f in forces]
-    ratios += [np.array([abs(i[0]) / max(i[1], NORMAL_FLOOR)]) for i in impulses
-               if abs(i[0]) > NORMAL_FLOOR or i[1] > NORMAL_FLOOR]
-    friction = float(max((np.max(r) for r in ratios), default=0.0))
+    min_impulse = float(min((i[1] for _, _, i in impulses), default=0.0))
+    # Every (tangential, normal) pair with where it acts: knots of the phases, then events.
+    pairs: list[tuple[str, NDArray[np.float64]]] = [
+        (f"{c}, knot {{k}} of {ph.name}", f)
+        for ph in gait.phases for c, f in ph.contact_forces.items()]
+    pairs += [(f"{c}, {e.name} impulse", np.asarray(i, dtype=float).reshape(1, 2))
+              for e, c, i in impulses
+              if abs(i[0]) > NORMAL_FLOOR or i[1] > NORMAL_FLOOR]
+    friction, where, tangential, normal = 0.0, "", 0.0, 0.0
+    for label, f in pairs:
+        ratio = np.abs(f[:, 0]) / np.maximum(f[:, 1], NORMAL_FLOOR)
+        k = int(np.argmax(ratio))
+        if ratio[k] > friction:
+            friction, where = float(ratio[k]), label.format(k=k)
+            tangential, normal = float(f[k, 0]), float(f[k, 1])
     swing = swing_heights(gait)
     return GaitMetrics(peak_torques=peaks, torque_bounds=bounds, min_normal_force=min_force,
                        min_normal_impulse=min_impulse,
                        swing_clearance=float(np.max(swing)),
-                       swing_min_height=float(np.min(swing)), friction_required=friction)
+                       swing_min_height=float(np.min(swing)), friction_required=friction,
+                       friction_where=where, friction_tangential=tangential,
+                       friction_normal=normal)

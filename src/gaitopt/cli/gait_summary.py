@@ -4,13 +4,16 @@ the accuracy estimates and the phase shares."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.table import Table
 
 from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.gait_file import Gait
 from gaitopt.units import format_speed
+
+if TYPE_CHECKING:
+    from gaitopt.analysis.metrics import GaitMetrics
 
 
 def summary_table(gait: Gait, sequence_used: ContactSequence | None) -> Table:
@@ -44,7 +47,7 @@ def summary_table(gait: Gait, sequence_used: ContactSequence | None) -> Table:
     table.add_row("smallest normal impulse", f"{metrics.min_normal_impulse:.4f} N s")
     table.add_row("swing clearance", f"{metrics.swing_clearance * 1000:.1f} mm (lowest "
                   f"{metrics.swing_min_height * 1000:.2f} mm)")
-    table.add_row("friction needed", f"{metrics.friction_required:.3f} (|tangential|/normal)")
+    table.add_row("friction needed", friction_text(metrics, gait.options.get("friction")))
     s = gait.solver
     table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
                   f"equality, {s['inequality_constraints']} inequality constraints")
@@ -53,6 +56,27 @@ def summary_table(gait: Gait, sequence_used: ContactSequence | None) -> Table:
         table.add_row(*row)
     table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
     return table
+
+
+#: A friction ratio above this is shown by the forces behind it: no ground offers a
+#: coefficient near it (rubber on concrete about 1), so the number itself says nothing more.
+FRICTION_SHOWN = 5.0
+
+
+def friction_text(metrics: GaitMetrics, friction: float | None) -> str:
+    """The summary's friction row: the largest ``|tangential| / normal`` and where it is;
+    above :data:`FRICTION_SHOWN` (a frictionless solve: a tip unloading while the ground still
+    pushes it sideways) the forces there and how to bound them (``--friction``)."""
+    unit = "N s" if metrics.friction_where.endswith(" impulse") else "N"
+    at = f" at {metrics.friction_where}" if metrics.friction_where else ""
+    if metrics.friction_required <= FRICTION_SHOWN:
+        return f"{metrics.friction_required:.3f} (|tangential|/normal{at})"
+    text = (f"{metrics.friction_required:.3g} (|tangential|/normal{at}: "
+            f"{abs(metrics.friction_tangential):.3g} {unit} sideways against a normal "
+            f"{metrics.friction_normal:.2g} {unit})")
+    if friction is None:
+        text += "; the ground has no friction limit here, --friction MU sets one"
+    return text
 
 
 def phase_fractions_text(sequence: ContactSequence, gait: Gait) -> str:
