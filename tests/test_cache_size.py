@@ -23,9 +23,11 @@ def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 
 def _file(folder: Path, name: str, size: int, age_s: float) -> Path:
+    """A cache file of ``size`` bytes last used ``age_s`` seconds ago (plus the minutes
+    :func:`gaitopt.codegen.prune_cache` spares)."""
     path = folder / name
     path.write_bytes(b"x" * size)
-    t = path.stat().st_mtime - age_s
+    t = path.stat().st_mtime - codegen.KEEP_RECENT_S - age_s
     os.utime(path, (t, t))
     return path
 
@@ -33,12 +35,15 @@ def _file(folder: Path, name: str, size: int, age_s: float) -> Path:
 def test_the_least_recently_used_files_go_first(cache: Path) -> None:
     old = [_file(cache, f"old-{i}.pickle", 3000, 100.0 - i) for i in range(3)]
     new = _file(cache, "new.so", 3000, 1.0)
+    recent = cache / "recent.so"  # used a moment ago: spared even when the cache is full
+    recent.write_bytes(b"x" * 3000)
     hidden = _file(cache, ".new.so.tmp", 5000, 500.0)  # another process's file being written
-    assert sum(p.stat().st_size for p in (*old, new)) == 12_000
+    assert sum(p.stat().st_size for p in (*old, new, recent)) == 15_000
     removed = codegen.prune_cache()
-    # 12,000 bytes > 10,000: the oldest go until at most 8,000 remain.
-    assert removed == old[:2]
-    assert [p.exists() for p in (*old, new, hidden)] == [False, False, True, True, True]
+    # 15,000 bytes > 10,000: the oldest go until at most 8,000 remain, but not the file used
+    # a moment ago, so the folder stays above the limit until that file ages.
+    assert removed == [*old, new]
+    assert [p.exists() for p in (*old, new, recent, hidden)] == [False] * 4 + [True] * 2
     assert codegen.prune_cache() == []  # within the limit now
 
 

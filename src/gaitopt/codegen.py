@@ -23,6 +23,7 @@ import os
 import shutil
 import subprocess
 import tempfile
+import time
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -36,6 +37,9 @@ CACHE_LIMIT_MB = 500.0
 #: :func:`prune_cache` deletes down to this share of the limit, so it does not run after
 #: every write once the folder is full.
 PRUNE_TO = 0.8
+#: :func:`prune_cache` never deletes a file used (written or loaded) this recently (s): a
+#: process may have found a library and not loaded it yet.
+KEEP_RECENT_S = 120.0
 
 
 class CompileError(RuntimeError):
@@ -82,11 +86,13 @@ def mark_used(path: Path) -> None:
 def prune_cache(limit: int | None = None) -> list[Path]:
     """Delete the least recently used files of :func:`cache_dir` (oldest modification time
     first) while it holds more than ``limit`` bytes (:func:`cache_limit_bytes`), down to
-    :data:`PRUNE_TO` of it; return the deleted paths. Hidden files (another process's files
+    :data:`PRUNE_TO` of it, sparing files used in the last :data:`KEEP_RECENT_S` seconds;
+    return the deleted paths. Hidden files (another process's files
     being written) are neither counted nor deleted; a file another process deleted first is
     skipped. A library this process has loaded stays usable (Linux keeps a deleted file's
     mapping); it is compiled again only by a later process that needs it."""
     limit = cache_limit_bytes() if limit is None else limit
+    recent = time.time() - KEEP_RECENT_S
     entries: list[tuple[float, int, Path]] = []
     for path in cache_dir().iterdir():
         if path.name.startswith("."):
@@ -99,8 +105,8 @@ def prune_cache(limit: int | None = None) -> list[Path]:
     if total <= limit:
         return []
     removed = []
-    for _, size, path in sorted(entries, key=lambda e: e[0]):
-        if total <= PRUNE_TO * limit:
+    for mtime, size, path in sorted(entries, key=lambda e: e[0]):
+        if total <= PRUNE_TO * limit or mtime > recent:
             break
         with contextlib.suppress(OSError):
             path.unlink()
