@@ -33,17 +33,17 @@ def _file(folder: Path, name: str, size: int, age_s: float) -> Path:
 
 
 def test_the_least_recently_used_files_go_first(cache: Path) -> None:
-    old = [_file(cache, f"old-{i}.pickle", 3000, 100.0 - i) for i in range(3)]
-    new = _file(cache, "new.so", 3000, 1.0)
+    old = [_file(cache, f"old-{i}.pickle", 1000, 100.0 - i) for i in range(2)]
+    new = _file(cache, "new.so", 1000, 1.0)
     recent = cache / "recent.so"  # used a moment ago: spared even when the cache is full
-    recent.write_bytes(b"x" * 3000)
+    recent.write_bytes(b"x" * 9000)
     hidden = _file(cache, ".new.so.tmp", 5000, 500.0)  # another process's file being written
-    assert sum(p.stat().st_size for p in (*old, new, recent)) == 15_000
+    assert sum(p.stat().st_size for p in (*old, new, recent)) == 12_000
     removed = codegen.prune_cache()
-    # 15,000 bytes > 10,000: the oldest go until at most 8,000 remain, but not the file used
-    # a moment ago, so the folder stays above the limit until that file ages.
+    # 12,000 bytes > 10,000: the oldest go first, toward at most 8,000 bytes, but not the
+    # file used a moment ago (the folder stays at 9,000 until that file ages).
     assert removed == [*old, new]
-    assert [p.exists() for p in (*old, new, recent, hidden)] == [False] * 4 + [True] * 2
+    assert [p.exists() for p in (*old, new, recent, hidden)] == [False] * 3 + [True] * 2
     assert codegen.prune_cache() == []  # within the limit now
 
 
