@@ -115,8 +115,9 @@ from gaitopt.gait.transcriptions import (
     transcription_for,
     warm_start_grid,
 )
-from gaitopt.ocp import Guess, Result, WarmStart, refined_mesh
+from gaitopt.ocp import Guess, ProblemError, Result, WarmStart, refined_mesh
 from gaitopt.ocp.mesh import split_intervals
+from gaitopt.ocp.regrid import regridded
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import leg_swap
 
@@ -133,6 +134,13 @@ COST_SMOOTHING_STEP = 10.0
 #: (the bound of ``GaitOptions.knots``).
 MAX_REFINEMENTS = 6
 MAX_REFINED_KNOTS = 400
+#: Whether a move to another grid (the target grid, the check grid, mesh refinement rounds)
+#: starts IPOPT from the last solution's values AND its multipliers mapped onto the new grid
+#: (:mod:`gaitopt.ocp.regrid`), with the transcription's warm-start options and
+#: :data:`REGRID_OPTIONS` over them; otherwise from the values only (docs/ocp.md, "Warm
+#: starts across grids", has the measurements behind the choice).
+REGRID_MULTIPLIERS = False
+REGRID_OPTIONS: dict[str, Any] = {}
 
 
 class _Run:
@@ -343,10 +351,22 @@ class _Run:
         (:mod:`gaitopt.gait.accuracy`); a check that fails leaves the answer without that
         estimate, never changes it."""
         o = self.options
-        finer = o.replace(knots=check_knots(o.knots))
-        self.stage("check grid", target_grid(self.model, finer), Relaxation(), result,
-                   parameter_bounds(o),
-                   solver_options=check_grid_options(o))
+        grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
+        self.stage("check grid", grid, Relaxation(), self.grid_start(grid, result),
+                   parameter_bounds(o), solver_options=check_grid_options(o),
+                   warm_start_options=REGRID_OPTIONS)
+
+    def grid_start(self, grid: Grid, result: Result) -> Result | WarmStart:
+        """The start on ``grid`` from ``result`` (another grid): with
+        :data:`REGRID_MULTIPLIERS` its values and multipliers mapped onto ``grid``
+        (:func:`gaitopt.ocp.regrid.regridded`), else ``result`` (its values only)."""
+        if not REGRID_MULTIPLIERS:
+            return result
+        tr = transcription_for(self.model, self.options, grid, compiled=self.compiled)
+        try:
+            return regridded(tr, result)
+        except ProblemError:  # another problem (the cold control model): the values only
+            return result
 
     def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
         """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
@@ -355,8 +375,9 @@ class _Run:
         held = dict(parameter_bounds(o))
         for key in ("step_length", "speed"):
             held[key] = (result.parameters[key], result.parameters[key])
-        fine = self.stage(name, grid, Relaxation(), result, held,
-                          solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)})
+        fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result), held,
+                          solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)},
+                          warm_start_options=REGRID_OPTIONS)
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
         if not fine.success or all_fixed:
