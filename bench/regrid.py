@@ -1,4 +1,4 @@
-"""Benchmark: warm starts across grids with the multipliers mapped (gaitopt.ocp.regrid) vs values only.
+"""Benchmark: warm starts across grids with mapped multipliers (gaitopt.ocp.regrid) or values.
 
 Every case is solved twice in this process by ``solve_walking``: first as main does
 (``gaitopt.gait.solve.REGRID_MULTIPLIERS = False``: a move to another grid starts IPOPT from

@@ -32,8 +32,8 @@ from gaitopt.ocp.layout import Layout
 from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
 from gaitopt.ocp.nlp import Nlp, assemble, assemble_expressions
 from gaitopt.ocp.pointwise import PointwiseNlp
-from gaitopt.ocp.regrid import regridded
 from gaitopt.ocp.problem import Problem
+from gaitopt.ocp.regrid import regridded
 from gaitopt.ocp.result import METHODS, NlpSize, PhaseTrajectory, Result, point_values
 from gaitopt.ocp.scaling import state_scales, variable_scales
 from gaitopt.ocp.solver import (
