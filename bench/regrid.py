@@ -1,12 +1,13 @@
 """Benchmark: warm starts across grids with mapped multipliers (gaitopt.ocp.regrid) or values.
 
 Every case is solved twice in this process by ``solve_walking``: first as main does
-(``gaitopt.gait.solve.REGRID_MULTIPLIERS = False``: a move to another grid starts IPOPT from
-the previous solution's values only, with ``PRIMAL_WARM_OPTIONS``), then with the mapped
-multipliers (``REGRID_MULTIPLIERS = True``, the transcription's ``WARM_START_OPTIONS`` with
-``--mu`` as IPOPT's initial barrier). The transcriptions are built by the first run and reused
-by the second, so the stage times compare solves, not builds (the second run builds one more
-IPOPT instance per grid for the warm-start options, from the derivatives already built).
+(``gaitopt.gait.solve.REGRID_MOVES`` empty: a move to another grid starts IPOPT from the
+previous solution's values only, with ``PRIMAL_WARM_OPTIONS``), then with the mapped
+multipliers on the grid moves ``--moves`` (``REGRID_MOVES``; default the check grid only), the
+transcription's ``WARM_START_OPTIONS`` with ``--mu`` as IPOPT's initial barrier. The
+transcriptions are built by the first run and reused by the second, so the stage times compare
+solves, not builds (the second run builds one more IPOPT instance per grid for the warm-start
+options, from the derivatives already built).
 
 Printed per case and run: the iterations of the cross-grid stages (``target grid``, ``target
 grid, all free``, ``check grid``), their wall time, every stage's iterations summed, the final
@@ -19,7 +20,8 @@ impulse; ``paper`` the paper control model on uniform 40 + 10 knots at 12 m/min;
 coordinates at 12 and 48 m/min; ``seven`` the seven-link heel-toe walk on 24 + 16 knots at
 12 m/min (about a minute per run).
 
-Run: ``python bench/regrid.py [--cases five paper full seven] [--mu 1e-6]``
+Run: ``python bench/regrid.py [--cases five paper full seven] [--mu 1e-6]
+[--moves target check]``
 """
 
 from __future__ import annotations
@@ -65,7 +67,8 @@ def cases(groups: list[str]) -> list[Case]:
                             GaitOptions(speed=speed / 60, formulation="full")))
     if "seven" in groups:
         out.append(Case("seven-link heel-toe 24+16 12 m/min", "seven-link",
-                        GaitOptions(speed=0.2, gait="heel-toe", knots=(24, 16))))
+                        GaitOptions(speed=0.2, gait="heel-toe", knots=(24, 16),
+                                    formulation="full")))
     return out
 
 
@@ -91,9 +94,9 @@ class Run:
         return sum(self.stage_seconds.get(s, 0.0) for s in CROSS_GRID)
 
 
-def run(case: Case, mapped: bool, mu: float) -> Run:
-    """Solve ``case`` with the multipliers mapped across grids or (main) not."""
-    walking.REGRID_MULTIPLIERS = mapped
+def run(case: Case, moves: frozenset[str], mu: float) -> Run:
+    """Solve ``case`` with the multipliers mapped across the grid ``moves`` (none: main)."""
+    walking.REGRID_MOVES = moves
     walking.REGRID_OPTIONS = {"ipopt.mu_init": mu}
     start = time.perf_counter()
     sol = solve_walking(load_model(case.model), case.options)
@@ -120,16 +123,21 @@ def main() -> None:
                         choices=["five", "paper", "full", "seven"])
     parser.add_argument("--mu", type=float, default=1e-6,
                         help="IPOPT's initial barrier of the mapped warm starts")
+    parser.add_argument("--moves", nargs="+", default=["check"],
+                        choices=["target", "check", "refinement"],
+                        help="the grid moves that map the multipliers in the mapped runs")
     args = parser.parse_args()
-    print(f"load average {os.getloadavg()[0]:.2f}; mapped runs: mu_init {args.mu:g}")
+    moves = frozenset(args.moves)
+    print(f"load average {os.getloadavg()[0]:.2f}; mapped runs: mu_init {args.mu:g}, moves "
+          f"{', '.join(sorted(moves))}")
     print(f"{'case / run':44s} {'tgt':>4s} {'free':>4s} {'chk':>4s}  {'cross':>5s} "
           f"{'s':>7s} {'all':>6s} {'cost':>14s}")
     totals = {False: [0, 0.0], True: [0, 0.0]}
     worst = 0.0
     elsewhere: list[str] = []
     for case in cases(args.cases):
-        main_run = run(case, False, args.mu)
-        mapped = run(case, True, args.mu)
+        main_run = run(case, frozenset(), args.mu)
+        mapped = run(case, moves, args.mu)
         rel = abs(mapped.cost - main_run.cost) / abs(main_run.cost)
         print(row(f"{case.label}: main", main_run))
         print(row(f"{case.label}: mapped", mapped) + f"  rel. cost diff {rel:.1e}")

@@ -134,12 +134,13 @@ COST_SMOOTHING_STEP = 10.0
 #: (the bound of ``GaitOptions.knots``).
 MAX_REFINEMENTS = 6
 MAX_REFINED_KNOTS = 400
-#: Whether a move to another grid (the target grid, the check grid, mesh refinement rounds)
-#: starts IPOPT from the last solution's values AND its multipliers mapped onto the new grid
-#: (:mod:`gaitopt.ocp.regrid`), with the transcription's warm-start options and
-#: :data:`REGRID_OPTIONS` over them; otherwise from the values only (docs/ocp.md, "Warm
-#: starts across grids", has the measurements behind the choice).
-REGRID_MULTIPLIERS = False
+#: The moves to another grid that start IPOPT from the last solution's values AND its
+#: multipliers mapped onto the new grid (:mod:`gaitopt.ocp.regrid`), with the transcription's
+#: warm-start options and :data:`REGRID_OPTIONS` over them: ``"target"`` (the target grid
+#: from the coarse solution), ``"check"`` (the check grid from the target grid's),
+#: ``"refinement"`` (mesh refinement rounds); the others start from the values only.
+#: docs/ocp.md, "Warm starts across grids", has the measurements behind the choice.
+REGRID_MOVES: frozenset[str] = frozenset()
 REGRID_OPTIONS: dict[str, Any] = {}
 
 
@@ -352,15 +353,15 @@ class _Run:
         estimate, never changes it."""
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
-        self.stage("check grid", grid, Relaxation(), self.grid_start(grid, result),
+        self.stage("check grid", grid, Relaxation(), self.grid_start(grid, result, "check"),
                    parameter_bounds(o), solver_options=check_grid_options(o),
                    warm_start_options=REGRID_OPTIONS)
 
-    def grid_start(self, grid: Grid, result: Result) -> Result | WarmStart:
-        """The start on ``grid`` from ``result`` (another grid): with
-        :data:`REGRID_MULTIPLIERS` its values and multipliers mapped onto ``grid``
+    def grid_start(self, grid: Grid, result: Result, move: str) -> Result | WarmStart:
+        """The start on ``grid`` from ``result`` (another grid): for a ``move`` in
+        :data:`REGRID_MOVES` its values and multipliers mapped onto ``grid``
         (:func:`gaitopt.ocp.regrid.regridded`), else ``result`` (its values only)."""
-        if not REGRID_MULTIPLIERS:
+        if move not in REGRID_MOVES:
             return result
         tr = transcription_for(self.model, self.options, grid, compiled=self.compiled)
         try:
@@ -368,14 +369,15 @@ class _Run:
         except ProblemError:  # another problem (the cold control model): the values only
             return result
 
-    def on_grid(self, name: str, grid: Grid, result: Result) -> Result:
-        """Solve on ``grid`` from ``result`` (another grid): the step length and speed held
-        at ``result``'s, then (stage ``name, all free``) released."""
+    def on_grid(self, name: str, grid: Grid, result: Result, move: str = "target") -> Result:
+        """Solve on ``grid`` from ``result`` (another grid; ``move`` as in
+        :data:`REGRID_MOVES`): the step length and speed held at ``result``'s, then (stage
+        ``name, all free``) released."""
         o = self.options
         held = dict(parameter_bounds(o))
         for key in ("step_length", "speed"):
             held[key] = (result.parameters[key], result.parameters[key])
-        fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result), held,
+        fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result, move), held,
                           solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)},
                           warm_start_options=REGRID_OPTIONS)
         all_fixed = o.speed is not None and (o.step_length is not None or
@@ -409,14 +411,14 @@ class _Run:
             mesh = refined_mesh(result, tol)
             if max(m.size for m in mesh) > MAX_REFINED_KNOTS:
                 break
-            result = self.on_grid(f"mesh refinement {round_}", mesh, result)
+            result = self.on_grid(f"mesh refinement {round_}", mesh, result, "refinement")
             if not result.success:
                 return result
         halved = tuple(split_intervals(m, np.full(m.size - 1, 2, dtype=np.int64))
                        for m in result.mesh)
         if max(m.size for m in halved) > MAX_REFINED_KNOTS:
             return result
-        return self.on_grid("mesh check (halved)", halved, result)
+        return self.on_grid("mesh check (halved)", halved, result, "refinement")
 
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
