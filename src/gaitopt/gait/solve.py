@@ -136,12 +136,20 @@ MAX_REFINEMENTS = 6
 MAX_REFINED_KNOTS = 400
 #: The moves to another grid that start IPOPT from the last solution's values AND its
 #: multipliers mapped onto the new grid (:mod:`gaitopt.ocp.regrid`), with the transcription's
-#: warm-start options and :data:`REGRID_OPTIONS` over them: ``"target"`` (the target grid
-#: from the coarse solution), ``"check"`` (the check grid from the target grid's),
-#: ``"refinement"`` (mesh refinement rounds); the others start from the values only.
-#: docs/ocp.md, "Warm starts across grids", has the measurements behind the choice.
-REGRID_MOVES: frozenset[str] = frozenset()
-REGRID_OPTIONS: dict[str, Any] = {}
+#: warm-start options and :data:`REGRID_OPTIONS` over them, by contact sequence (``gait``, or
+#: ``"sequence"`` for a given ``contact_sequence``): ``"target"`` (the target grid from the
+#: coarse solution), ``"check"`` (the check grid from the target grid's), ``"refinement"``
+#: (mesh refinement rounds); other moves start from the values only. Measured by
+#: bench/regrid.py (docs/benchmarks-gait.md): the heel-toe walk's check grid took 112 instead
+#: of 188 iterations at 12 m/min and 31 instead of 63 at 36 m/min (seven-link, 24 + 16 knots),
+#: the same optima; on the two-phase walk it saved nothing, and the target grid move, which
+#: saved a fifth of that stage's iterations on the five-link walks, sent the heel-toe walk to
+#: a 0.5 % dearer optimum.
+REGRID_MOVES: dict[str, frozenset[str]] = {"heel-toe": frozenset({"check"})}
+#: The initial barrier of the mapped starts: 1e-4, as a start from values only. With the
+#: transcription's 1e-6 the heel-toe walk's check grid took 58 iterations at 12 m/min but to
+#: a 1.8 % dearer optimum.
+REGRID_OPTIONS: dict[str, Any] = {"ipopt.mu_init": 1e-4}
 
 
 class _Run:
@@ -361,9 +369,11 @@ class _Run:
         """The start on ``grid`` from ``result`` (another grid): for a ``move`` in
         :data:`REGRID_MOVES` its values and multipliers mapped onto ``grid``
         (:func:`gaitopt.ocp.regrid.regridded`), else ``result`` (its values only)."""
-        if move not in REGRID_MOVES:
+        o = self.options
+        if move not in REGRID_MOVES.get(o.gait if o.contact_sequence is None else "sequence",
+                                        frozenset()):
             return result
-        tr = transcription_for(self.model, self.options, grid, compiled=self.compiled)
+        tr = transcription_for(self.model, o, grid, compiled=self.compiled)
         try:
             return regridded(tr, result)
         except ProblemError:  # another problem (the cold control model): the values only
