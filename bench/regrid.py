@@ -22,10 +22,10 @@ Cases (``--cases``, default all but ``seven``): ``five`` the five-link default (
 knots, jumps control model) at 3, 12, 36, 60 m/min, with and without ankle torques and liftoff
 impulse; ``paper`` the paper control model on uniform 40 + 10 knots at 12 m/min; ``full`` full
 coordinates at 12 and 48 m/min; ``seven`` the seven-link heel-toe walk on 24 + 16 knots at
-12 m/min (about a minute per run).
+``--seven-speeds`` (default 12 m/min; about a minute per run).
 
 Run: ``python bench/regrid.py [--cases five paper full seven] [--mu 1e-4]
-[--moves target check]``
+[--moves target check] [--seven-speeds 12 24 36 48]``
 """
 
 from __future__ import annotations
@@ -54,8 +54,9 @@ class Case:
     options: GaitOptions
 
 
-def cases(groups: list[str]) -> list[Case]:
-    """The cases of ``groups`` (see the module docstring)."""
+def cases(groups: list[str], seven_speeds: list[float]) -> list[Case]:
+    """The cases of ``groups`` (see the module docstring); the seven-link walk at
+    ``seven_speeds`` (m/min)."""
     out: list[Case] = []
     if "five" in groups:
         for speed in (3, 12, 36, 60):
@@ -71,9 +72,10 @@ def cases(groups: list[str]) -> list[Case]:
             out.append(Case(f"full coordinates {speed} m/min", "five-link",
                             GaitOptions(speed=speed / 60, formulation="full")))
     if "seven" in groups:
-        out.append(Case("seven-link heel-toe 24+16 12 m/min", "seven-link",
-                        GaitOptions(speed=0.2, gait="heel-toe", knots=(24, 16),
-                                    formulation="full")))
+        for speed in seven_speeds:
+            out.append(Case(f"seven-link heel-toe 24+16 {speed:g} m/min", "seven-link",
+                            GaitOptions(speed=speed / 60, gait="heel-toe", knots=(24, 16),
+                                        formulation="full")))
     return out
 
 
@@ -136,6 +138,8 @@ def main() -> None:
     parser.add_argument("--moves", nargs="+", default=["check"],
                         choices=["target", "check", "refinement"],
                         help="the grid moves that map the multipliers in the mapped runs")
+    parser.add_argument("--seven-speeds", nargs="+", type=float, default=[12.0],
+                        help="speeds (m/min) of the seven-link case")
     args = parser.parse_args()
     moves = frozenset(args.moves)
     print(f"load average {os.getloadavg()[0]:.2f}; mapped runs: mu_init {args.mu:g}, moves "
@@ -145,7 +149,7 @@ def main() -> None:
     totals = {False: [0, 0.0], True: [0, 0.0]}
     worst = 0.0
     elsewhere: list[str] = []
-    for case in cases(args.cases):
+    for case in cases(args.cases, args.seven_speeds):
         main_run = run(case, frozenset(), args.mu)
         mapped = run(case, moves, args.mu)
         rel = max(abs(mapped.cost - main_run.cost) / abs(main_run.cost),
