@@ -376,7 +376,7 @@ class _Run:
         tr = transcription_for(self.model, o, grid, compiled=self.compiled)
         try:
             return regridded(tr, result)
-        except ProblemError:  # another problem (the cold control model): the values only
+        except ProblemError:  # a result of another problem: its values only, as before
             return result
 
     def on_grid(self, name: str, grid: Grid, result: Result, move: str = "target") -> Result:
