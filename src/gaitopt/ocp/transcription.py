@@ -33,6 +33,7 @@ from gaitopt.ocp.mesh import IntervalsSpec, Mesh, make_mesh
 from gaitopt.ocp.nlp import Nlp, assemble, assemble_expressions
 from gaitopt.ocp.pointwise import PointwiseNlp
 from gaitopt.ocp.problem import Problem
+from gaitopt.ocp.regrid import regridded
 from gaitopt.ocp.result import METHODS, NlpSize, PhaseTrajectory, Result, point_values
 from gaitopt.ocp.scaling import state_scales, variable_scales
 from gaitopt.ocp.solver import (
@@ -225,7 +226,8 @@ class Transcription:
               parameters: ParameterBounds | None = None,
               options: Mapping[str, Any] | None = None,
               warm_start_multipliers: bool = False,
-              warm_start_options: Mapping[str, Any] | None = None) -> Result:
+              warm_start_options: Mapping[str, Any] | None = None,
+              regrid: bool = False) -> Result:
         """Solve the NLP from ``guess``; never raises for solver failures.
 
         ``bounds`` replaces the statement's bounds; ``parameters`` then bounds parameters by
@@ -233,7 +235,10 @@ class Transcription:
         transcription's solver options. ``warm_start_multipliers`` passes a Result's
         multipliers to IPOPT when its layout matches (a :class:`WarmStart` must match; values
         and multipliers are taken as they are), and then :data:`WARM_START_OPTIONS` with
-        ``warm_start_options`` merged over them apply, over ``options``."""
+        ``warm_start_options`` merged over them apply, over ``options``. With ``regrid`` too,
+        a Result on another grid of this problem (same method) passes its multipliers mapped
+        onto this grid (:func:`gaitopt.ocp.regrid.regridded`; a Result of another problem
+        is a ProblemError)."""
         b = bounds or self._bounds
         if b.layout.signature() != self.layout.signature() or b.lbg.size != self.nlp.lbg.size:
             raise ProblemError("bounds: made for another transcription (layout differs)")
@@ -245,6 +250,9 @@ class Transcription:
                 raise ProblemError(str(exc.args[0])) from None
         b.check()
         opts = merge_options(self.options, options)
+        if (warm_start_multipliers and regrid and isinstance(guess, Result)
+                and guess.layout_signature != self.layout.signature()):
+            guess = regridded(self, guess)
         w0 = self.initial_guess(guess)
         d_w, d_g, s_j = self.nlp.d_w, self.nlp.d_g, self.nlp.objective_scale
         args: dict[str, Any] = dict(x0=w0 / d_w, lbx=b.lbw / d_w, ubx=b.ubw / d_w,
