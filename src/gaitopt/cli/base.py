@@ -130,13 +130,16 @@ def paper_grid_option(f: F) -> F:
                              "one.")(f)
 
 
-def knot_spacing_option(help: str, default: str | None = "cosine") -> Callable[[F], F]:
-    """``--knot-spacing uniform|cosine`` with this help text (``default`` None: the
-    :class:`~gaitopt.gait.options.GaitOptions` default, see :func:`grid_choice`)."""
-    from gaitopt.gait.options import KNOT_SPACINGS
+def knot_spacing_option(help: str) -> Callable[[F], F]:
+    """``--knot-spacing uniform|cosine`` with this help text (None when not given: the
+    :class:`~gaitopt.gait.options.GaitOptions` default, uniform with ``--paper-grid``; see
+    :func:`grid_choice`)."""
+    from gaitopt.gait.options import KNOT_SPACINGS, GaitOptions
 
     return click.option("--knot-spacing", type=click.Choice(list(KNOT_SPACINGS)),
-                        default=default, show_default=default is not None, help=help)
+                        default=None,
+                        help=f"{help} [default: {GaitOptions().knot_spacing}; uniform with "
+                             "--paper-grid]")
 
 
 def resting_power_option(f: F) -> F:

@@ -117,9 +117,7 @@ def _step_time(text: str) -> float | None:
                    "share (at most 0.95), starting from it (needs --formulation full).")
 @knots_option
 @knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events; "
-                     "docs/walking.md section 6) or uniform [default: "
-                     f"{GaitOptions().knot_spacing}; uniform with --paper-grid].",
-                     default=None)
+                     "docs/walking.md section 6) or uniform.")
 @paper_grid_option
 @click.option("--transcription", type=click.Choice(list(TRANSCRIPTIONS)), default=None,
               help="hermite-simpson: DIRCOL's compressed form, the paper's NLP; "

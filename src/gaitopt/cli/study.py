@@ -102,7 +102,7 @@ def _workers_option(f: Any) -> Any:
 @min_knee_flexion_option
 @knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events, the "
                      "default of every solve since 2026-12-02; docs/walking.md section 6) or "
-                     "uniform [default: cosine; uniform with --paper-grid].", default=None)
+                     "uniform.")
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
@@ -182,8 +182,7 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
                    "periodic controls); checked against 16+6 knots.")
 @knots_option
 @knot_spacing_option("The knots of each phase of the paper's study (and of the cost study): "
-                     "cosine-spaced (clustered at the events) or uniform [default: cosine; "
-                     "uniform with --paper-grid].", default=None)
+                     "cosine-spaced (clustered at the events) or uniform.")
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
                   paper_grid: bool, knots: str | None, knot_spacing: str | None,

@@ -157,11 +157,9 @@ def base_point(model: RobotModel, held: Sequence[str]) -> str | None:
         return None
     nq = model.nq
     q, qd = ca.SX.sym("q", nq), ca.SX.sym("qd", nq)
-    fn = ca.Function("point", [q, qd], [contact_position(model, vector(as_scalars(q, nq, "q")),
-                                                          pinned[0]),
-                                        contact_velocity(model, vector(as_scalars(q, nq, "q")),
-                                                         vector(as_scalars(qd, nq, "qd")),
-                                                         pinned[0])])
+    qv, qdv = vector(as_scalars(q, nq, "q")), vector(as_scalars(qd, nq, "qd"))
+    fn = ca.Function("point", [q, qd], [contact_position(model, qv, pinned[0]),
+                                        contact_velocity(model, qv, qdv, pinned[0])])
     rng = np.random.default_rng(0)
     q0, qd0, shift = rng.normal(size=nq), rng.normal(size=nq), np.zeros(nq)
     shift[:2] = rng.normal(size=2)

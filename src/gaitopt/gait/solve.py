@@ -106,6 +106,7 @@ from gaitopt.gait.stages import (
     fine_stage_options,
     held_ankles,
     held_bounds,
+    sequence_kind,
 )
 from gaitopt.gait.transcriptions import (
     Grid,
@@ -136,8 +137,8 @@ MAX_REFINEMENTS = 6
 MAX_REFINED_KNOTS = 400
 #: The moves to another grid that start IPOPT from the last solution's values AND its
 #: multipliers mapped onto the new grid (:mod:`gaitopt.ocp.regrid`), with the transcription's
-#: warm-start options and :data:`REGRID_OPTIONS` over them, by contact sequence (``gait``, or
-#: ``"sequence"`` for a given ``contact_sequence``): ``"target"`` (the target grid from the
+#: warm-start options and :data:`REGRID_OPTIONS` over them, by contact sequence kind
+#: (:func:`~gaitopt.gait.stages.sequence_kind`): ``"target"`` (the target grid from the
 #: coarse solution), ``"check"`` (the check grid from the target grid's), ``"refinement"``
 #: (mesh refinement rounds); other moves start from the values only. Measured by
 #: bench/regrid.py (docs/benchmarks-gait.md): the heel-toe walk's check grid took 112 instead
@@ -370,8 +371,7 @@ class _Run:
         :data:`REGRID_MOVES` its values and multipliers mapped onto ``grid``
         (:func:`gaitopt.ocp.regrid.regridded`), else ``result`` (its values only)."""
         o = self.options
-        if move not in REGRID_MOVES.get(o.gait if o.contact_sequence is None else "sequence",
-                                        frozenset()):
+        if move not in REGRID_MOVES.get(sequence_kind(o), frozenset()):
             return result
         tr = transcription_for(self.model, o, grid, compiled=self.compiled)
         try:

@@ -60,15 +60,6 @@ PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
 #: instead of 63 iterations but to another local optimum, 0.26 % dearer (2867.92 against
 #: 2860.47), which would change the error estimate (at 12 m/min: 193 against 188, the same).
 CHECK_GRID_OPTIONS = {**PRIMAL_WARM_OPTIONS, "ipopt.mu_init": 1e-6}
-
-
-def check_grid_options(options: GaitOptions) -> dict[str, Any]:
-    """The IPOPT options of the check-grid stage: :data:`CHECK_GRID_OPTIONS` for the walk
-    (two phases), :data:`PRIMAL_WARM_OPTIONS` for other contact sequences; with
-    :func:`fine_stage_options` merged over them."""
-    walk = options.gait == "walk" and options.contact_sequence is None
-    return {**(CHECK_GRID_OPTIONS if walk else PRIMAL_WARM_OPTIONS),
-            **fine_stage_options(options)}
 #: The Hessian of the target-grid stages of a cold solve: a limited-memory quasi-Newton
 #: approximation (as SNOPT's, which the paper used). Deriving the exact Hessian of the
 #: expanded NLP costs far more than these stages: at 40 + 10 knots 9-12 s against 2 s for
@@ -88,6 +79,22 @@ def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
     if options.formulation != "reduced" or options.transcription == "hermite-simpson-separated":
         return {}
     return dict(FINE_STAGE_OPTIONS)
+
+
+def sequence_kind(options: GaitOptions) -> str:
+    """The contact sequence of ``options`` by kind, which stage settings are chosen by: its
+    ``gait`` (``walk``, ``run``, ``heel-toe``), or ``"sequence"`` for a given
+    ``contact_sequence``."""
+    return options.gait if options.contact_sequence is None else "sequence"
+
+
+def check_grid_options(options: GaitOptions) -> dict[str, Any]:
+    """The IPOPT options of the check-grid stage: :data:`CHECK_GRID_OPTIONS` for the walk
+    (two phases), :data:`PRIMAL_WARM_OPTIONS` for other contact sequences; with
+    :func:`fine_stage_options` merged over them."""
+    walk = sequence_kind(options) == "walk"
+    return {**(CHECK_GRID_OPTIONS if walk else PRIMAL_WARM_OPTIONS),
+            **fine_stage_options(options)}
 
 
 def coarse_knots(options: GaitOptions) -> tuple[int, int]:
