@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from gaitopt.ocp import (
+    BoundaryConstraint,
     KnotStates,
     PathConstraint,
     Phase,
@@ -30,10 +31,12 @@ def _dynamics(x: ca.SX, u: ca.SX, p: ca.SX, t: ca.SX) -> ca.SX:
     return ca.vertcat(x[1], u[0], 2 * x[0] * x[1] + u[1])
 
 
-def rest_to_rest(given: bool) -> Problem:
+def rest_to_rest(given: bool, ends_read_z: bool = False) -> Problem:
     """Move ``s`` from 0 to 1 at rest in 1 s minimising ``int a^2`` (optimum 12, exact for
     Hermite-Simpson: ``a = 6 - 12 t``), with ``z = s^2`` at every knot after the first:
-    given by :class:`KnotStates` (``given``) or stated as an equality path constraint."""
+    given by :class:`KnotStates` (``given``) or stated as an equality path constraint.
+    ``ends_read_z`` adds a boundary constraint and a Mayer term on the final ``z`` (another
+    problem: for derivatives only, so that the ends function reads a given state)."""
     common = dict(initial_state={"s": 0.0, "v": 0.0, "z": 0.0},
                   final_state={"s": 1.0, "v": 0.0},
                   state_bounds={"z": (-5.0, 5.0)},
@@ -47,7 +50,11 @@ def rest_to_rest(given: bool) -> Problem:
                       path_constraints=[PathConstraint("z = s^2", lambda x, u, p, t:
                                                        x[2] - x[0] ** 2, 0.0, 0.0, at="knots")],
                       **common)
-    return Problem([phase])
+    if not ends_read_z:
+        return Problem([phase])
+    return Problem([phase], boundary_constraints=[BoundaryConstraint(
+        "final z", lambda e, p: e["move"].xf[2] * e["move"].xf[0], -10.0, 10.0)],
+        mayer=lambda e, p: 0.1 * e["move"].xf[2] ** 2)
 
 
 def _solve(tr: Transcription) -> object:
@@ -77,11 +84,21 @@ def test_given_states_reach_the_optimum_of_the_stated_equalities(
     assert given.nlp.dependent.size == 6
 
 
+@pytest.mark.parametrize("method", [SEPARATED, "trapezoidal"])
 def test_point_derivatives_with_given_states_equal_those_of_the_expanded_nlp(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        method: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The point-wise NLP computes the given states inside the knots' point function and
+    the ends function (``fold_knot_states``): the same functions as the expanded NLP, which
+    computes them in the expressions around the point functions."""
     monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
-    ref = transcribe(rest_to_rest(True), method=SEPARATED)
-    tr = transcribe(rest_to_rest(True), method=SEPARATED, compiled="points")
+    problem = rest_to_rest(True, ends_read_z=True)
+    ref = transcribe(problem, method=method)
+    tr = transcribe(problem, method=method, compiled="points")
+    # The knots after the first have their own point function, which returns the given
+    # states; the ends function computes the final one.
+    assert tr._pointwise is not None
+    names = {fn.name() for fn in tr._pointwise.point_functions}
+    assert names == {"point_move", "knot_point_move", "ends_knot_states_rows"}
     rng = np.random.default_rng(5)
     w = rng.standard_normal(ref.layout.size)
     lam = rng.standard_normal(ref.nlp.lbg.size)
@@ -94,7 +111,7 @@ def test_point_derivatives_with_given_states_equal_those_of_the_expanded_nlp(
         for e, g in zip(expected, got, strict=True):
             e, g = np.asarray(ca.DM(e).full()), np.asarray(ca.DM(g).full())
             assert np.max(np.abs(g - e)) <= 1e-11 * max(1.0, np.max(np.abs(e))), kind
-    # s^2 enters the Hessian through the given z (the chain rule's z(w) term is exercised).
+    # s^2 enters the Hessian through the given z (in the knots' point Hessians).
     hess = np.asarray(ca.DM(ref.solver(ref.options).get_function("nlp_hess_l")(
         w, [], 0.7, lam)).full())
     s_knot = ref.layout.phase("move").index("state", "s", 2)

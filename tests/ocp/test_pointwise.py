@@ -108,8 +108,9 @@ def test_point_libraries_are_cached_and_rebuilt_when_the_model_changes(
     monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
     first = transcribe(nonlinear(1.0), method=SEPARATED, compiled="points")
     libs = sorted(tmp_path.glob("pt_*.so"))
-    assert len(libs) == 1
-    inode = libs[0].stat().st_ino  # a rebuilt library replaces the file (a new inode)
+    # One library for the phase's point function, one for the ends function's rows.
+    assert [lib.name.split("-")[0] for lib in libs] == ["pt_ends_rows", "pt_point_swing"]
+    inodes = [lib.stat().st_ino for lib in libs]  # a rebuilt library gets a new inode
 
     def no_compiling(*args: object, **kwargs: object) -> None:
         raise AssertionError("compiled although the library is cached")
@@ -117,13 +118,16 @@ def test_point_libraries_are_cached_and_rebuilt_when_the_model_changes(
     # Another mesh and another process-level build: the library is loaded, not compiled.
     monkeypatch.setattr(codegen, "compile_libraries", no_compiling)
     again = transcribe(nonlinear(1.0, intervals=9), method=SEPARATED, compiled="points")
-    assert sorted(tmp_path.glob("pt_*.so")) == libs and libs[0].stat().st_ino == inode
+    assert sorted(tmp_path.glob("pt_*.so")) == libs
+    assert [lib.stat().st_ino for lib in libs] == inodes
     assert again.solve().success
     monkeypatch.undo()
     monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
-    # A changed model (another gain in the dynamics) compiles a new library.
+    # A changed model (another gain in the dynamics) compiles a new point library; the
+    # ends are unchanged, so their library is reused.
     changed = transcribe(nonlinear(2.0), method=SEPARATED, compiled="points")
-    assert len(list(tmp_path.glob("pt_*.so"))) == 2
+    assert len(list(tmp_path.glob("pt_*.so"))) == 3
+    assert [lib.stat().st_ino for lib in libs] == inodes
     a, b = first.solve(), changed.solve()
     assert a.success and b.success and not math.isclose(a.objective, b.objective)
 

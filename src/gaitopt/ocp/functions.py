@@ -14,7 +14,9 @@ the knots and the midpoints. One more function evaluates everything at the phase
 where ``E`` stacks ``[t0, tf, x0 (n), xf (n), u0 (m), uf (m)]`` of every phase in order.
 A phase with :class:`~gaitopt.ocp.problem.KnotStates` also has
 ``knot_states(x (n,1), p (n_p,1)) -> (values (d,1))``, the d states it gives at the knots
-after the first, and their positions in ``x`` (``PhaseFunction.knot_state_rows``).
+after the first, and their positions in ``x`` (``PhaseFunction.knot_state_rows``);
+:func:`knot_point` and :func:`ends_with_knot_states` compute them inside the point function
+and the ends function from the state variables (for :mod:`gaitopt.ocp.pointwise`).
 """
 
 from __future__ import annotations
@@ -204,6 +206,42 @@ def _knot_states(phase: Phase, x: ca.SX, p: ca.SX
     fn = ca.Function(c_name(f"knot_states_{phase.name}"), [x, p], [val], ["x", "p"],
                      ["values"])
     return fn, index
+
+
+def knot_point(pf: PhaseFunction) -> ca.Function:
+    """The point function of a phase with knot states at its knots after the first, on the
+    state variables: ``(x (n,1), u, p, t) -> (xdot, path, lagrange, values (d,1))`` where
+    ``values = knot_states(x, p)`` replace the rows ``knot_state_rows`` of ``x`` before the
+    point function is evaluated (they do not depend on those rows) and are returned too."""
+    assert pf.knot_states is not None
+    point = pf.point
+    x = ca.SX.sym("x", point.size1_in(0))
+    u, p, t = (ca.SX.sym(name, point.size1_in(j)) for j, name in enumerate("upt", start=1))
+    values = pf.knot_states(x, p)
+    rows = {int(r): j for j, r in enumerate(pf.knot_state_rows)}
+    placed = ca.vertcat(*[values[rows[r]] if r in rows else x[r]
+                          for r in range(int(x.shape[0]))])
+    return ca.Function(f"knot_{point.name()}", [x, u, p, t], [*point(placed, u, p, t), values],
+                       ["x", "u", "p", "t"], [*point.name_out(), "knot_states"])
+
+
+def ends_with_knot_states(fn: ca.Function, phases: Sequence[tuple[int, PhaseFunction]]
+                          ) -> ca.Function:
+    """The ends function ``fn(E, p)`` on phase ends whose final states are the state
+    variables: for each ``(start, pf)`` in ``phases``, the knot states of ``pf`` replace their
+    rows of the final state at ``E[start:start + n]`` (computed from it and ``p``) before
+    ``fn`` is evaluated."""
+    E = ca.SX.sym("E", fn.size1_in(0))
+    p = ca.SX.sym("p", fn.size1_in(1))
+    entries = [E[j] for j in range(int(E.shape[0]))]
+    for start, pf in phases:
+        assert pf.knot_states is not None
+        n = pf.point.size1_in(0)
+        values = pf.knot_states(E[start:start + n], p)
+        for j, r in enumerate(pf.knot_state_rows):
+            entries[start + int(r)] = values[j]
+    return ca.Function(f"{fn.name()}_knot_states", [E, p], fn.call([ca.vertcat(*entries), p]),
+                       fn.name_in(), fn.name_out())
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,12 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from gaitopt.ocp.functions import EndsFunction, PhaseFunction
+from gaitopt.ocp.functions import (
+    EndsFunction,
+    PhaseFunction,
+    ends_with_knot_states,
+    knot_point,
+)
 from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.mesh import Mesh
 from gaitopt.ocp.method import Method, midpoint_control
@@ -97,18 +102,30 @@ def flat(m: Any) -> Any:
     return ca.reshape(m, m.numel(), 1)
 
 
-#: How the point function of phase ``i`` is evaluated at M grid points:
-#: ``(i, point, X (n, M), U (m, M), p (n_p, 1), t (1, M)) -> (xdot (n, M), path (r, M),
-#: L (1, M))``. The default maps the point function (:func:`mapped_points`);
-#: :mod:`gaitopt.ocp.pointwise` substitutes symbols for the outputs instead.
-PointCalls = Callable[[int, ca.Function, Any, Any, Any, Any], tuple[Any, Any, Any]]
+#: How a point function of phase ``i`` is evaluated at M grid points:
+#: ``(i, point, X (n, M), U (m, M), p (n_p, 1), t (1, M)) -> its outputs, one column per
+#: point`` (``(xdot (n, M), path (r, M), L (1, M))`` for the phase's point function, and the
+#: knot states as a fourth output for :func:`~gaitopt.ocp.functions.knot_point`). The default
+#: maps the point function (:func:`mapped_points`); :mod:`gaitopt.ocp.pointwise` substitutes
+#: symbols for the outputs instead.
+PointCalls = Callable[[int, ca.Function, Any, Any, Any, Any], tuple[Any, ...]]
 
 
 def mapped_points(i: int, point: ca.Function, X: Any, U: Any, p: Any, t: Any
-                  ) -> tuple[Any, Any, Any]:
+                  ) -> tuple[Any, ...]:
     """The point function mapped over the M columns of ``X, U, t`` (one call per point)."""
-    XD, C, L = point.map(int(X.shape[1]))(X, U, p, t)
-    return XD, C, L
+    return tuple(point.map(int(X.shape[1]))(X, U, p, t))
+
+
+#: How the ends function is evaluated: ``(fn, E (size, 1), p (n_p, 1)) -> (linkages,
+#: boundary, mayer, parameter_cost, denominator)``. The default calls it
+#: (:func:`called_ends`); :mod:`gaitopt.ocp.pointwise` substitutes symbols for the outputs.
+EndsCall = Callable[[ca.Function, Any, Any], list[Any]]
+
+
+def called_ends(fn: ca.Function, E: Any, p: Any) -> list[Any]:
+    """The ends function called on ``E`` and ``p``."""
+    return list(fn(E, p))
 
 
 @dataclass(frozen=True)
@@ -155,10 +172,21 @@ def assemble(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
 def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: Layout,
                          phase_fns: tuple[PhaseFunction, ...], ends_fn: EndsFunction,
                          d_w: Array, state_scales: tuple[Array, ...], *,
-                         symbols: Any = ca.MX, point_calls: PointCalls = mapped_points
+                         symbols: Any = ca.MX, point_calls: PointCalls = mapped_points,
+                         ends_call: EndsCall = called_ends, fold_knot_states: bool = False
                          ) -> Assembly:
     """The scaled objective and constraints as expressions of ``w_hat`` (a ``symbols``
-    symbol: ``ca.MX`` or ``ca.SX``), the point functions evaluated by ``point_calls``."""
+    symbol: ``ca.MX`` or ``ca.SX``), the point functions evaluated by ``point_calls`` and the
+    ends function by ``ends_call``.
+
+    ``fold_knot_states``: the knot states of a phase with
+    :class:`~gaitopt.ocp.problem.KnotStates` are computed inside the point function of its
+    knots after the first (:func:`~gaitopt.ocp.functions.knot_point`, which also returns
+    them) and inside the ends function (:func:`~gaitopt.ocp.functions.ends_with_knot_states`),
+    from the state variables, instead of in the expressions around them: the same NLP, whose
+    point inputs are then a selection of w and whose constraints are affine in the point
+    outputs apart from the durations (what :mod:`gaitopt.ocp.pointwise` differentiates
+    cheaply)."""
     sym = symbols
     w_hat = sym.sym("w", layout.size)
     w = w_hat * ca.DM(d_w)
@@ -171,6 +199,7 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
     dependent_index: list[int] = []
     dependent_values: list[Any] = []
     t_start = sym(problem.t0)
+    folded_ends: list[tuple[int, PhaseFunction]] = []
     for i, (ph, pl, pf, tau) in enumerate(zip(problem.phases, layout.phases, phase_fns, mesh,
                                               strict=True)):
         spec = ph.duration_spec()
@@ -184,8 +213,11 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
         durations.append(T)
         Z = ca.reshape(w[pl.knot_block()], pl.stride, K)
         X, U = Z[:n, :], Z[n:, :]
-        if pf.knot_states is not None and K > 1:
-            X, index, values = _knot_states(pf, pl, X, p)
+        fold = fold_knot_states and pf.knot_states is not None and K > 1
+        if pf.knot_states is not None and K > 1 and not fold:
+            assert pf.knot_states is not None
+            X, index, values = _with_knot_states(
+                pf, pl, X, pf.knot_states.map(K - 1)(X[:, 1:], p))
             dependent_index.extend(index)
             dependent_values.append(values)
         tk = t_start + T * ca.DM(tau).T
@@ -200,14 +232,25 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
             # Separated form: one call of the point function per knot and per midpoint, all
             # in one map, at the variable midpoint states (no dynamics nested in dynamics).
             Xm = ca.reshape(w[pl.midpoint_block()], n, N)
-            XD, C, L = point_calls(i, pf.point, ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
-                                   ca.horzcat(tk, tm))
+            if fold:
+                XD, C, L, X, index, values = _folded_knots(i, pf, pl, X, U, p, tk, point_calls,
+                                                           (Xm, Um, tm))
+                dependent_index.extend(index)
+                dependent_values.append(values)
+            else:
+                XD, C, L = point_calls(i, pf.point, ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
+                                       ca.horzcat(tk, tm))
             f_m, Cm, L_m = XD[:, K:], C[:, K:], L[:, K:]
             XD, C, L = XD[:, :K], C[:, :K], L[:, :K]
             x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
             mid_defects = Xm - method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
         else:
-            XD, C, L = point_calls(i, pf.point, X, U, p, tk)
+            if fold:
+                XD, C, L, X, index, values = _folded_knots(i, pf, pl, X, U, p, tk, point_calls)
+                dependent_index.extend(index)
+                dependent_values.append(values)
+            else:
+                XD, C, L = point_calls(i, pf.point, X, U, p, tk)
             x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
             if method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0:
                 Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
@@ -235,10 +278,15 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
                      np.array([spec.lower]), np.array([spec.upper]), np.array([sc]))
         numerator = numerator + ca.sum2(method.quadrature(L[:, :-1], L[:, 1:], L_m, h))
         t_end = t_start + T
-        ends_parts += [t_start, t_end, X[:, 0], X[:, -1], U[:, 0], U[:, -1]]
+        if fold:  # the ends function computes the last knot's knot states itself
+            folded_ends.append((ends_fn.ends_offsets[i] + 2 + n, pf))
+            ends_parts += [t_start, t_end, X[:, 0], Z[:n, -1], U[:, 0], U[:, -1]]
+        else:
+            ends_parts += [t_start, t_end, X[:, 0], X[:, -1], U[:, 0], U[:, -1]]
         t_start = t_end
     E = ca.vertcat(*ends_parts)
-    link, bnd, mayer, pcost, den = ends_fn.fn(E, p)
+    ends = ends_with_knot_states(ends_fn.fn, folded_ends) if folded_ends else ends_fn.fn
+    link, bnd, mayer, pcost, den = ends_call(ends, E, p)
     for name, sl in ends_fn.linkage_rows:
         r = sl.stop - sl.start
         rows.add(name, None, "linkage", link[sl.start:sl.stop], (r,), np.zeros(r), np.zeros(r),
@@ -259,14 +307,36 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
                     ca.vertcat(*dependent_values) if dependent_values else sym(0, 1))
 
 
-def _knot_states(pf: PhaseFunction, pl: PhaseLayout, X: Any, p: Any
-                 ) -> tuple[Any, list[int], Any]:
-    """``X`` (n, K) with the phase's knot states (``pf.knot_states``) in place of their
-    variables at knots 1..K-1, the indices in w of those variables and their values (a
+def _folded_knots(i: int, pf: PhaseFunction, pl: PhaseLayout, X: Any, U: Any, p: Any,
+                  tk: Any, point_calls: PointCalls,
+                  midpoints: tuple[Any, Any, Any] | None = None
+                  ) -> tuple[Any, Any, Any, Any, list[int], Any]:
+    """The point outputs ``(xdot, path, L)`` at the K knots (then at the midpoints
+    ``(Xm, Um, tm)``, if given) of a phase with knot states, those of knots 1..K-1 from
+    :func:`~gaitopt.ocp.functions.knot_point` on the state variables ``X`` (n, K); and, as
+    :func:`_with_knot_states`, ``X`` with the knot states it returned, their indices in w
+    and their values."""
+    plain_x, plain_u, plain_t = X[:, :1], U[:, :1], tk[:, :1]
+    if midpoints is not None:
+        Xm, Um, tm = midpoints
+        plain_x, plain_u, plain_t = (ca.horzcat(plain_x, Xm), ca.horzcat(plain_u, Um),
+                                     ca.horzcat(plain_t, tm))
+    XD0, C0, L0 = point_calls(i, pf.point, plain_x, plain_u, p, plain_t)
+    XD1, C1, L1, values = point_calls(i, knot_point(pf), X[:, 1:], U[:, 1:], p, tk[:, 1:])
+    X, index, flat_values = _with_knot_states(pf, pl, X, values)
+    # Knot 0, knots 1..K-1, then the midpoints (the order of the unfolded call).
+    XD = ca.horzcat(XD0[:, :1], XD1, XD0[:, 1:])
+    C = ca.horzcat(C0[:, :1], C1, C0[:, 1:])
+    L = ca.horzcat(L0[:, :1], L1, L0[:, 1:])
+    return XD, C, L, X, index, flat_values
+
+
+def _with_knot_states(pf: PhaseFunction, pl: PhaseLayout, X: Any, values: Any
+                      ) -> tuple[Any, list[int], Any]:
+    """``X`` (n, K) with the phase's knot states ``values`` (d, K-1) in place of their
+    variables at knots 1..K-1, the indices in w of those variables and the values (a
     column, knot by knot)."""
-    assert pf.knot_states is not None
     K = int(X.shape[1])
-    values = pf.knot_states.map(K - 1)(X[:, 1:], p)
     replaced = dict(zip((int(r) for r in pf.knot_state_rows), range(values.shape[0]),
                         strict=True))
     X = ca.vertcat(*[ca.horzcat(X[r, 0], values[replaced[r], :]) if r in replaced else X[r, :]

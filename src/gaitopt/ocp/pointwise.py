@@ -3,31 +3,40 @@
 In a transcription whose constraints touch the dynamics at single grid points only (separated
 Hermite-Simpson; trapezoidal without midpoint path constraints) the scaled NLP has the form::
 
-    f(w) = F(w, Y),   g(w) = G(w, Y),   Y_j = phi(z_j(w))   at every grid point j,
+    f(w) = F(w, Y),   g(w) = G(w, Y),   Y_j = phi(z_j(w))   at every point j,
 
-where ``phi(z) -> y = (xdot (n), path (r), L (1))`` is the phase's point function of one
-point, ``z_j = (x_j, u_j, p, t_j)`` its input (a selection of w and the time, a cheap
-expression of w), and ``F``, ``G`` (the "outer" functions: defects, quadrature, linkages,
-boundary rows, scaling) are cheap expressions, linear in ``Y`` for collocation. With
-``J = blockdiag_j dphi/dz (z_j)`` (ny x nz per point), ``Dz = dz/dw``, the Lagrangian
-``L = sigma F + lambda^T G``, ``mu = dL/dY`` (ny per point), ``nu = J^T mu`` and
-``H = blockdiag_j Hess_z (mu_j^T phi)(z_j)`` (nz x nz per point), the chain rule gives::
+where ``phi(z) -> y`` is a point function of one point: the phase's
+``(x, u, p, t) -> (xdot (n), path (r), L (1))`` at its midpoints and first knot, the same with
+the phase's knot states computed inside and returned as a fourth output at its other knots
+(:func:`gaitopt.ocp.functions.knot_point`), and the constraint rows of the ends function
+(linkages, boundary; one call). ``z_j`` is its input (a selection of w and the time, a cheap
+expression of w), and ``F``, ``G`` (the "outer" functions: defects, quadrature, the
+objective's end terms, scaling) are cheap expressions, affine in ``Y`` apart from the
+durations. With ``J = blockdiag_j dphi/dz (z_j)`` (ny x nz per point), ``Dz = dz/dw``, the
+Lagrangian ``L = sigma F + lambda^T G``, ``mu = dL/dY = G_Y^T lambda + sigma F_Y`` (ny per
+point), ``nu = J^T mu`` and ``H = blockdiag_j Hess_z (mu_j^T phi)(z_j)`` (nz x nz per point),
+the chain rule gives::
 
     grad f  = F_w + Dz^T J^T F_Y                                          (nw,)
     jac g   = G_w + G_Y J Dz                                              (ng, nw)
     hess L  = L_ww + (L_wY J Dz) + (L_wY J Dz)^T + (J Dz)^T L_YY (J Dz)
               + Dz^T H Dz + Hess_w (nu^T z(w))                            (nw, nw)
 
-(IPOPT receives the upper triangle; ``f``, ``g`` and ``grad f`` are evaluated instead as one SX
-graph with the point functions inlined, since ``f`` reads only the cheap integrand of each
-point). Only ``phi``, its Jacobian and the weighted Hessian
-``Hess_z (mu^T phi)`` see the dynamics; they are functions of one point, so their size and
-the time to compile them do not depend on the mesh. They are generated as C once per point
-function and compiled into the disk cache of :mod:`gaitopt.codegen` (keyed by a hash of the
-serialized point function, which determines the C, see :func:`library_key`: a changed model
-or problem compiles anew; an unchanged one loads in milliseconds) and mapped over the grid.
-Without a C compiler the same functions run in CasADi's virtual machine. The outer functions
-are small SX functions, always interpreted.
+(IPOPT receives the upper triangle; the last term is derived only where ``z(w)`` is not
+affine, e.g. with durations that are products of parameters). ``g`` is ``G`` of the mapped
+point values; ``f`` and ``grad f`` are one SX graph with the point outputs ``f`` reads (the
+cheap integrand) inlined at every point. Only ``phi``, its Jacobian and the weighted Hessian
+``Hess_z (mu^T phi)`` see the dynamics, the event maps and the knot states; they are
+functions of one point, so their size and the time to compile them do not depend on the
+mesh. They are generated as C once per point function and compiled into the disk cache of
+:mod:`gaitopt.codegen` (keyed by a hash of the serialized point function, which determines
+the C, see :func:`library_key`: a changed model or problem compiles anew; an unchanged one
+loads in milliseconds) and mapped over the grid. Without a C compiler the same functions run
+in CasADi's virtual machine. The outer functions are SX functions, always interpreted; their
+derivatives are derived for every mesh, and keeping the dynamics, the event maps and the
+knot states out of them is what keeps that cheap (the five-link biped at 60 + 15 knots, full
+coordinates: 0.21-0.28 s per transcription against 0.53-0.57 s with the ends function and the
+knot states in them; ``docs/benchmarks-gait.md``).
 """
 
 from __future__ import annotations
@@ -171,10 +180,9 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
 
 @dataclass(frozen=True)
 class _Group:
-    """The M grid points of one phase: their inputs z (nz, M) as an SX expression of w and
-    the symbols standing for their outputs (ny, M)."""
+    """The M calls of one point function: their inputs z (nz, M) as an SX expression of w
+    and the symbols standing for their outputs (ny, M)."""
 
-    phase: int
     point: ca.Function
     z: ca.SX
     y: ca.SX
@@ -182,19 +190,41 @@ class _Group:
 
 class PointRecorder:
     """A :data:`gaitopt.ocp.nlp.PointCalls` that records the inputs of every point call
-    (SX) and returns fresh symbols for the outputs."""
+    (SX) and returns fresh symbols for the outputs; :meth:`ends` does the same for the ends
+    function (:data:`gaitopt.ocp.nlp.EndsCall`), a point function called once."""
 
     def __init__(self) -> None:
         self.groups: list[_Group] = []
 
+    def _record(self, point: ca.Function, z: ca.SX) -> list[ca.SX]:
+        """Record the calls of ``point`` on the columns of ``z`` (its inputs stacked); its
+        outputs (each a column) as symbols, one column per call."""
+        sizes = [point.size1_out(j) for j in range(point.n_out())]
+        y = ca.SX.sym(f"y{len(self.groups)}", int(sum(sizes)), int(z.shape[1]))
+        self.groups.append(_Group(point, z, y))
+        bounds = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+        return [y[int(a):int(b), :] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
     def __call__(self, i: int, point: ca.Function, X: Any, U: Any, p: Any, t: Any
-                 ) -> tuple[Any, Any, Any]:
+                 ) -> tuple[Any, ...]:
         M = int(X.shape[1])
-        z = ca.vertcat(X, U, ca.repmat(p, 1, M), t)
-        n, r = point.size1_out(0), point.size1_out(1)
-        y = ca.SX.sym(f"y{len(self.groups)}", n + r + 1, M)
-        self.groups.append(_Group(i, point, z, y))
-        return y[:n, :], y[n:n + r, :], y[n + r:, :]
+        return tuple(self._record(point, ca.vertcat(X, U, ca.repmat(p, 1, M), t)))
+
+    def ends(self, fn: ca.Function, E: Any, p: Any) -> list[Any]:
+        """The ends function's constraint rows (linkages, boundary) as symbols: their
+        derivatives, of one call, are then derived and compiled once per problem like those
+        of the phases' point functions, instead of for every mesh (their Hessian, with the
+        event maps, was the largest part of the outer one). The objective's terms (Mayer,
+        parameter cost, denominator) stay in the outer functions, which keeps the objective
+        affine in the recorded outputs (a ratio of recorded outputs has a dense Hessian
+        row)."""
+        z = ca.vertcat(E, p)
+        E_sym = ca.SX.sym("E", fn.size1_in(0))
+        p_sym = ca.SX.sym("p", fn.size1_in(1))
+        rows = ca.Function(f"{fn.name()}_rows", [E_sym, p_sym], fn.call([E_sym, p_sym])[:2],
+                           ["E", "p"], ["linkages", "boundary"])
+        link, bnd = self._record(rows, z)
+        return [link, bnd, *fn.call([E, p])[2:]]
 
 
 def _block_diagonal(mapped: ca.MX, block: ca.Sparsity, count: int) -> ca.MX:
@@ -205,6 +235,29 @@ def _block_diagonal(mapped: ca.MX, block: ca.Sparsity, count: int) -> ca.MX:
     return ca.MX(sp, mapped.nz[:])
 
 
+def _inlined_outputs(expr: ca.SX, groups: list[_Group]) -> tuple[ca.SX, ca.SX]:
+    """The point-output symbols ``expr`` reads and their values as SX expressions of w (the
+    point functions inlined, pruned to those outputs): the arguments of ``ca.substitute``
+    that make ``expr`` an expression of w alone."""
+    Y = ca.vertcat(*[ca.vec(gr.y) for gr in groups])
+    read = set(ca.jacobian_sparsity(expr, Y).get_col())
+    symbols, values = [], []
+    pos = 0
+    for gr in groups:
+        ny, M = int(gr.y.shape[0]), int(gr.z.shape[1])
+        rows = sorted({(j - pos) % ny for j in read if pos <= j < pos + ny * M})
+        pos += ny * M
+        if not rows:
+            continue
+        z = ca.SX.sym("z", gr.z.shape[0])
+        pruned = ca.Function("outputs", [z], [stacked_point(gr.point)(z)[rows]])
+        symbols.append(ca.vec(gr.y[rows, :]))
+        values.append(ca.vec(pruned.map(M)(gr.z)))
+    if not symbols:
+        return ca.SX(0, 1), ca.SX(0, 1)
+    return ca.vertcat(*symbols), ca.densify(ca.vertcat(*values))
+
+
 @dataclass(frozen=True)
 class PointwiseNlp:
     """The solver functions of an NLP with the signatures ``nlpsol`` uses:
@@ -213,6 +266,8 @@ class PointwiseNlp:
 
     functions: dict[str, ca.Function]
     compiled: bool
+    #: The point functions whose derivatives the NLP's are assembled from (one per group).
+    point_functions: tuple[ca.Function, ...] = ()
 
 
 def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
@@ -227,14 +282,25 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
     F, G = assembly.f, assembly.g
     sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
     lagrangian = sigma * F + ca.dot(lam, G)
-    L_w, L_Y = ca.gradient(lagrangian, w), ca.gradient(lagrangian, Y)
-    outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), ca.jacobian(G, Y)])
+    G_Y_sym = ca.jacobian(G, Y)
+    outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), G_Y_sym])
+    # mu = L_Y from G_Y (sparse, G is affine in Y for collocation) rather than by reverse AD
+    # of the whole Lagrangian, and L_wY as the transpose of d(mu)/dw: mu depends on few
+    # entries of w (durations, parameters), where the Jacobian of the large gradient graph
+    # L_w with respect to Y took 4x as long (60 + 15 knots, full coordinates: 0.014 s
+    # against 0.061 s).
+    L_Y = ca.mtimes(G_Y_sym.T, lam) + sigma * ca.gradient(F, Y)
     L_YY = ca.jacobian(L_Y, Y)
     outer_hess = ca.Function("outer_hess", [w, Y, sigma, lam],
-                             [ca.jacobian(L_w, w), ca.jacobian(L_w, Y), L_YY, L_Y])
+                             [ca.hessian(lagrangian, w)[0], ca.jacobian(L_Y, w).T, L_YY, L_Y])
     nu = ca.SX.sym("nu", Z.shape[0])
-    z_of_w = ca.Function("z_of_w", [w], [Z, ca.jacobian(Z, w)])
-    z_hess = ca.Function("z_hess", [w, nu], [ca.hessian(ca.dot(nu, Z), w)[0]])
+    Dz_sym = ca.jacobian(Z, w)
+    z_of_w = ca.Function("z_of_w", [w], [Z, Dz_sym])
+    # Hess_w (nu^T z(w)) vanishes where the point inputs are affine in w (fixed durations, or
+    # durations affine in the parameters): then it is not derived.
+    z_linear = not ca.depends_on(Dz_sym, w)
+    z_hess = (None if z_linear else
+              ca.Function("z_hess", [w, nu], [ca.hessian(ca.dot(nu, Z), w)[0]]))
 
     derivs = point_derivatives([gr.point for gr in groups], compile_c)
     W, P = ca.MX.sym("w", nw), ca.MX.sym("p", 0)
@@ -261,19 +327,16 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
         return ca.diagcat(*blocks)
 
     Yv = values()
-    # The objective and constraints themselves as one SX graph (the point functions inlined
-    # at every point): a few VM instructions per point, cheaper than a call of a compiled
-    # function per point, and no derivative of it is ever taken.
-    Y_sx = ca.vertcat(*[ca.vec(stacked_point(gr.point).map(int(gr.z.shape[1]))(gr.z))
-                        for gr in groups])
-    F_sx, G_sx = ca.substitute([F, G], [Y], [ca.densify(Y_sx)])
+    # The constraints from the mapped point values (compiled) and the outer function.
+    outer_g = ca.Function("outer_g", [w, Y], [G])
+    # The objective as one SX graph with the point outputs it reads (the integrand L) inlined
+    # at every point, and its gradient by reverse AD of that graph: small next to the
+    # dynamics, and smaller than the point Jacobians the chain rule would need.
+    F_sx = ca.substitute(F, *_inlined_outputs(F, groups))
     P_sx = ca.SX.sym("p", 0)
-    # The objective's gradient by reverse AD of that graph: the objective reads only the
-    # integrand L of each point (cheap next to the dynamics), so its graph and its gradient
-    # are small, smaller than the point Jacobians the chain rule would need.
     fns: dict[str, ca.Function] = {
         "nlp_f": ca.Function("nlp_f", [w, P_sx], [F_sx], ["x", "p"], ["f"]),
-        "nlp_g": ca.Function("nlp_g", [w, P_sx], [G_sx], ["x", "p"], ["g"]),
+        "nlp_g": ca.Function("nlp_g", [W, P], [outer_g(W, Yv)], ["x", "p"], ["g"]),
         "nlp_grad_f": ca.Function("nlp_grad_f", [w, P_sx], [F_sx, ca.gradient(F_sx, w)],
                                   ["x", "p"], ["f", "grad_f_x"]),
     }
@@ -295,9 +358,12 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
                                           strict=True)])
     JDh = ca.mtimes(JBh, Dz)
     cross = ca.mtimes(L_wY, JDh)
-    H = L_ww + cross + cross.T + ca.mtimes([Dz.T, HB, Dz]) + z_hess(W, ca.mtimes(JBh.T, mu))
+    H = L_ww + cross + cross.T + ca.mtimes([Dz.T, HB, Dz])
+    if z_hess is not None:
+        H = H + z_hess(W, ca.mtimes(JBh.T, mu))
     if L_YY.nnz() > 0:
         H = H + ca.mtimes([JDh.T, L_YYv, JDh])
     fns["nlp_hess_l"] = ca.Function("nlp_hess_l", [W, P, S, Lam], [ca.triu(H)],
                                     ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
-    return PointwiseNlp(fns, compiled=all(d.compiled for d in derivs))
+    return PointwiseNlp(fns, compiled=all(d.compiled for d in derivs),
+                        point_functions=tuple(gr.point for gr in groups))

@@ -135,7 +135,8 @@ class Transcription:
             recorder = pointwise.PointRecorder()
             outer = assemble_expressions(problem, METHODS[method], mesh, self.layout,
                                          self.phase_functions, ends, d_w, sx, symbols=ca.SX,
-                                         point_calls=recorder)
+                                         point_calls=recorder, ends_call=recorder.ends,
+                                         fold_knot_states=True)
             self._pointwise = pointwise.build_pointwise(outer, recorder.groups, compile_c=True)
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, False)
         else:
