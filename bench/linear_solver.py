@@ -25,10 +25,18 @@ Suites (``--suite``):
 * ``seven``: the seven-link heel-toe walk (24 + 16 knots) at 12 and 36 m/min;
 * ``sweep``: ``gaitopt sweep``'s 80 points on the paper grid (``GaitOptions.paper()``, as
   ``bench/sweep.py --grid paper``), in this process (no workers), once untimed to build the
-  transcriptions, then ``--repeat`` times per set, alternately.
+  transcriptions, then ``--repeat`` times per set, alternately;
+* ``ocp``: the engine's known-answer problems of ``bench/ocp.py`` at 40 and 160 intervals
+  (no biped: the generic OCP).
+
+Per solve the sets' times are compared as they come (the sums take the fastest of
+``--repeat`` runs); the tables per solve (small suites) and per stage take the medians. A
+set can change the iterations of the cold stages (another pivot sequence, other inertia
+corrections); ``--fine-only`` applies the sets only to grids finer than the coarse 8 + 5,
+so the cold stages run alike and the fine stages show the time per iteration.
 
 Run: ``PYTHONPATH=src python bench/linear_solver.py [--suite representative grid full seven
-sweep] [--speeds 3 12 ...] [--repeat 1] [--set NAME:KEY=VALUE[,KEY=VALUE] ...]``
+sweep] [--speeds 3 12 ...] [--repeat 1] [--fine-only] [--set NAME:KEY=VALUE[,KEY=VALUE] ...]``
 """
 
 from __future__ import annotations
@@ -41,6 +49,7 @@ import argparse  # noqa: E402
 import contextlib  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable, Iterator, Mapping  # noqa: E402
@@ -71,6 +80,8 @@ VARIANTS = {
     "plain": {"ankle": False, "impulse": False},
 }
 SPEEDS_M_MIN = tuple(float(s) for s in range(3, 61, 3))
+#: Suites of at most this many solves also get a table per solve.
+CASE_TABLE_MAX = 10
 #: Relative cost difference below which two optima count as the same.
 SAME_OPTIMUM = 1e-6
 
@@ -89,21 +100,34 @@ class Run:
     """What one solve (or sweep point) measured with one option set."""
 
     success: bool
-    costs: tuple[float, ...]  # the full-problem grids' costs, coarse to fine (or the cost)
+    #: The costs of the full-problem grids, coarse to fine: the last two are the gait's cost
+    #: (target grid) and its check grid's (the error estimate); a sweep point's cost alone.
+    costs: tuple[float, ...]
     iterations: int
     solve_s: float  # the stages' solves (IPOPT and their setup), no transcription builds
     wall_s: float
     stages: tuple[tuple[str, int, float], ...] = ()  # (stage, iterations, seconds)
 
 
+#: The most intervals a phase has on the coarse grid of the first stages (8 + 5 for the
+#: walk, at most 8 in every phase of other sequences); ``--fine-only`` applies the sets to
+#: finer grids only.
+COARSE_INTERVALS = 8
+#: Whether the option sets apply to the fine grids only (set by ``--fine-only``).
+FINE_ONLY = [False]
+
+
 @contextlib.contextmanager
 def extra_options(options: Mapping[str, Any]) -> Iterator[None]:
     """Every solver that a :class:`Transcription` creates while inside gets ``options``
     merged over the ones it is asked for (the solver cache is keyed by the merged
-    options, so each set has its own solvers)."""
+    options, so each set has its own solvers); with :data:`FINE_ONLY`, only those of
+    grids with more than :data:`COARSE_INTERVALS` intervals in a phase."""
     original = Transcription.solver
 
     def solver(self: Transcription, asked: Mapping[str, Any]) -> Any:
+        if FINE_ONLY[0] and max(m.size for m in self.mesh) <= COARSE_INTERVALS:
+            return original(self, asked)
         return original(self, merge_options(asked, options))
 
     Transcription.solver = solver  # type: ignore[method-assign,assignment]
@@ -184,10 +208,18 @@ def best(runs: list[Run]) -> Run:
 
 
 def relative_difference(a: tuple[float, ...], b: tuple[float, ...]) -> float:
-    """Largest relative difference of two solves' grid costs (NaN if they differ in count)."""
-    if len(a) != len(b) or not a:
+    """Largest relative difference of two solves' final costs: the gait's cost and its
+    check grid's (the last two grid costs; NaN if either failed)."""
+    if len(a) < 1 or len(b) < 1:
         return math.nan
-    return max(abs(x - y) / abs(x) for x, y in zip(a, b, strict=True))
+    return max(abs(x - y) / abs(x) for x, y in zip(a[-2:], b[-2:], strict=False))
+
+
+def coarse_difference(a: tuple[float, ...], b: tuple[float, ...]) -> float:
+    """Largest relative difference of the coarser grids' costs (the 8 + 5 stages; 0 if
+    none)."""
+    pairs = list(zip(a[:-2], b[:-2], strict=False)) if len(a) == len(b) else []
+    return max((abs(x - y) / abs(x) for x, y in pairs), default=0.0)
 
 
 def summary(runs: dict[str, dict[str, list[Run]]], title: str) -> None:
@@ -220,33 +252,63 @@ def summary(runs: dict[str, dict[str, list[Run]]], title: str) -> None:
                   if not best(ref[label]).success and best(runs[name][label]).success]
         finite = [d for d in diffs.values() if not math.isnan(d)]
         largest = max(finite) if finite else math.nan
-        print(f"\n{name} against {names[0]}: largest relative cost difference {largest:.1e} "
-              f"over {len(finite)} solves converged with both")
+        print(f"\n{name} against {names[0]}: largest relative difference of the final costs "
+              f"(target and check grid) {largest:.1e} over {len(finite)} solves converged "
+              "with both")
         for label, d in diffs.items():
             if not d <= SAME_OPTIMUM and not math.isnan(d):
                 print(f"  other optimum: {label}: {best(ref[label]).costs} against "
                       f"{best(runs[name][label]).costs} ({d:.1e})")
+        for label in labels:
+            d = coarse_difference(best(ref[label]).costs, best(runs[name][label]).costs)
+            if d > SAME_OPTIMUM:
+                print(f"  other optimum on the coarse grid: {label}: "
+                      f"{best(ref[label]).costs[:-2]} against "
+                      f"{best(runs[name][label]).costs[:-2]} ({d:.1e})")
         print(f"  converged with {names[0]} only: {lost or 'none'}; "
               f"with {name} only: {gained or 'none'}")
+    if len(labels) <= CASE_TABLE_MAX:
+        case_table(runs, labels)
     stage_table(runs, labels)
 
 
 def stage_table(runs: dict[str, dict[str, list[Run]]], labels: list[str]) -> None:
-    """Iterations and seconds per stage name, summed over the solves, per set."""
+    """Per stage name: iterations (of the first repetition) and the median over the
+    repetitions of its seconds, summed over the solves, per set, and the ratio of the
+    seconds to the first set's."""
     names = list(runs)
     per: dict[str, dict[str, tuple[int, float]]] = {}
     for name in names:
         for label in labels:
-            for stage, it, sec in best(runs[name][label]).stages:
+            reps = runs[name][label]
+            for stage, it, _ in reps[0].stages:
+                secs = [sec for r in reps for st, _, sec in r.stages if st == stage]
                 i0, s0 = per.setdefault(stage, {}).get(name, (0, 0.0))
-                per[stage][name] = (i0 + it, s0 + sec)
+                per[stage][name] = (i0 + it, s0 + statistics.median(secs))
     if not per:
         return
-    print("\n| stage | " + " | ".join(f"{n}: iterations, s" for n in names) + " |")
-    print("|:---|" + "---:|" * len(names))
+    print("\n| stage | " + " | ".join(f"{n}: iterations, s" for n in names) + " | "
+          + " | ".join(f"{n} / {names[0]} (s)" for n in names[1:]) + " |")
+    print("|:---|" + "---:|" * (2 * len(names) - 1))
     for stage, by in per.items():
         cells = [f"{by.get(n, (0, 0.0))[0]}, {by.get(n, (0, 0.0))[1]:.2f}" for n in names]
-        print(f"| {stage} | " + " | ".join(cells) + " |")
+        ref = by.get(names[0], (0, math.nan))[1]
+        ratios = [f"{by.get(n, (0, math.nan))[1] / ref:.2f}" for n in names[1:]]
+        print(f"| {stage} | " + " | ".join(cells + ratios) + " |")
+
+
+def case_table(runs: dict[str, dict[str, list[Run]]], labels: list[str]) -> None:
+    """Per solve: iterations and the median over the repetitions of the stages' solve
+    seconds per set, and their ratio to the first set's."""
+    names = list(runs)
+    print("\n| solve | " + " | ".join(f"{n}: iterations, solves median (s)" for n in names)
+          + " | " + " | ".join(f"{n} / {names[0]}" for n in names[1:]) + " |")
+    print("|:---|" + "---:|" * (2 * len(names) - 1))
+    for label in labels:
+        med = {n: statistics.median(r.solve_s for r in runs[n][label]) for n in names}
+        cells = [f"{runs[n][label][0].iterations}, {med[n]:.3f}" for n in names]
+        ratios = [f"{med[n] / med[names[0]]:.2f}" for n in names[1:]]
+        print(f"| {label} | " + " | ".join(cells + ratios) + " |")
 
 
 def sweep_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
@@ -300,7 +362,7 @@ def solve_suite(suite: str, sets: Mapping[str, Mapping[str, Any]],
         return new
 
     def show(label: str, name: str, run: Run) -> None:
-        cost = f"{run.costs[-1]:.6f}" if run.costs else "FAILED"
+        cost = f"{run.costs[-2 if len(run.costs) > 1 else -1]:.6f}" if run.costs else "FAILED"
         print(f"  {label:<40} {name:<12} {cost:>14} it {run.iterations:5d} "
               f"solves {run.solve_s:6.2f} s wall {run.wall_s:6.2f} s", flush=True)
 
@@ -309,7 +371,46 @@ def solve_suite(suite: str, sets: Mapping[str, Mapping[str, Any]],
     summary(runs, suite)
 
 
-SUITES = ("representative", "grid", "full", "seven", "sweep")
+def ocp_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
+    """The engine's known-answer problems (``bench/ocp.py``: five problems with analytic
+    optima and a 5-link chain) at 40 and 160 intervals, each transcribed once (MX mode) and
+    solved ``repeat`` x 2 times per set alternately (the options passed to ``solve``); per
+    problem the fastest IPOPT time, the iterations, and the objective's difference."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from ocp import PROBLEMS  # the engine benchmark's problems
+
+    from gaitopt.ocp import transcribe
+
+    names = list(sets)
+    totals = dict.fromkeys(names, 0.0)
+    print("\n| problem | intervals | " + " | ".join(f"{n}: s, iterations" for n in names)
+          + " | " + " | ".join(f"{n} / {names[0]}" for n in names[1:])
+          + " | largest relative objective difference |")
+    print("|:---|---:|" + "---:|" * (2 * len(names)))
+    for problem, (build, guess, _) in PROBLEMS.items():
+        for n in (40, 160):
+            tr = transcribe(build(n), expand=False, compiled=None)
+            fastest: dict[str, tuple[float, int, float, bool]] = {}
+            for k in range(2 * repeat):
+                for name in (names if k % 2 == 0 else names[::-1]):
+                    res = tr.solve(guess, options=sets[name])
+                    t = float(res.times["total"])
+                    if name not in fastest or t < fastest[name][0]:
+                        fastest[name] = (t, res.iterations, res.objective, res.success)
+            ref = fastest[names[0]]
+            for name in names:
+                totals[name] += fastest[name][0]
+            diff = max(abs(fastest[m][2] - ref[2]) / max(abs(ref[2]), 1e-300) for m in names)
+            cells = [f"{fastest[m][0]:.3f}, {fastest[m][1]}"
+                     + ("" if fastest[m][3] else " FAILED") for m in names]
+            ratios = [f"{fastest[m][0] / ref[0]:.2f}" for m in names[1:]]
+            print(f"| {problem} | {n} | " + " | ".join(cells + ratios) + f" | {diff:.1e} |",
+                  flush=True)
+    print("\nsum of the fastest solves (s): " + ", ".join(
+        f"{name} {totals[name]:.3f} ({totals[name] / totals[names[0]]:.3f})" for name in names))
+
+
+SUITES = ("representative", "grid", "full", "seven", "sweep", "ocp")
 
 
 def parse_set(text: str) -> tuple[str, dict[str, Any]]:
@@ -338,11 +439,16 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--suite", nargs="+", choices=SUITES, default=["representative"])
     parser.add_argument("--speeds", type=float, nargs="+", help="m/min (grid, full, seven)")
     parser.add_argument("--repeat", type=int, default=1,
-                        help="solves per case and set (the fastest counts)")
+                        help="solves per case and set (the sums count the fastest, the "
+                             "tables per solve and per stage the medians)")
     parser.add_argument("--set", dest="sets", type=parse_set, action="append",
                         help="an option set NAME:KEY=VALUE[,...] (repeat; the first is the "
                              "reference; default: mumps_permuting_scaling 7 and 0)")
+    parser.add_argument("--fine-only", action="store_true",
+                        help="apply the sets only to grids finer than the coarse 8+5 (the "
+                             "coarse stages then run alike)")
     args = parser.parse_args(argv)
+    FINE_ONLY[0] = args.fine_only
     if args.repeat < 1:
         parser.error(f"--repeat must be >= 1, got {args.repeat}")
     sets = dict(args.sets) if args.sets else DEFAULT_SETS
@@ -350,10 +456,14 @@ def main(argv: list[str] | None = None) -> None:
         parser.error("--set: give at least two option sets")
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     print(f"{time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC, load average {load} "
-          f"({os.cpu_count()} cores); option sets: {sets}")
+          f"({os.cpu_count()} cores); option sets: {sets}"
+          + (" on the fine grids only" if args.fine_only else ""))
     for suite in args.suite:
         if suite == "sweep":
             sweep_suite(sets, args.repeat)
+            continue
+        if suite == "ocp":
+            ocp_suite(sets, args.repeat)
             continue
         solve_suite(suite, sets, args.speeds, args.repeat)
     print(f"\nload average after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
