@@ -4,8 +4,9 @@ Solves the same gaits with two (or more) sets of IPOPT options in one process, a
 (the order flips from case to case, so both sets see the same machine load), and prints per
 case the wall time, the time in the stages' solves, the IPOPT iterations and the cost, then
 per suite the sums and medians, their ratios to the first set, the largest relative cost
-difference (over every full-problem grid of a solve: target and check grid) and any point
-that converged with the first set and failed with another.
+difference (the gait's cost and its check grid's; other optima of the coarse 8 + 5 stages
+are listed apart) and any point that converged with the first set and failed with
+another.
 
 The options are merged over every solver of every stage (a wrapper of
 :meth:`gaitopt.ocp.Transcription.solver`), over the defaults, so both sets are explicit
@@ -36,7 +37,8 @@ corrections); ``--fine-only`` applies the sets only to grids finer than the coar
 so the cold stages run alike and the fine stages show the time per iteration.
 
 Run: ``PYTHONPATH=src python bench/linear_solver.py [--suite representative grid full seven
-sweep] [--speeds 3 12 ...] [--repeat 1] [--fine-only] [--set NAME:KEY=VALUE[,KEY=VALUE] ...]``
+sweep ocp] [--speeds 3 12 ...] [--repeat 1] [--only TEXT] [--fine-only]
+[--set NAME:KEY=VALUE[,KEY=VALUE] ...]``
 """
 
 from __future__ import annotations
@@ -348,11 +350,13 @@ def sweep_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
 
 
 def solve_suite(suite: str, sets: Mapping[str, Mapping[str, Any]],
-                speeds: list[float] | None, repeat: int) -> None:
+                speeds: list[float] | None, repeat: int, only: str | None = None) -> None:
     """The solves of ``suite``, each set alternately; one line per solve, then the summary.
     The first solve of each problem structure (the options but the speed) runs once untimed
-    first."""
-    cases = {c.label: c for c in cases_of(suite, speeds)}
+    first. ``only``: the solves whose label contains it."""
+    cases = {c.label: c for c in cases_of(suite, speeds) if only is None or only in c.label}
+    if not cases:
+        raise SystemExit(f"--only {only!r}: no solve of suite {suite} has it in its label")
     seen: set[str] = set()
 
     def first_of_structure(label: str) -> bool:
@@ -444,6 +448,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--set", dest="sets", type=parse_set, action="append",
                         help="an option set NAME:KEY=VALUE[,...] (repeat; the first is the "
                              "reference; default: mumps_permuting_scaling 7 and 0)")
+    parser.add_argument("--only", help="only the solves whose label contains this text, "
+                                       "e.g. 'uniform 40+10' (grid, full, seven, "
+                                       "representative)")
     parser.add_argument("--fine-only", action="store_true",
                         help="apply the sets only to grids finer than the coarse 8+5 (the "
                              "coarse stages then run alike)")
@@ -465,7 +472,7 @@ def main(argv: list[str] | None = None) -> None:
         if suite == "ocp":
             ocp_suite(sets, args.repeat)
             continue
-        solve_suite(suite, sets, args.speeds, args.repeat)
+        solve_suite(suite, sets, args.speeds, args.repeat, args.only)
     print(f"\nload average after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
