@@ -111,10 +111,10 @@ class Run:
     stages: tuple[tuple[str, int, float], ...] = ()  # (stage, iterations, seconds)
 
 
-#: The most intervals a phase has on the coarse grid of the first stages (8 + 5 for the
-#: walk, at most 8 in every phase of other sequences); ``--fine-only`` applies the sets to
-#: finer grids only.
-COARSE_INTERVALS = 8
+#: The most knots (mesh points, intervals + 1) a phase has on the coarse grid of the first
+#: stages (8 + 5 for the walk, at most 8 in every phase of other sequences);
+#: ``--fine-only`` applies the sets to finer grids only.
+COARSE_KNOTS = 8
 #: Whether the option sets apply to the fine grids only (set by ``--fine-only``).
 FINE_ONLY = [False]
 
@@ -124,11 +124,11 @@ def extra_options(options: Mapping[str, Any]) -> Iterator[None]:
     """Every solver that a :class:`Transcription` creates while inside gets ``options``
     merged over the ones it is asked for (the solver cache is keyed by the merged
     options, so each set has its own solvers); with :data:`FINE_ONLY`, only those of
-    grids with more than :data:`COARSE_INTERVALS` intervals in a phase."""
+    grids with more than :data:`COARSE_KNOTS` knots in a phase."""
     original = Transcription.solver
 
     def solver(self: Transcription, asked: Mapping[str, Any]) -> Any:
-        if FINE_ONLY[0] and max(m.size for m in self.mesh) <= COARSE_INTERVALS:
+        if FINE_ONLY[0] and max(m.size for m in self.mesh) <= COARSE_KNOTS:
             return original(self, asked)
         return original(self, merge_options(asked, options))
 
