@@ -24,9 +24,9 @@ Suites (``--suite``):
 * ``full``: the same speeds in full coordinates for the two ankle variants (with impulse);
   ``--speeds`` narrows it;
 * ``seven``: the seven-link heel-toe walk (24 + 16 knots) at 12 and 36 m/min;
-* ``sweep``: ``gaitopt sweep``'s 80 points on the paper grid (``GaitOptions.paper()``, as
-  ``bench/sweep.py --grid paper``), in this process (no workers), once untimed to build the
-  transcriptions, then ``--repeat`` times per set, alternately;
+* ``sweep``: ``gaitopt sweep``'s 80 points on the paper grid (``GaitOptions.paper()`` in
+  the separated form, as ``bench/sweep.py --grid paper``), in this process (no workers),
+  once untimed to build the transcriptions, then ``--repeat`` times per set, alternately;
 * ``ocp``: the engine's known-answer problems of ``bench/ocp.py`` at 40 and 160 intervals
   (no biped: the generic OCP).
 
@@ -74,6 +74,9 @@ DEFAULT_SETS: dict[str, dict[str, Any]] = {
     "scaling 7": {"ipopt.mumps_permuting_scaling": 7},
     "scaling 0": {"ipopt.mumps_permuting_scaling": 0},
 }
+#: The sweep suite's transcription: ``bench/sweep.py``'s default (the paper's grid and
+#: control model, solved in the separated form).
+SWEEP_TRANSCRIPTION = "hermite-simpson-separated"
 #: The convergence grid's variants (``bench/gait_grid.py``): name -> GaitOptions fields.
 VARIANTS = {
     "ankle+impulse": {"ankle": True, "impulse": True},
@@ -317,7 +320,8 @@ def sweep_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
     """``gaitopt sweep``'s paper grid in this process: once untimed (builds), then each set
     ``repeat`` times alternately; per point the cost and iterations, in all the times."""
     spec = SweepSpec(model=load_model("five-link"), speeds=tuple(s / 60 for s in SPEEDS_M_MIN),
-                     variants=SWEEP_VARIANTS, free_speed=False, base=GaitOptions.paper())
+                     variants=SWEEP_VARIANTS, free_speed=False,
+                     base=GaitOptions.paper(transcription=SWEEP_TRANSCRIPTION))
 
     def once() -> tuple[float, dict[str, Run]]:
         with tempfile.TemporaryDirectory(prefix="gaitopt-bench-linear-") as tmp:
