@@ -1,0 +1,83 @@
+"""bench/linear_solver.py: its option sets reach IPOPT (and only while asked), and its
+command-line sets parse or fail with a clear message. The figures are in
+docs/benchmarks-gait.md, section "MUMPS scaling"."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+from problems import double_integrator
+
+from gaitopt.ocp import Transcription, transcribe
+
+BENCH = Path(__file__).resolve().parents[2] / "bench"
+
+
+@pytest.fixture(scope="module")
+def bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("bench_linear_solver",
+                                                  BENCH / "linear_solver.py")
+    assert spec and spec.loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+#: An option value IPOPT refuses (the permuting scaling is 0..7): a solve fails if, and only
+#: if, the option reached its solver.
+INVALID = {"ipopt.mumps_permuting_scaling": 99}
+
+
+def test_sets_reach_every_solver_and_only_inside(bench: ModuleType) -> None:
+    tr = transcribe(double_integrator(4))
+    original = Transcription.solver
+    assert tr.solve().success
+    with bench.extra_options(INVALID):
+        inside = tr.solve()
+        # another solver of the same transcription (other options) gets the set too
+        other = tr.solve(options={"ipopt.tol": 1e-6})
+    assert not inside.success and not other.success
+    assert Transcription.solver is original
+    after = tr.solve()
+    assert after.success and abs(after.objective - 12.0) < 1e-8
+
+
+def test_valid_sets_give_the_same_optimum(bench: ModuleType) -> None:
+    tr = transcribe(double_integrator(6))
+    objectives = []
+    for options in bench.DEFAULT_SETS.values():
+        with bench.extra_options(options):
+            res = tr.solve()
+        assert res.success
+        objectives.append(res.objective)
+    assert abs(objectives[0] - 12.0) < 1e-8 and abs(objectives[1] - objectives[0]) < 1e-10
+
+
+def test_fine_only_leaves_coarse_grids_alone(bench: ModuleType) -> None:
+    # double_integrator(n): n intervals, n + 1 knots
+    coarse = transcribe(double_integrator(bench.COARSE_KNOTS - 1))
+    fine = transcribe(double_integrator(bench.COARSE_KNOTS))
+    bench.FINE_ONLY[0] = True
+    try:
+        with bench.extra_options(INVALID):
+            assert coarse.solve().success
+            assert not fine.solve().success
+    finally:
+        bench.FINE_ONLY[0] = False
+
+
+def test_parse_set(bench: ModuleType) -> None:
+    assert bench.parse_set("off:mumps_permuting_scaling=0,ipopt.mumps_pivtol=1e-8") == (
+        "off", {"ipopt.mumps_permuting_scaling": 0, "ipopt.mumps_pivtol": 1e-8})
+    assert bench.parse_set("as is:") == ("as is", {})
+    assert bench.parse_set("order:mumps_pivot_order=amd") == (
+        "order", {"ipopt.mumps_pivot_order": "amd"})
+    for bad in ("no colon", ":x=1", "a:x"):
+        with pytest.raises(argparse.ArgumentTypeError, match="--set"):
+            bench.parse_set(bad)
