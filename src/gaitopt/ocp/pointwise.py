@@ -35,7 +35,7 @@ loads in milliseconds) and mapped over the grid. Without a C compiler the same f
 in CasADi's virtual machine. The outer functions are SX functions, always interpreted; their
 derivatives are derived for every mesh, and keeping the dynamics, the event maps and the
 knot states out of them is what keeps that cheap (the five-link biped at 60 + 15 knots, full
-coordinates: 0.21-0.28 s per transcription against 0.53-0.57 s with the ends function and the
+coordinates: 0.19-0.28 s per transcription against 0.49-0.57 s with the ends function and the
 knot states in them; ``docs/benchmarks-gait.md``).
 """
 
