@@ -103,6 +103,7 @@ from gaitopt.gait.stages import (
     RELEASES,
     check_grid_options,
     coarse_knots,
+    fine_grid_options,
     fine_stage_options,
     held_ankles,
     held_bounds,
@@ -112,6 +113,7 @@ from gaitopt.gait.transcriptions import (
     Grid,
     evaluation_mode,
     grid_knots,
+    is_mesh,
     target_grid,
     transcription_for,
     warm_start_grid,
@@ -185,6 +187,8 @@ class _Run:
         (another cost, say)."""
         tr = transcription_for(self.model, problem or self.options, knots,
                                compiled=self.compiled)
+        if is_mesh(knots) or tuple(knots) != coarse_knots(self.options):
+            solver_options = {**fine_grid_options(self.options), **(solver_options or {})}
         start = time.perf_counter()
         nlp_bounds = with_step_time(stage_bounds(tr, relax, self.options), self.options)
         if hold_ankles:

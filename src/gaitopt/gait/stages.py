@@ -81,6 +81,27 @@ def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
     return dict(FINE_STAGE_OPTIONS)
 
 
+#: IPOPT options of every stage on a grid finer than the coarse one (the target grid and its
+#: release, the check grid, mesh refinement, a warm start) of the two-phase walk in full
+#: coordinates: MUMPS without its permuting scaling (the MC64 matching, which MUMPS otherwise
+#: chooses itself and applies at every factorization). Measured by bench/linear_solver.py
+#: (docs/benchmarks-gait.md, "MUMPS scaling"): on these stages the same iterations to the same
+#: optima (40/40 points, 3-60 m/min, both ankle variants, relative cost differences below
+#: 3e-13), each iteration cheaper: the target grid 0.92x, the check grid 0.88x on the default
+#: 16 + 6 grid, 0.81x on uniform 40 + 10. Not elsewhere: the coarse stages change their path
+#: with it (for better or worse), the reduced formulation and the heel-toe walk gain nothing,
+#: and on the reduced walk's fine stages two of the 80 convergence-grid points then failed.
+FULL_WALK_FINE_GRID_OPTIONS: dict[str, Any] = {"ipopt.mumps_permuting_scaling": 0}
+
+
+def fine_grid_options(options: GaitOptions) -> dict[str, Any]:
+    """The IPOPT options of the stages on grids finer than the coarse one:
+    :data:`FULL_WALK_FINE_GRID_OPTIONS` for the walk in full coordinates, else none."""
+    if options.formulation == "full" and sequence_kind(options) == "walk":
+        return dict(FULL_WALK_FINE_GRID_OPTIONS)
+    return {}
+
+
 def sequence_kind(options: GaitOptions) -> str:
     """The contact sequence of ``options`` by kind, which stage settings are chosen by: its
     ``gait`` (``walk``, ``run``, ``heel-toe``), or ``"sequence"`` for a given
