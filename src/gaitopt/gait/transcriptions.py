@@ -86,6 +86,19 @@ class NlpStructure:
 
 
 _CACHE: dict[NlpStructure, Transcription] = {}
+#: How many large transcriptions evaluated as one expanded SX graph (the compressed form:
+#: the exact Hessian of the whole mesh is derived) this process keeps, the least recently
+#: used going first. Such a transcription of the five-link walk in full coordinates on
+#: 40 + 10 knots takes 1.28 GB once its solver is built (0.4-0.6 GB on 16 + 6 knots), where a
+#: point-wise one takes 5-16 MB: a process that solved several variants kept them all. The
+#: four variants of tests/gait/test_full_coordinates.py's fine-grid comparison (compressed,
+#: 40 + 10, checked on 60 + 15) peaked at 13.0 GB, with this bound at 5.8 GB, in the same
+#: 207 s. Smaller ones (:data:`LARGE_EXPANDED`) and point-wise ones are all kept: sweeps
+#: reuse them point after point.
+MAX_LARGE_EXPANDED = 2
+#: The NLP size (variables) from which an expanded transcription counts as large: the
+#: paper's 8 + 5 grid has 183-481, a 16 + 6 grid 300-800 (reduced, full).
+LARGE_EXPANDED = 1000
 
 
 def clear_cache() -> None:
@@ -182,7 +195,9 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
     from the disk cache (:func:`functions_file`), or are built and saved there."""
     compiled = evaluation_mode(options, compiled)
     key = NlpStructure.of(model, options, knots, compiled)
-    if key not in _CACHE:
+    if key in _CACHE:
+        _CACHE[key] = _CACHE.pop(key)  # the most recently used last
+    else:
         same = [tr.functions for k, tr in _CACHE.items()
                 if dataclasses.replace(k, grid=key.grid) == key]
         path = functions_file(key)
@@ -200,7 +215,17 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
             build_solver=False, functions=functions)
         if functions is None:
             save_functions(path, _CACHE[key].functions)
+        _forget_large_expanded()
     return _CACHE[key]
+
+
+def _forget_large_expanded() -> None:
+    """Drop the least recently used large expanded transcriptions beyond
+    :data:`MAX_LARGE_EXPANDED` (a caller still holding one keeps it alive)."""
+    large = [k for k, tr in _CACHE.items()
+             if k.compiled != "points" and tr.layout.size >= LARGE_EXPANDED]
+    for k in large[:max(0, len(large) - MAX_LARGE_EXPANDED)]:
+        del _CACHE[k]
 
 
 def cosine_knots(n: int) -> np.ndarray:
