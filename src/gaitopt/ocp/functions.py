@@ -208,6 +208,14 @@ def _knot_states(phase: Phase, x: ca.SX, p: ca.SX
     return fn, index
 
 
+def with_knot_states(pf: PhaseFunction, x: Any, values: Any) -> Any:
+    """``x`` (n, M) with its rows ``pf.knot_state_rows`` replaced by the knot states
+    ``values`` (d, M), column by column (SX or MX)."""
+    rows = {int(r): j for j, r in enumerate(pf.knot_state_rows)}
+    return ca.vertcat(*[values[rows[r], :] if r in rows else x[r, :]
+                        for r in range(int(x.shape[0]))])
+
+
 def knot_point(pf: PhaseFunction) -> ca.Function:
     """The point function of a phase with knot states at its knots after the first, on the
     state variables: ``(x (n,1), u, p, t) -> (xdot, path, lagrange, values (d,1))`` where
@@ -218,9 +226,7 @@ def knot_point(pf: PhaseFunction) -> ca.Function:
     x = ca.SX.sym("x", point.size1_in(0))
     u, p, t = (ca.SX.sym(name, point.size1_in(j)) for j, name in enumerate("upt", start=1))
     values = pf.knot_states(x, p)
-    rows = {int(r): j for j, r in enumerate(pf.knot_state_rows)}
-    placed = ca.vertcat(*[values[rows[r]] if r in rows else x[r]
-                          for r in range(int(x.shape[0]))])
+    placed = with_knot_states(pf, x, values)
     return ca.Function(f"knot_{point.name()}", [x, u, p, t], [*point(placed, u, p, t), values],
                        ["x", "u", "p", "t"], [*point.name_out(), "knot_states"])
 
@@ -233,14 +239,13 @@ def ends_with_knot_states(fn: ca.Function, phases: Sequence[tuple[int, PhaseFunc
     ``fn`` is evaluated."""
     E = ca.SX.sym("E", fn.size1_in(0))
     p = ca.SX.sym("p", fn.size1_in(1))
-    entries = [E[j] for j in range(int(E.shape[0]))]
+    placed = E
     for start, pf in phases:
         assert pf.knot_states is not None
-        n = pf.point.size1_in(0)
-        values = pf.knot_states(E[start:start + n], p)
-        for j, r in enumerate(pf.knot_state_rows):
-            entries[start + int(r)] = values[j]
-    return ca.Function(f"{fn.name()}_knot_states", [E, p], fn.call([ca.vertcat(*entries), p]),
+        xf = E[start:start + pf.point.size1_in(0)]
+        placed = ca.vertcat(placed[:start], with_knot_states(pf, xf, pf.knot_states(xf, p)),
+                            placed[start + xf.shape[0]:])
+    return ca.Function(f"{fn.name()}_knot_states", [E, p], fn.call([placed, p]),
                        fn.name_in(), fn.name_out())
 
 

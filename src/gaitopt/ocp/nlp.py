@@ -32,6 +32,7 @@ from gaitopt.ocp.functions import (
     PhaseFunction,
     ends_with_knot_states,
     knot_point,
+    with_knot_states,
 )
 from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.mesh import Mesh
@@ -337,10 +338,7 @@ def _with_knot_states(pf: PhaseFunction, pl: PhaseLayout, X: Any, values: Any
     variables at knots 1..K-1, the indices in w of those variables and the values (a
     column, knot by knot)."""
     K = int(X.shape[1])
-    replaced = dict(zip((int(r) for r in pf.knot_state_rows), range(values.shape[0]),
-                        strict=True))
-    X = ca.vertcat(*[ca.horzcat(X[r, 0], values[replaced[r], :]) if r in replaced else X[r, :]
-                     for r in range(int(X.shape[0]))])
+    X = ca.horzcat(X[:, :1], with_knot_states(pf, X[:, 1:], values))
     names = [pl.states[int(r)] for r in pf.knot_state_rows]
     index = [pl.index("state", name, k) for k in range(1, K) for name in names]
     return X, index, ca.vec(values)
