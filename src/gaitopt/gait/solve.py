@@ -107,6 +107,7 @@ from gaitopt.gait.stages import (
     fine_stage_options,
     held_ankles,
     held_bounds,
+    held_stage_options,
     sequence_kind,
 )
 from gaitopt.gait.transcriptions import (
@@ -385,17 +386,18 @@ class _Run:
 
     def on_grid(self, name: str, grid: Grid, result: Result, move: str = "target") -> Result:
         """Solve on ``grid`` from ``result`` (another grid; ``move`` as in
-        :data:`REGRID_MOVES`): the step length and speed held at ``result``'s, then (stage
-        ``name, all free``) released."""
+        :data:`REGRID_MOVES`): the step length and speed held at ``result``'s (to a looser
+        tolerance when a release follows, :func:`~gaitopt.gait.stages.held_stage_options`),
+        then (stage ``name, all free``) released."""
         o = self.options
         held = dict(parameter_bounds(o))
         for key in ("step_length", "speed"):
             held[key] = (result.parameters[key], result.parameters[key])
-        fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result, move), held,
-                          solver_options={**PRIMAL_WARM_OPTIONS, **fine_stage_options(o)},
-                          warm_start_options=REGRID_OPTIONS)
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
+        fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result, move), held,
+                          solver_options=held_stage_options(o, released=not all_fixed),
+                          warm_start_options=REGRID_OPTIONS)
         if not fine.success or all_fixed:
             return fine
         free = self.stage(f"{name}, all free", grid, Relaxation(), fine,

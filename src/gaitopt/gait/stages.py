@@ -49,6 +49,19 @@ ENFORCED_CONTACT_OPTIONS = {"ipopt.mu_init": 1e-4}
 #: warm-start options apply instead.)
 PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
                        "ipopt.bound_frac": 1e-6}
+#: IPOPT's tolerance for a held stage on a finer grid (the step length and speed held at the
+#: coarser solution's) when its release follows (stage ``..., all free``): the held stage is
+#: only the release's start, and the release starts its barrier at 1e-6 (the
+#: transcription's warm-start options). Solved to the final tolerance, its point (at a
+#: barrier of 1e-8) was first moved back to the 1e-6 barrier's central path by the release,
+#: in 5-12 iterations; at 1e-5 IPOPT stops once the 1e-6 barrier problem is solved. The
+#: five-link walk, 2 variants x 7 speeds (3-60 m/min): the fine stages took 698 instead of
+#: 837 iterations in full coordinates on 40 + 10 knots (7.8 instead of 9.0 s) and 741
+#: instead of 874 in the reduced formulation on the default grid, to the same optima
+#: (largest relative difference 8e-11; ``docs/benchmarks-gait.md``). A user's ``tol``
+#: above it applies instead, and a held stage that is the answer (speed and step length or
+#: step time given) keeps the user's.
+HELD_STAGE_TOL = 1e-5
 #: IPOPT options of the check-grid stage (the cost error estimate's finer grid), started
 #: from the target grid's optimum without multipliers: that start is closer to the check
 #: grid's optimum than a coarse solution is to the target grid's, so the barrier starts at
@@ -107,6 +120,16 @@ def sequence_kind(options: GaitOptions) -> str:
     ``gait`` (``walk``, ``run``, ``heel-toe``), or ``"sequence"`` for a given
     ``contact_sequence``."""
     return options.gait if options.contact_sequence is None else "sequence"
+
+
+def held_stage_options(options: GaitOptions, released: bool) -> dict[str, Any]:
+    """The IPOPT options of a held stage on a finer grid: :data:`PRIMAL_WARM_OPTIONS` with
+    :func:`fine_stage_options` merged over them and, when its release follows
+    (``released``), the tolerance :data:`HELD_STAGE_TOL` (or the user's, if looser)."""
+    out = {**PRIMAL_WARM_OPTIONS, **fine_stage_options(options)}
+    if released:
+        out["ipopt.tol"] = max(options.tol, HELD_STAGE_TOL)
+    return out
 
 
 def check_grid_options(options: GaitOptions) -> dict[str, Any]:

@@ -1,0 +1,64 @@
+"""The held stage on a finer grid (step length and speed held at the coarse solution's) is
+solved to :data:`gaitopt.gait.stages.HELD_STAGE_TOL` when its release follows: it is only the
+release's start. The answer must not change, and a held stage that is the answer keeps the
+user's tolerance."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from gaitopt.gait import stages
+from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.stages import HELD_STAGE_TOL, held_stage_options
+from gaitopt.ocp import Transcription
+from gaitopt.robot import load_model
+
+COARSE = (8, 5)
+
+
+def _fine_tolerances(monkeypatch: pytest.MonkeyPatch, options: GaitOptions
+                     ) -> tuple[list[Any], float]:
+    """Solve ``options``; the ``ipopt.tol`` given to each IPOPT call on a grid finer than the
+    coarse one, in order (None: the transcription's, the user's ``tol``), and the answer's
+    cost."""
+    given: list[Any] = []
+    original = Transcription.solve
+
+    def recording(self: Transcription, *args: Any, **kwargs: Any) -> Any:
+        if tuple(m.size for m in self.mesh) != COARSE:
+            given.append((kwargs.get("options") or {}).get("ipopt.tol"))
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(Transcription, "solve", recording)
+    solution = solve_gait_solution(load_model("five-link"), options)
+    assert solution.success
+    return given, solution.result.objective
+
+
+def test_the_held_stage_before_a_release_stops_early_and_the_answer_is_unchanged(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    options = GaitOptions(knots=(16, 6), speed=0.4)
+    given, cost = _fine_tolerances(monkeypatch, options)
+    # the held target grid, its release, the check grid
+    assert given == [HELD_STAGE_TOL, None, None]
+    # the same solve with the held stage solved to the user's tolerance
+    monkeypatch.setattr(stages, "HELD_STAGE_TOL", 0.0)
+    strict, strict_cost = _fine_tolerances(monkeypatch, options)
+    assert strict == [options.tol, None, None]
+    assert cost == pytest.approx(strict_cost, rel=1e-8)
+
+
+def test_a_held_stage_that_is_the_answer_keeps_the_users_tolerance(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    given, _ = _fine_tolerances(monkeypatch, GaitOptions(knots=(16, 6), speed=0.4,
+                                                         step_length=0.3))
+    assert given == [None, None]  # the target grid (nothing to release), the check grid
+
+
+def test_a_looser_user_tolerance_wins() -> None:
+    assert held_stage_options(GaitOptions(tol=1e-4), released=True)["ipopt.tol"] == 1e-4
+    assert held_stage_options(GaitOptions(), released=True)["ipopt.tol"] == HELD_STAGE_TOL
+    assert "ipopt.tol" not in held_stage_options(GaitOptions(), released=False)
