@@ -65,14 +65,20 @@ HELD_STAGE_TOL = 1e-5
 #: IPOPT options of the check-grid stage (the cost error estimate's finer grid), started
 #: from the target grid's optimum without multipliers: that start is closer to the check
 #: grid's optimum than a coarse solution is to the target grid's, so the barrier starts at
-#: 1e-6 instead of 1e-4. Over the 80 default solves of the convergence grid (four variants,
+#: 1e-8, the barrier the target grid's solve ended at. From 1e-6 IPOPT first moved the
+#: start onto the 1e-6 central path and back, in 5-12 iterations: 2 variants x 7 speeds
+#: (3-60 m/min), the check stages took 155 instead of 216 iterations in full coordinates
+#: on 40 + 10 knots (checked on 60 + 15) and 214 instead of 233 in the reduced formulation
+#: on the default grid; the check costs moved by at most 2e-7 relative, within the solve's
+#: own accuracy (1e-6 against a solve to tol 1e-11, from either start). Earlier, 1e-6
+#: against IPOPT's 1e-4: over the 80 default solves of the convergence grid (four variants,
 #: 3-60 m/min, cosine 16 + 6 knots checked on 24 + 8) the check stages took 1,327 instead of
 #: 1,962 iterations to the same optima (largest relative difference 1.6e-9); in full
 #: coordinates (two variants at 3/12/24/48 m/min) 126 instead of 178. Only for the walk:
 #: on the seven-link heel-toe walk (24 + 16 knots checked on 36 + 24) at 36 m/min it took 35
 #: instead of 63 iterations but to another local optimum, 0.26 % dearer (2867.92 against
 #: 2860.47), which would change the error estimate (at 12 m/min: 193 against 188, the same).
-CHECK_GRID_OPTIONS = {**PRIMAL_WARM_OPTIONS, "ipopt.mu_init": 1e-6}
+CHECK_GRID_OPTIONS = {**PRIMAL_WARM_OPTIONS, "ipopt.mu_init": 1e-8}
 #: The Hessian of the target-grid stages of a cold solve: a limited-memory quasi-Newton
 #: approximation (as SNOPT's, which the paper used). Deriving the exact Hessian of the
 #: expanded NLP costs far more than these stages: at 40 + 10 knots 9-12 s against 2 s for

@@ -1,7 +1,12 @@
-"""The held stage on a finer grid (step length and speed held at the coarse solution's) is
-solved to :data:`gaitopt.gait.stages.HELD_STAGE_TOL` when its release follows: it is only the
-release's start. The answer must not change, and a held stage that is the answer keeps the
-user's tolerance."""
+"""How the stages on finer grids start and stop (docs/walking.md, section "Stages"):
+
+* the held stage (step length and speed held at the coarse solution's) is solved to
+  :data:`gaitopt.gait.stages.HELD_STAGE_TOL` when its release follows: it is only the
+  release's start. The answer must not change, and a held stage that is the answer keeps
+  the user's tolerance;
+* the walk's check grid starts its barrier at 1e-8
+  (:data:`~gaitopt.gait.stages.CHECK_GRID_OPTIONS`): its cost must be the one a start at
+  1e-6 reaches, within the solve's accuracy."""
 
 from __future__ import annotations
 
@@ -12,7 +17,8 @@ import pytest
 from gaitopt.gait import stages
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.stages import HELD_STAGE_TOL, held_stage_options
+from gaitopt.gait.solution import WalkingSolution
+from gaitopt.gait.stages import CHECK_GRID_OPTIONS, HELD_STAGE_TOL, held_stage_options
 from gaitopt.ocp import Transcription
 from gaitopt.robot import load_model
 
@@ -24,18 +30,26 @@ def _fine_tolerances(monkeypatch: pytest.MonkeyPatch, options: GaitOptions
     """Solve ``options``; the ``ipopt.tol`` given to each IPOPT call on a grid finer than the
     coarse one, in order (None: the transcription's, the user's ``tol``), and the answer's
     cost."""
+    given, solution = _fine_calls(monkeypatch, options, "ipopt.tol")
+    return given, solution.result.objective
+
+
+def _fine_calls(monkeypatch: pytest.MonkeyPatch, options: GaitOptions, key: str
+                ) -> tuple[list[Any], WalkingSolution]:
+    """Solve ``options``; the option ``key`` given to each IPOPT call on a grid finer than the
+    coarse one, in order (None: not given), and the solution."""
     given: list[Any] = []
     original = Transcription.solve
 
     def recording(self: Transcription, *args: Any, **kwargs: Any) -> Any:
         if tuple(m.size for m in self.mesh) != COARSE:
-            given.append((kwargs.get("options") or {}).get("ipopt.tol"))
+            given.append((kwargs.get("options") or {}).get(key))
         return original(self, *args, **kwargs)
 
     monkeypatch.setattr(Transcription, "solve", recording)
     solution = solve_gait_solution(load_model("five-link"), options)
     assert solution.success
-    return given, solution.result.objective
+    return given, solution
 
 
 def test_the_held_stage_before_a_release_stops_early_and_the_answer_is_unchanged(
@@ -62,3 +76,22 @@ def test_a_looser_user_tolerance_wins() -> None:
     assert held_stage_options(GaitOptions(tol=1e-4), released=True)["ipopt.tol"] == 1e-4
     assert held_stage_options(GaitOptions(), released=True)["ipopt.tol"] == HELD_STAGE_TOL
     assert "ipopt.tol" not in held_stage_options(GaitOptions(), released=False)
+
+
+def _check_cost(solution: WalkingSolution) -> float:
+    (check,) = [s for s in solution.stages if s.name == "check grid"]
+    assert check.success
+    return check.objective
+
+
+def test_the_check_grid_starts_at_a_small_barrier_and_reaches_the_same_cost(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    options = GaitOptions(knots=(16, 6), speed=0.6)
+    given, solution = _fine_calls(monkeypatch, options, "ipopt.mu_init")
+    assert given[-1] == CHECK_GRID_OPTIONS["ipopt.mu_init"] == 1e-8
+    monkeypatch.setitem(CHECK_GRID_OPTIONS, "ipopt.mu_init", 1e-6)
+    given, before = _fine_calls(monkeypatch, options, "ipopt.mu_init")
+    assert given[-1] == 1e-6
+    assert solution.result.objective == pytest.approx(before.result.objective, rel=1e-10)
+    # the check costs agree within the solves' accuracy (about 1e-6 against a tight solve)
+    assert _check_cost(solution) == pytest.approx(_check_cost(before), rel=1e-6)
