@@ -5,6 +5,7 @@ docs/benchmarks-gait.md, section "MUMPS scaling"."""
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib.util
 import sys
 from pathlib import Path
@@ -81,3 +82,33 @@ def test_parse_set(bench: ModuleType) -> None:
     for bad in ("no colon", ":x=1", "a:x"):
         with pytest.raises(argparse.ArgumentTypeError, match="--set"):
             bench.parse_set(bad)
+
+
+def test_fine_stages_sum_the_fine_grids_only(bench: ModuleType) -> None:
+    stages = (("coarse", 50, 0.5), ("target grid", 30, 0.25), ("check grid", 17, 0.5))
+    fine = frozenset({"target grid", "check grid"})
+    runs = [bench.Run(True, (1.0,), 97, 1.25, 1.5, stages, fine),
+            bench.Run(True, (1.0,), 97, 1.25, 1.5,
+                      tuple((n, i, 3 * s) for n, i, s in stages), fine),
+            bench.Run(True, (1.0,), 97, 1.25, 1.5,
+                      tuple((n, i, 2 * s) for n, i, s in stages), fine)]
+    # iterations of the first repetition, the median (here the third) of the summed seconds
+    assert bench.fine_stages(runs) == (47, 1.5)
+    assert bench.fine_stages([bench.Run(True, (1.0,), 97, 1.25, 1.5, stages)]) == (0, 0.0)
+    assert bench.ratio(1.5, 0.0) == "-" and bench.ratio(1.5, 1.0) == "1.500"
+
+
+@pytest.mark.parametrize(("asked", "used"), [(0, 0), (4, 2)])
+def test_mumps_choices_read_what_mumps_used(bench: ModuleType, asked: int, used: int) -> None:
+    # AMD (0) is built in; PORD (4) is not in CasADi's MUMPS, which falls back to AMF (2)
+    tr = transcribe(double_integrator(5))
+    with bench.captured_fd1() as out:
+        res = tr.solve(options={"ipopt.mumps_pivot_order": asked, "ipopt.mumps_scaling": 8,
+                                "ipopt.mumps_print_level": 2})
+        del tr  # its solver's MUMPS instance reports its termination while captured
+        gc.collect()
+    assert res.success and abs(res.objective - 12.0) < 1e-8
+    choices = bench.mumps_choices(out[0])
+    assert choices["ordering"] == [used] and choices["scaling"] == [8]
+    assert bench.mumps_choices("no report") == {"ordering": [], "permuting scaling": [],
+                                                "scaling": []}
