@@ -465,20 +465,29 @@ def ocp_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
 ORDERINGS = {0: "AMD", 1: "given", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 6: "QAMD",
              7: "automatic"}
 #: What MUMPS reports (at ``ipopt.mumps_print_level`` 2) of the choices it made: name ->
-#: pattern of the line holding the value it effectively used.
+#: pattern of the line holding the value it effectively used. (Its line "ICNTL (6) Maximum
+#: transversal option" reads 0 after the analysis even where the matching was used: the
+#: analysis says "Compute maximum matching (Maximum Transversal): JOB" where it is.)
 MUMPS_CHOICES = {
     "ordering": re.compile(r"\(7\) Ordering option effectively used\s*=\s*(-?\d+)"),
-    "permuting scaling": re.compile(r"ICNTL \(6\) Maximum transversal option\s*=\s*(-?\d+)"),
     "scaling": re.compile(r"ICNTL\s*\(8\) Scaling effectively used\s*=\s*(-?\d+)"),
 }
+MATCHING = re.compile(r"Compute maximum matching \(Maximum Transversal\):\s*(\d+)")
 
 
 def mumps_choices(report: str) -> dict[str, list[int]]:
-    """The values MUMPS effectively used (ordering ICNTL(7), permuting scaling ICNTL(6),
-    scaling ICNTL(8)), each distinct value once in order of appearance, from its printed
-    report; an unavailable ordering (SCOTCH, PORD in CasADi's build) shows as another."""
-    return {name: list(dict.fromkeys(int(v) for v in pattern.findall(report)))
-            for name, pattern in MUMPS_CHOICES.items()}
+    """The values MUMPS effectively used, each distinct value once in order of appearance,
+    from its printed report: the ordering (ICNTL(7); an unavailable one, SCOTCH or PORD in
+    CasADi's build, shows as the one used instead), the permuting scaling (the maximum
+    matching's job of ICNTL(6) per analysis, 0 where none ran) and the scaling (ICNTL(8);
+    -2: computed during the analysis, with the matching)."""
+    analyses = [part.split("Leaving analysis phase")[0]
+                for part in report.split("ANALYSIS STEP")[1:]]
+    choices = {name: list(dict.fromkeys(int(v) for v in pattern.findall(report)))
+               for name, pattern in MUMPS_CHOICES.items()}
+    matchings = [int(m.group(1)) if (m := MATCHING.search(a)) else 0 for a in analyses]
+    return {"ordering": choices["ordering"], "permuting scaling": list(dict.fromkeys(matchings)),
+            "scaling": choices["scaling"]}
 
 
 def flush_fortran() -> None:

@@ -98,17 +98,22 @@ def test_fine_stages_sum_the_fine_grids_only(bench: ModuleType) -> None:
     assert bench.ratio(1.5, 0.0) == "-" and bench.ratio(1.5, 1.0) == "1.500"
 
 
-@pytest.mark.parametrize(("asked", "used"), [(0, 0), (4, 2)])
-def test_mumps_choices_read_what_mumps_used(bench: ModuleType, asked: int, used: int) -> None:
-    # AMD (0) is built in; PORD (4) is not in CasADi's MUMPS, which falls back to AMF (2)
+@pytest.mark.parametrize(("asked", "used", "matching", "scaling", "scaled"),
+                         [(0, 0, 0, 8, 8), (4, 2, 5, 77, -2)])
+def test_mumps_choices_read_what_mumps_used(bench: ModuleType, asked: int, used: int,
+                                            matching: int, scaling: int, scaled: int) -> None:
+    # AMD (0) is built in; PORD (4) is not in CasADi's MUMPS, which falls back to AMF (2).
+    # The scaling asked for (8) is used as such; the automatic one (77) after the matching
+    # (job 5) is the matching's, computed during the analysis (-2).
     tr = transcribe(double_integrator(5))
     with bench.captured_fd1() as out:
-        res = tr.solve(options={"ipopt.mumps_pivot_order": asked, "ipopt.mumps_scaling": 8,
+        res = tr.solve(options={"ipopt.mumps_pivot_order": asked, "ipopt.mumps_scaling": scaling,
+                                "ipopt.mumps_permuting_scaling": matching,
                                 "ipopt.mumps_print_level": 2})
         del tr  # its solver's MUMPS instance reports its termination while captured
         gc.collect()
     assert res.success and abs(res.objective - 12.0) < 1e-8
-    choices = bench.mumps_choices(out[0])
-    assert choices["ordering"] == [used] and choices["scaling"] == [8]
+    assert bench.mumps_choices(out[0]) == {"ordering": [used], "permuting scaling": [matching],
+                                           "scaling": [scaled]}
     assert bench.mumps_choices("no report") == {"ordering": [], "permuting scaling": [],
                                                 "scaling": []}
