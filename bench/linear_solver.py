@@ -473,6 +473,8 @@ MUMPS_CHOICES = {
     "scaling": re.compile(r"ICNTL\s*\(8\) Scaling effectively used\s*=\s*(-?\d+)"),
 }
 MATCHING = re.compile(r"Compute maximum matching \(Maximum Transversal\):\s*(\d+)")
+#: MUMPS's analysis call (JOB 1) with the order N of the matrix and its stored entries NNZ.
+ANALYSIS = re.compile(r"JOB, N, NNZ =\s*1\s+(\d+)\s+(\d+)")
 
 
 def mumps_choices(report: str) -> dict[str, list[int]]:
@@ -480,14 +482,17 @@ def mumps_choices(report: str) -> dict[str, list[int]]:
     from its printed report: the ordering (ICNTL(7); an unavailable one, SCOTCH or PORD in
     CasADi's build, shows as the one used instead), the permuting scaling (the maximum
     matching's job of ICNTL(6) per analysis, 0 where none ran) and the scaling (ICNTL(8);
-    -2: computed during the analysis, with the matching)."""
+    -2: computed during the analysis, with the matching); and the rows of the matrices
+    analysed (IPOPT's augmented system: free variables + equality rows + twice the
+    inequality rows, one of them for the slacks)."""
     analyses = [part.split("Leaving analysis phase")[0]
                 for part in report.split("ANALYSIS STEP")[1:]]
     choices = {name: list(dict.fromkeys(int(v) for v in pattern.findall(report)))
                for name, pattern in MUMPS_CHOICES.items()}
     matchings = [int(m.group(1)) if (m := MATCHING.search(a)) else 0 for a in analyses]
     return {"ordering": choices["ordering"], "permuting scaling": list(dict.fromkeys(matchings)),
-            "scaling": choices["scaling"]}
+            "scaling": choices["scaling"],
+            "rows": list(dict.fromkeys(int(n) for n, _ in ANALYSIS.findall(report)))}
 
 
 def flush_fortran() -> None:
@@ -534,8 +539,9 @@ def show_mumps_choices(case: Case, sets: Mapping[str, Mapping[str, Any]]) -> Non
         orders = ", ".join(f"{ORDERINGS.get(v, v)} ({v})" for v in used["ordering"])
         permuting = ", ".join(map(str, used["permuting scaling"]))
         scaling = ", ".join(map(str, used["scaling"]))
+        rows = ", ".join(f"{n:,}" for n in used["rows"])
         print(f"  {name:<16} MUMPS used: ordering {orders or '?'}; permuting scaling "
-              f"{permuting or '?'}; scaling {scaling or '?'}", flush=True)
+              f"{permuting or '?'}; scaling {scaling or '?'} (rows {rows or '?'})", flush=True)
 
 
 SUITES = ("representative", "grid", "full", "seven", "sweep", "ocp")

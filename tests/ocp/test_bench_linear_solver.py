@@ -106,6 +106,10 @@ def test_mumps_choices_read_what_mumps_used(bench: ModuleType, asked: int, used:
     # The scaling asked for (8) is used as such; the automatic one (77) after the matching
     # (job 5) is the matching's, computed during the analysis (-2).
     tr = transcribe(double_integrator(5))
+    size = tr.nlp_size()
+    # IPOPT's augmented system: free variables, equality rows, inequality rows and slacks
+    rows = (size.variables - size.fixed_variables + size.equality_constraints
+            + 2 * size.inequality_constraints)
     with bench.captured_fd1() as out:
         res = tr.solve(options={"ipopt.mumps_pivot_order": asked, "ipopt.mumps_scaling": scaling,
                                 "ipopt.mumps_permuting_scaling": matching,
@@ -114,6 +118,6 @@ def test_mumps_choices_read_what_mumps_used(bench: ModuleType, asked: int, used:
         gc.collect()
     assert res.success and abs(res.objective - 12.0) < 1e-8
     assert bench.mumps_choices(out[0]) == {"ordering": [used], "permuting scaling": [matching],
-                                           "scaling": [scaled]}
+                                           "scaling": [scaled], "rows": [rows]}
     assert bench.mumps_choices("no report") == {"ordering": [], "permuting scaling": [],
-                                                "scaling": []}
+                                                "scaling": [], "rows": []}
