@@ -501,7 +501,9 @@ def flush_fortran() -> None:
     with open("/proc/self/maps") as maps:
         libraries = {line.split()[-1] for line in maps if "libgfortran" in line}
     for library in sorted(libraries):
-        ctypes.CDLL(library)._gfortran_flush_i4(None)  # no unit: all of them
+        flush = getattr(ctypes.CDLL(library), "_gfortran_flush_i4", None)
+        if flush is not None:
+            flush(None)  # no unit: all of them
 
 
 @contextlib.contextmanager
@@ -584,7 +586,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--mumps-used", action="store_true",
                         help="first solve each suite's first case once per set with MUMPS's "
                              "report on and print the ordering and scalings it effectively "
-                             "used (an unavailable ordering falls back to another)")
+                             "used (an unavailable ordering falls back to another; grid, "
+                             "full, seven, representative)")
     parser.add_argument("--fine-only", action="store_true",
                         help="apply the sets only to grids finer than the coarse 8+5 (the "
                              "coarse stages then run alike)")
