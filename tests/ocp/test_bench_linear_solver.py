@@ -121,3 +121,14 @@ def test_mumps_choices_read_what_mumps_used(bench: ModuleType, asked: int, used:
                                            "scaling": [scaled], "rows": [rows]}
     assert bench.mumps_choices("no report") == {"ordering": [], "permuting scaling": [],
                                                 "scaling": [], "rows": []}
+
+
+def test_sets_keep_the_stage_options_they_do_not_name(bench: ModuleType) -> None:
+    # as FULL_WALK_FINE_GRID_OPTIONS reaches the full walk's fine stages: a set without the
+    # key keeps the stage's value (here an invalid one, so the solve fails), one naming it wins
+    tr = transcribe(double_integrator(4))
+    with bench.extra_options({"ipopt.fast_step_computation": "yes"}):
+        assert not tr.solve(options=INVALID).success
+    with bench.extra_options({"ipopt.mumps_permuting_scaling": 0}):
+        res = tr.solve(options=INVALID)
+    assert res.success and abs(res.objective - 12.0) < 1e-8
