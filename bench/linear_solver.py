@@ -36,8 +36,18 @@ set can change the iterations of the cold stages (another pivot sequence, other 
 corrections); ``--fine-only`` applies the sets only to grids finer than the coarse 8 + 5,
 so the cold stages run alike and the fine stages show the time per iteration.
 
+The summary's "fine stages" columns sum the stages on grids finer than 8 + 5 (seconds: per
+solve the median of the repetitions). ``--mumps-used`` first solves each suite's first case
+once per set with MUMPS's report on and prints the ordering and scalings MUMPS effectively
+used (CasADi's MUMPS has AMD, AMF, METIS and QAMD; it replaces SCOTCH and PORD by AMF).
+
+The sets are merged over the options the stages ask for, so a set that leaves a key out
+keeps the stage's value: on the full walk's fine grids that is
+``gaitopt.gait.stages.FULL_WALK_FINE_GRID_OPTIONS`` (``mumps_permuting_scaling`` 0), which a
+set overrides only by naming the key.
+
 Run: ``PYTHONPATH=src python bench/linear_solver.py [--suite representative grid full seven
-sweep ocp] [--speeds 3 12 ...] [--repeat 1] [--only TEXT] [--fine-only]
+sweep ocp] [--speeds 3 12 ...] [--repeat 1] [--only TEXT] [--fine-only] [--mumps-used]
 [--set NAME:KEY=VALUE[,KEY=VALUE] ...]``
 """
 
@@ -49,7 +59,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as the gaitopt command run
 
 import argparse  # noqa: E402
 import contextlib  # noqa: E402
+import ctypes  # noqa: E402
+import gc  # noqa: E402
 import math  # noqa: E402
+import re  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -61,6 +74,7 @@ from typing import Any  # noqa: E402
 
 from gaitopt.gait.api import solve_gait_solution  # noqa: E402
 from gaitopt.gait.options import GaitOptions  # noqa: E402
+from gaitopt.gait.transcriptions import clear_cache  # noqa: E402
 from gaitopt.ocp import Transcription  # noqa: E402
 from gaitopt.ocp.solver import merge_options  # noqa: E402
 from gaitopt.robot import load_model  # noqa: E402
@@ -112,6 +126,8 @@ class Run:
     solve_s: float  # the stages' solves (IPOPT and their setup), no transcription builds
     wall_s: float
     stages: tuple[tuple[str, int, float], ...] = ()  # (stage, iterations, seconds)
+    #: The names of the stages on grids finer than the coarse 8 + 5 (:data:`COARSE_KNOTS`).
+    fine: frozenset[str] = frozenset()
 
 
 #: The most knots (mesh points, intervals + 1) a phase has on the coarse grid of the first
@@ -150,7 +166,18 @@ def solve_case(case: Case) -> Run:
     costs = tuple(c for _, c in sol.grid_costs) if sol.success else ()
     return Run(sol.success, costs, sum(s.iterations for s in sol.stages),
                sum(s.wall_time_s for s in sol.stages), wall,
-               tuple((s.name, s.iterations, s.wall_time_s) for s in sol.stages))
+               tuple((s.name, s.iterations, s.wall_time_s) for s in sol.stages),
+               frozenset(s.name for s in sol.stages if max(s.knots) > COARSE_KNOTS))
+
+
+def fine_stages(runs: list[Run]) -> tuple[int, float]:
+    """The stages on the fine grids of one solve repeated: their iterations (of the first
+    repetition) and the median over the repetitions of their summed seconds."""
+    def seconds(run: Run) -> float:
+        return sum(sec for stage, _, sec in run.stages if stage in run.fine)
+
+    return (sum(it for stage, it, _ in runs[0].stages if stage in runs[0].fine),
+            statistics.median(seconds(r) for r in runs))
 
 
 def cases_of(suite: str, speeds: list[float] | None) -> list[Case]:
@@ -227,6 +254,12 @@ def coarse_difference(a: tuple[float, ...], b: tuple[float, ...]) -> float:
     return max((abs(x - y) / abs(x) for x, y in pairs), default=0.0)
 
 
+def ratio(x: float, ref: float) -> str:
+    """``x / ref`` to three decimals, or ``-`` where the reference is zero (a suite with no
+    fine-grid stage, a sweep point)."""
+    return f"{x / ref:.3f}" if ref else "-"
+
+
 def summary(runs: dict[str, dict[str, list[Run]]], title: str) -> None:
     """Per set: converged, sums and medians, their ratios to the first set; cost checks."""
     names = list(runs)
@@ -235,19 +268,23 @@ def summary(runs: dict[str, dict[str, list[Run]]], title: str) -> None:
     print(f"\n### {title}: {len(labels)} solves per set\n")
     print("| options | converged | wall sum (s) | wall median (s) | solves sum (s) | "
           "solves median (s) | iterations | wall sum / ref | solves sum / ref | "
-          "iterations / ref |")
-    print("|:---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "iterations / ref | fine stages (s) | fine iterations | fine s / ref | "
+          "fine iterations / ref |")
+    print("|:---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     totals = {}
     for name in names:
         rs = [best(runs[name][label]) for label in labels]
+        fine = [fine_stages(runs[name][label]) for label in labels]
         totals[name] = (sum(r.wall_s for r in rs), statistics.median(r.wall_s for r in rs),
                         sum(r.solve_s for r in rs), statistics.median(r.solve_s for r in rs),
-                        sum(r.iterations for r in rs), sum(r.success for r in rs))
-    w0, _, s0, _, i0, _ = totals[names[0]]
+                        sum(r.iterations for r in rs), sum(r.success for r in rs),
+                        sum(s for _, s in fine), sum(it for it, _ in fine))
+    w0, _, s0, _, i0, _, f0, fi0 = totals[names[0]]
     for name in names:
-        w, wm, s, sm, it, ok = totals[name]
+        w, wm, s, sm, it, ok, f, fi = totals[name]
         print(f"| {name} | {ok}/{len(labels)} | {w:.2f} | {wm:.3f} | {s:.2f} | {sm:.3f} | "
-              f"{it} | {w / w0:.3f} | {s / s0:.3f} | {it / i0:.3f} |")
+              f"{it} | {w / w0:.3f} | {s / s0:.3f} | {it / i0:.3f} | {f:.2f} | {fi} | "
+              f"{ratio(f, f0)} | {ratio(fi, fi0)} |")
     for name in names[1:]:
         diffs = {label: relative_difference(best(ref[label]).costs, best(runs[name][label]).costs)
                  for label in labels}
@@ -354,13 +391,19 @@ def sweep_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
 
 
 def solve_suite(suite: str, sets: Mapping[str, Mapping[str, Any]],
-                speeds: list[float] | None, repeat: int, only: str | None = None) -> None:
+                speeds: list[float] | None, repeat: int, only: str | None = None,
+                mumps_used: bool = False) -> None:
     """The solves of ``suite``, each set alternately; one line per solve, then the summary.
     The first solve of each problem structure (the options but the speed) runs once untimed
-    first. ``only``: the solves whose label contains it."""
+    first. ``only``: the solves whose label contains it; ``mumps_used``: first print what
+    MUMPS effectively used with each set on the first solve (:func:`show_mumps_choices`)."""
     cases = {c.label: c for c in cases_of(suite, speeds) if only is None or only in c.label}
     if not cases:
         raise SystemExit(f"--only {only!r}: no solve of suite {suite} has it in its label")
+    if mumps_used:
+        first = next(iter(cases.values()))
+        print(f"{suite}: what MUMPS used on {first.label}")
+        show_mumps_choices(first, sets)
     seen: set[str] = set()
 
     def first_of_structure(label: str) -> bool:
@@ -418,6 +461,91 @@ def ocp_suite(sets: Mapping[str, Mapping[str, Any]], repeat: int) -> None:
         f"{name} {totals[name]:.3f} ({totals[name] / totals[names[0]]:.3f})" for name in names))
 
 
+#: MUMPS's fill-reducing orderings (ICNTL(7), IPOPT's ``mumps_pivot_order``): value -> name.
+ORDERINGS = {0: "AMD", 1: "given", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 6: "QAMD",
+             7: "automatic"}
+#: What MUMPS reports (at ``ipopt.mumps_print_level`` 2) of the choices it made: name ->
+#: pattern of the line holding the value it effectively used. (Its line "ICNTL (6) Maximum
+#: transversal option" reads 0 after the analysis even where the matching was used: the
+#: analysis says "Compute maximum matching (Maximum Transversal): JOB" where it is.)
+MUMPS_CHOICES = {
+    "ordering": re.compile(r"\(7\) Ordering option effectively used\s*=\s*(-?\d+)"),
+    "scaling": re.compile(r"ICNTL\s*\(8\) Scaling effectively used\s*=\s*(-?\d+)"),
+}
+MATCHING = re.compile(r"Compute maximum matching \(Maximum Transversal\):\s*(\d+)")
+#: MUMPS's analysis call (JOB 1) with the order N of the matrix and its stored entries NNZ.
+ANALYSIS = re.compile(r"JOB, N, NNZ =\s*1\s+(\d+)\s+(\d+)")
+
+
+def mumps_choices(report: str) -> dict[str, list[int]]:
+    """The values MUMPS effectively used, each distinct value once in order of appearance,
+    from its printed report: the ordering (ICNTL(7); an unavailable one, SCOTCH or PORD in
+    CasADi's build, shows as the one used instead), the permuting scaling (the maximum
+    matching's job of ICNTL(6) per analysis, 0 where none ran) and the scaling (ICNTL(8);
+    -2: computed during the analysis, with the matching); and the rows of the matrices
+    analysed (IPOPT's augmented system: free variables + equality rows + twice the
+    inequality rows, one of them for the slacks)."""
+    analyses = [part.split("Leaving analysis phase")[0]
+                for part in report.split("ANALYSIS STEP")[1:]]
+    choices = {name: list(dict.fromkeys(int(v) for v in pattern.findall(report)))
+               for name, pattern in MUMPS_CHOICES.items()}
+    matchings = [int(m.group(1)) if (m := MATCHING.search(a)) else 0 for a in analyses]
+    return {"ordering": choices["ordering"], "permuting scaling": list(dict.fromkeys(matchings)),
+            "scaling": choices["scaling"],
+            "rows": list(dict.fromkeys(int(n) for n, _ in ANALYSIS.findall(report)))}
+
+
+def flush_fortran() -> None:
+    """Flush the output buffers of every Fortran runtime (libgfortran) in the process, where
+    MUMPS's report waits otherwise (standard output is buffered when it is not a terminal)."""
+    with open("/proc/self/maps") as maps:
+        libraries = {line.split()[-1] for line in maps if "libgfortran" in line}
+    for library in sorted(libraries):
+        flush = getattr(ctypes.CDLL(library), "_gfortran_flush_i4", None)
+        if flush is not None:
+            flush(None)  # no unit: all of them
+
+
+@contextlib.contextmanager
+def captured_fd1() -> Iterator[list[str]]:
+    """What the process writes to its standard output (file descriptor 1, where MUMPS
+    prints) while inside: the list gets the text on leaving."""
+    out: list[str] = []
+    sys.stdout.flush()
+    saved = os.dup(1)
+    with tempfile.TemporaryFile(mode="w+b") as tmp:
+        os.dup2(tmp.fileno(), 1)
+        try:
+            yield out
+        finally:
+            sys.stdout.flush()
+            flush_fortran()
+            os.dup2(saved, 1)
+            os.close(saved)
+            tmp.seek(0)
+            out.append(tmp.read().decode(errors="replace"))
+
+
+def show_mumps_choices(case: Case, sets: Mapping[str, Mapping[str, Any]]) -> None:
+    """Solve ``case`` once per set (untimed) with MUMPS's report on and print the ordering
+    and scalings it effectively used in the stages the sets apply to. The transcriptions
+    (and their solvers, whose MUMPS instances report again when destroyed) are dropped
+    after each: the suite's first solve of a structure builds them again untimed."""
+    for name, options in sets.items():
+        with captured_fd1() as out:
+            with extra_options({**options, "ipopt.mumps_print_level": 2}):
+                solve_case(case)
+            clear_cache()
+            gc.collect()  # the solvers' MUMPS instances report their end while captured
+        used = mumps_choices(out[0])
+        orders = ", ".join(f"{ORDERINGS.get(v, v)} ({v})" for v in used["ordering"])
+        permuting = ", ".join(map(str, used["permuting scaling"]))
+        scaling = ", ".join(map(str, used["scaling"]))
+        rows = ", ".join(f"{n:,}" for n in used["rows"])
+        print(f"  {name:<16} MUMPS used: ordering {orders or '?'}; permuting scaling "
+              f"{permuting or '?'}; scaling {scaling or '?'} (rows {rows or '?'})", flush=True)
+
+
 SUITES = ("representative", "grid", "full", "seven", "sweep", "ocp")
 
 
@@ -455,6 +583,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--only", help="only the solves whose label contains this text, "
                                        "e.g. 'uniform 40+10' (grid, full, seven, "
                                        "representative)")
+    parser.add_argument("--mumps-used", action="store_true",
+                        help="first solve each suite's first case once per set with MUMPS's "
+                             "report on and print the ordering and scalings it effectively "
+                             "used (an unavailable ordering falls back to another; grid, "
+                             "full, seven, representative)")
     parser.add_argument("--fine-only", action="store_true",
                         help="apply the sets only to grids finer than the coarse 8+5 (the "
                              "coarse stages then run alike)")
@@ -476,7 +609,7 @@ def main(argv: list[str] | None = None) -> None:
         if suite == "ocp":
             ocp_suite(sets, args.repeat)
             continue
-        solve_suite(suite, sets, args.speeds, args.repeat, args.only)
+        solve_suite(suite, sets, args.speeds, args.repeat, args.only, args.mumps_used)
     print(f"\nload average after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
