@@ -1,7 +1,9 @@
 """The linear-algebra options of the fine-grid stages (``gaitopt.gait.stages.fine_grid_options``):
-the two-phase walk in full coordinates solves its target and check grids with MUMPS's
-permuting scaling off, its coarse stages and every other problem with MUMPS's defaults (the
-measurements behind the choice: docs/benchmarks-gait.md, "MUMPS scaling")."""
+the two-phase walk solves its target and check grids with IPOPT's fast step computation (in
+either formulation) and, in full coordinates, with MUMPS's permuting scaling off; its coarse
+stages and every other problem keep IPOPT's and MUMPS's defaults (the measurements behind
+the choice: docs/benchmarks-gait.md, "MUMPS scaling" and "MUMPS ordering and IPOPT's step
+options")."""
 
 from __future__ import annotations
 
@@ -11,23 +13,28 @@ import pytest
 
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.stages import FULL_WALK_FINE_GRID_OPTIONS, fine_grid_options
+from gaitopt.gait.stages import (
+    FULL_WALK_FINE_GRID_OPTIONS,
+    WALK_FINE_GRID_OPTIONS,
+    fine_grid_options,
+)
 from gaitopt.ocp import Transcription
 from gaitopt.robot import load_model
 
 KEY = "ipopt.mumps_permuting_scaling"
+FAST = "ipopt.fast_step_computation"
 
 
-def _solved_with(monkeypatch: pytest.MonkeyPatch, options: GaitOptions
+def _solved_with(monkeypatch: pytest.MonkeyPatch, options: GaitOptions, key: str = KEY
                  ) -> list[tuple[tuple[int, ...], Any]]:
-    """Solve ``options`` and return, per IPOPT call, the knots per phase and the permuting
-    scaling it was given (None: MUMPS's default)."""
+    """Solve ``options`` and return, per IPOPT call, the knots per phase and the option
+    ``key`` it was given (None: the default)."""
     calls: list[tuple[tuple[int, ...], Any]] = []
     original = Transcription.solve
 
     def recording(self: Transcription, *args: Any, **kwargs: Any) -> Any:
         given = kwargs.get("options") or {}
-        calls.append((tuple(m.size for m in self.mesh), given.get(KEY)))
+        calls.append((tuple(m.size for m in self.mesh), given.get(key)))
         return original(self, *args, **kwargs)
 
     monkeypatch.setattr(Transcription, "solve", recording)
@@ -50,4 +57,16 @@ def test_other_problems_keep_mumps_defaults(monkeypatch: pytest.MonkeyPatch) -> 
     assert any(knots != (8, 5) for knots, _ in calls)
     assert all(value is None for _, value in calls)
     assert fine_grid_options(GaitOptions(formulation="full", gait="heel-toe")) == {}
-    assert fine_grid_options(GaitOptions(formulation="full")) == FULL_WALK_FINE_GRID_OPTIONS
+    assert fine_grid_options(GaitOptions(formulation="full")) == {
+        **WALK_FINE_GRID_OPTIONS, **FULL_WALK_FINE_GRID_OPTIONS}
+
+
+@pytest.mark.parametrize("formulation", ["reduced", "full"])
+def test_the_walk_computes_only_its_fine_steps_fast(monkeypatch: pytest.MonkeyPatch,
+                                                    formulation: str) -> None:
+    calls = _solved_with(monkeypatch, GaitOptions(formulation=formulation, knots=(16, 6)),
+                         FAST)
+    coarse = [value for knots, value in calls if knots == (8, 5)]
+    fine = [value for knots, value in calls if knots != (8, 5)]
+    assert coarse and all(value is None for value in coarse)
+    assert len(fine) >= 3 and all(value == "yes" for value in fine)

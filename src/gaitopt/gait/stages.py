@@ -101,24 +101,40 @@ def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
 
 
 #: IPOPT options of every stage on a grid finer than the coarse one (the target grid and its
-#: release, the check grid, mesh refinement, a warm start) of the two-phase walk in full
-#: coordinates: MUMPS without its permuting scaling (the MC64 matching, which MUMPS otherwise
-#: chooses itself and applies at every factorization). Measured by bench/linear_solver.py
-#: (docs/benchmarks-gait.md, "MUMPS scaling"): on these stages the same iterations to the same
-#: optima (40/40 points, 3-60 m/min, both ankle variants, relative cost differences below
-#: 3e-13), each iteration cheaper: the target grid 0.92x, the check grid 0.88x on the default
-#: 16 + 6 grid, 0.81x on uniform 40 + 10. Not elsewhere: the coarse stages change their path
-#: with it (for better or worse), the reduced formulation and the heel-toe walk gain nothing,
-#: and on the reduced walk's fine stages two of the 80 convergence-grid points then failed.
+#: release, the check grid, mesh refinement, a warm start) of the two-phase walk, in either
+#: formulation: IPOPT takes MUMPS's solution of each step's linear system as it is
+#: (``fast_step_computation``: no residuals, no refinement back-solve to check it). Measured
+#: by bench/linear_solver.py (docs/benchmarks-gait.md, "MUMPS ordering and IPOPT's step
+#: options"): the fine stages took 0.92-0.94x the time on the reduced convergence grid
+#: (80/80 points, 4,769 against 4,783 iterations) and 0.88-0.92x on the full-coordinate
+#: sample (40/40, 2,481 against 2,482), the optima equal to 3e-12. Not for the heel-toe walk
+#: (0.986x, and 515 instead of 474 iterations at 36 m/min) nor other contact sequences,
+#: where it was not measured. What is given up is IPOPT's check of a step's accuracy (and
+#: the larger pivot tolerance it asks for after a poor one); no point failed or moved
+#: without it.
+WALK_FINE_GRID_OPTIONS: dict[str, Any] = {"ipopt.fast_step_computation": "yes"}
+#: Added to :data:`WALK_FINE_GRID_OPTIONS` for the walk in full coordinates: MUMPS without
+#: its permuting scaling (the MC64 matching, which MUMPS otherwise chooses itself, computes
+#: once per analysis and reuses; without it MUMPS scales at every factorization). Measured
+#: by bench/linear_solver.py (docs/benchmarks-gait.md, "MUMPS scaling"): on these stages the
+#: same iterations to the same optima (40/40 points, 3-60 m/min, both ankle variants,
+#: relative cost differences below 3e-13), each iteration cheaper: the target grid 0.92x,
+#: the check grid 0.88x on the default 16 + 6 grid, 0.81x on uniform 40 + 10. Not elsewhere:
+#: the coarse stages change their path with it (for better or worse), the reduced
+#: formulation and the heel-toe walk gain nothing, and on the reduced walk's fine stages two
+#: of the 80 convergence-grid points then failed.
 FULL_WALK_FINE_GRID_OPTIONS: dict[str, Any] = {"ipopt.mumps_permuting_scaling": 0}
 
 
 def fine_grid_options(options: GaitOptions) -> dict[str, Any]:
-    """The IPOPT options of the stages on grids finer than the coarse one:
-    :data:`FULL_WALK_FINE_GRID_OPTIONS` for the walk in full coordinates, else none."""
-    if options.formulation == "full" and sequence_kind(options) == "walk":
-        return dict(FULL_WALK_FINE_GRID_OPTIONS)
-    return {}
+    """The IPOPT options of the stages on grids finer than the coarse one: for the two-phase
+    walk :data:`WALK_FINE_GRID_OPTIONS`, in full coordinates with
+    :data:`FULL_WALK_FINE_GRID_OPTIONS`; none for other contact sequences."""
+    if sequence_kind(options) != "walk":
+        return {}
+    if options.formulation == "full":
+        return {**WALK_FINE_GRID_OPTIONS, **FULL_WALK_FINE_GRID_OPTIONS}
+    return dict(WALK_FINE_GRID_OPTIONS)
 
 
 def sequence_kind(options: GaitOptions) -> str:
