@@ -117,9 +117,11 @@ def lowest_force_by_phase(gait: Gait) -> float:
 
 def solve_point(variant: str, speed_m_min: float, *, check: bool,
                 transcription: str = "hermite-simpson",
-                knot_spacing: str = GaitOptions().knot_spacing) -> Point:
+                knot_spacing: str = GaitOptions().knot_spacing,
+                formulation: str = GaitOptions().formulation) -> Point:
     options = GaitOptions(speed=speed_m_min / 60.0, transcription=transcription,  # type: ignore[arg-type]
                           knot_spacing=knot_spacing,  # type: ignore[arg-type]
+                          formulation=formulation,  # type: ignore[arg-type]
                           **VARIANTS[variant])
     start = time.perf_counter()
     solution = solve_gait_solution("five-link", options)
@@ -183,6 +185,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--knot-spacing", default=GaitOptions().knot_spacing,
                         choices=KNOT_SPACINGS,
                         help="GaitOptions.knot_spacing of every point (default: the default)")
+    parser.add_argument("--formulation", default=GaitOptions().formulation,
+                        choices=("reduced", "full"),
+                        help="GaitOptions.formulation of every point (default: the default)")
     args = parser.parse_args(argv)
 
     print(f"load average before: {load_average()} (1, 5, 15 min; {os.cpu_count()} cores)")
@@ -192,7 +197,8 @@ def main(argv: list[str] | None = None) -> None:
         for speed in args.speeds:
             point = solve_point(variant, speed, check=not args.no_verify,
                                 transcription=args.transcription,
-                                knot_spacing=args.knot_spacing)
+                                knot_spacing=args.knot_spacing,
+                                formulation=args.formulation)
             rows.append(point)
             print(f"  {variant:<14} {speed:5.1f} m/min  {'ok ' if point.success else 'FAIL'}"
                   f" {point.wall_time_s:6.2f} s  verify {point.verify}", flush=True)
