@@ -216,7 +216,6 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
         X, U = Z[:n, :], Z[n:, :]
         fold = fold_knot_states and pf.knot_states is not None and K > 1
         if pf.knot_states is not None and K > 1 and not fold:
-            assert pf.knot_states is not None
             X, index, values = _with_knot_states(
                 pf, pl, X, pf.knot_states.map(K - 1)(X[:, 1:], p))
             dependent_index.extend(index)
@@ -229,33 +228,28 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
         Um = midpoint_control(U[:, :-1], U[:, 1:])
         mid_defects = None
         f_m = L_m = None
-        if method.midpoint_variables:
-            # Separated form: one call of the point function per knot and per midpoint, all
-            # in one map, at the variable midpoint states (no dynamics nested in dynamics).
-            Xm = ca.reshape(w[pl.midpoint_block()], n, N)
-            if fold:
-                XD, C, L, X, index, values = _folded_knots(i, pf, pl, X, U, p, tk, point_calls,
-                                                           (Xm, Um, tm))
-                dependent_index.extend(index)
-                dependent_values.append(values)
-            else:
-                XD, C, L = point_calls(i, pf.point, ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
-                                       ca.horzcat(tk, tm))
+        # Separated form: one call of the point function per knot and per midpoint, all in
+        # one map, at the variable midpoint states (no dynamics nested in dynamics).
+        Xm = ca.reshape(w[pl.midpoint_block()], n, N) if method.midpoint_variables else None
+        if fold:
+            XD, C, L, X, index, values = _folded_knots(
+                i, pf, pl, X, U, p, tk, point_calls, None if Xm is None else (Xm, Um, tm))
+            dependent_index.extend(index)
+            dependent_values.append(values)
+        elif Xm is not None:
+            XD, C, L = point_calls(i, pf.point, ca.horzcat(X, Xm), ca.horzcat(U, Um), p,
+                                   ca.horzcat(tk, tm))
+        else:
+            XD, C, L = point_calls(i, pf.point, X, U, p, tk)
+        if Xm is not None:
             f_m, Cm, L_m = XD[:, K:], C[:, K:], L[:, K:]
             XD, C, L = XD[:, :K], C[:, :K], L[:, :K]
-            x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
+        x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
+        if Xm is not None:
             mid_defects = Xm - method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
-        else:
-            if fold:
-                XD, C, L, X, index, values = _folded_knots(i, pf, pl, X, U, p, tk, point_calls)
-                dependent_index.extend(index)
-                dependent_values.append(values)
-            else:
-                XD, C, L = point_calls(i, pf.point, X, U, p, tk)
-            x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
-            if method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0:
-                Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
-                f_m, Cm, L_m = point_calls(i, pf.point, Xm, Um, p, tm)
+        elif method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0:
+            Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
+            f_m, Cm, L_m = point_calls(i, pf.point, Xm, Um, p, tm)
         defects = method.defects(x_k, x_k1, f_k, f_k1, f_m, Hn)
         dx = state_scales[i]
         rows.add(f"{ph.name}/defects", ph.name, "defects", flat(defects), (N, n),
