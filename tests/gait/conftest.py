@@ -34,10 +34,12 @@ from tests.dynamics.pinocchio_model import PinModel, build
 
 Array = NDArray[np.float64]
 
-#: Absolute tolerance of the equations of motion residual relative to their size (N, N m).
-EOM_RTOL = 1e-8
-#: Tips held on the ground: position (m), velocity (m/s), acceleration (m/s^2).
-TIP_TOL = 1e-8
+#: Absolute tolerance of the equations of motion residual relative to their size (N, N m),
+#: and of the tips held on the ground: position (m), velocity (m/s), acceleration (m/s^2).
+#: Full-coordinate solves meet both as constraints to their tolerance (tol 1e-7), so the
+#: margin is 10 x that (a rule of docs/testing.md).
+EOM_RTOL = 1e-6
+TIP_TOL = 1e-6
 
 
 # -- solving once per session -------------------------------------------------------------------

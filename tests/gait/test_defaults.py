@@ -66,19 +66,20 @@ def test_the_default_solve_reports_its_error_within_one_percent(solved: SolveFn)
     assert acc["check_knots"] == {"single_support": 24, "double_support": 8}
     assert acc["previous_knots"] == {"single_support": 8, "double_support": 5}
     check = solved(GaitOptions(knots=(24, 8))).gait
-    # within the solves' accuracy (tol 1e-7: about 1e-6 of J against a solve to 1e-11)
-    assert acc["check_cost"] == pytest.approx(check.cost_value, rel=1e-6)
+    # Two solves of the same problem agree to their accuracy (tol 1e-7: about 1e-6 of J
+    # against a solve to 1e-11); the margin is 10 x that.
+    assert acc["check_cost"] == pytest.approx(check.cost_value, rel=1e-5)
     assert acc["cost_error_factor"] == 3.0  # 24 / (24 - 16)
     assert acc["cost_error"] == pytest.approx(3.0 * (gait.cost_value - acc["check_cost"]),
                                               rel=1e-9)
     assert acc["cost_error"] == pytest.approx(3.0 * (gait.cost_value - check.cost_value),
-                                              abs=3.0 * 1e-6 * gait.cost_value)
+                                              abs=3.0 * 1e-5 * gait.cost_value)
     assert acc["cost_error_relative"] == pytest.approx(
         abs(acc["cost_error"]) / gait.cost_value, rel=1e-9)
     assert 0.0 < acc["cost_error_relative"] < 0.01
     assert acc["speed_change"] == 0.0  # the speed is given
     assert acc["step_length_change"] == pytest.approx(
-        check.step_length - gait.step_length, abs=1e-6)
+        check.step_length - gait.step_length, abs=1e-5)
     assert acc["step_length_error"] == pytest.approx(3.0 * abs(acc["step_length_change"]))
 
 
@@ -89,9 +90,9 @@ def test_the_speed_free_default_says_how_far_speed_and_step_moved(solved: SolveF
     gait = solved(GaitOptions(speed=None)).gait
     check = solved(GaitOptions(speed=None, knots=(24, 8))).gait
     acc = gait.solver["accuracy"]
-    assert acc["speed_change"] == pytest.approx(check.speed - gait.speed, abs=1e-6)
+    assert acc["speed_change"] == pytest.approx(check.speed - gait.speed, abs=1e-5)
     assert acc["step_length_change"] == pytest.approx(check.step_length - gait.step_length,
-                                                      abs=1e-6)
+                                                      abs=1e-5)
     assert acc["speed_change"] != 0.0
     assert acc["speed_error"] == pytest.approx(3.0 * abs(acc["speed_change"]))
     assert acc["cost_error_relative"] < 0.01

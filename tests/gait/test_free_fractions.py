@@ -199,12 +199,12 @@ def test_both_mechanisms_give_the_same_optimum(solved: SolveFn) -> None:
     """Five-link walk at 12 m/min in full coordinates: the single-support fraction free in
     [0.6, 0.95] by ``single_support_fraction_bounds`` (from the two-link guess) and by a
     sequence whose two fractions carry the same bounds (from the generic guess): the same
-    optimum to 1e-6 (cost, step length and fractions)."""
+    optimum to 1e-5, 10 x the solves' accuracy (cost, step length and fractions)."""
     old = solved(FULL.replace(single_support_fraction_bounds=(0.6, 0.95))).gait
     new = solved(FULL.replace(contact_sequence=FREE_WALK)).gait
     assert old.success and new.success
-    assert new.cost_value == pytest.approx(old.cost_value, rel=1e-6)
-    assert new.step_length == pytest.approx(old.step_length, rel=1e-6)
+    assert new.cost_value == pytest.approx(old.cost_value, rel=1e-5)
+    assert new.step_length == pytest.approx(old.step_length, rel=1e-5)
     assert old.contact_sequence is not None and new.contact_sequence is not None
     for a, b in zip(old.contact_sequence["phases"], new.contact_sequence["phases"],
                     strict=True):
@@ -323,7 +323,7 @@ def test_the_summary_prints_the_solved_fractions(tmp_path: Any, solved: SolveFn)
                         str(out))
     assert result.exit_code == 0, result.output
     gait = Gait.load(out)
-    assert gait.cost_value == pytest.approx(api.cost_value, rel=1e-6)
+    assert gait.cost_value == pytest.approx(api.cost_value, rel=1e-5)
     assert gait.contact_sequence is not None
     shares = [ph["fraction"] for ph in gait.contact_sequence["phases"]]
     # the table may wrap a cell onto the next line: compare its words without the rules

@@ -162,7 +162,7 @@ def test_warm_start_from_a_full_gait_file(solved: SolveFn, tmp_path) -> None:  #
     again = solve_gait("five-link", FULL, warm_start=Gait.load(path))
     assert again.success
     assert again.solver["stages"][0]["name"] == "warm start"
-    assert again.cost_value == pytest.approx(gait.cost_value, rel=1e-6)
+    assert again.cost_value == pytest.approx(gait.cost_value, rel=1e-5)
 
 
 def test_contact_sequences_are_one_mechanism() -> None:

@@ -6,16 +6,22 @@ from __future__ import annotations
 import copy
 import json
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from numpy.typing import NDArray
 
+from gaitopt.analysis.checks.knots import full_state_function
+from gaitopt.analysis.checks.samples import points_function
 from gaitopt.analysis.verify import CHECKS, VerifyReport, verify_gait
 from gaitopt.cli import cli
 from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.gait_parts import GaitSamples
+from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from tests.gait.conftest import (
@@ -26,6 +32,7 @@ from tests.gait.conftest import (
     lowest_sample_normal_force,
 )
 
+Array = NDArray[np.float64]
 RefFn = Callable[..., Reference]
 Corruption = Callable[[dict[str, Any]], None]
 
@@ -122,7 +129,7 @@ def test_verify_passes_on_the_default_gait(default_gait: Gait) -> None:
     for exact in ("eom.residual", "contacts.position", "contacts.velocity", "states.values",
                   "samples.states", "events.maps", "events.impulses", "cost.recomputed"):
         assert report.check(exact).value < 1e-9, report.check(exact)
-    assert report.check("events.periodicity").value < 1e-7
+    assert report.check("events.periodicity").value < 1e-6  # 10 x the solve's tol
     assert 0.0 < report.check("integration.interval").value < 10.0
 
 
@@ -240,51 +247,111 @@ def test_cli_verify_rejects_a_bad_tolerance(default_gait_file: Path) -> None:
     assert "--tolerance" in result.stderr and "Traceback" not in result.output
 
 
-# -- a gait whose dense samples include the heel-strike instant ---------------------------------
+# -- samples at, just before and just after the heel strike ------------------------------------
+#
+# A dense sample that falls on the heel strike, or a rounding error on either side of it, is the
+# floating-point edge case of the phase assignment (module docstring of
+# gaitopt.analysis.checks.samples). Whether a solve's uniform sample grid happens to produce
+# one depends on the last bits of the solution, which differ between CPUs and BLAS kernels, so
+# the cases are built on purpose: the samples are re-evaluated at chosen times from the
+# phases' own interpolants, each by the phase the documented rule gives it.
 
-FAST = GaitOptions.paper(speed=0.5)  # 30 m/min: step time < 0.5 s, 101 samples, one at 0.85 T
+FAST = GaitOptions.paper(speed=0.5)  # 30 m/min
+SIDES = {"before": -np.inf, "at": None, "after": np.inf}
+
+
+def _times_around(t: Array, strike: float) -> tuple[Array, dict[str, int]]:
+    """``t`` with the three samples nearest ``strike`` replaced by ``nextafter(strike, -inf)``,
+    ``strike`` and ``nextafter(strike, +inf)``; their indices by side."""
+    chosen = {side: strike if to is None else float(np.nextafter(strike, to))
+              for side, to in SIDES.items()}
+    near = np.argsort(np.abs(t - strike))[:3]
+    out = np.sort(np.concatenate([np.delete(t, near), list(chosen.values())]))
+    return out, {side: int(np.flatnonzero(out == v)[0]) for side, v in chosen.items()}
+
+
+def _resampled(gait: Gait, t: Array) -> Gait:
+    """``gait`` with its samples re-evaluated at times ``t`` (sorted): sample k by the first
+    phase whose last knot time is >= t[k] (exact comparison), from that phase's state and
+    control interpolants and the forward kinematics."""
+    model, step = gait.model, gait.parameters["step_length"]
+    q = np.zeros((t.size, model.nq))
+    qd = np.zeros((t.size, model.nq))
+    u = np.zeros((t.size, model.nu))
+    taken = np.zeros(t.size, dtype=bool)
+    for ph in gait.phases:
+        mask = (t <= ph.t[-1]) & ~taken
+        taken |= mask
+        if not mask.any():
+            continue
+        full = full_state_function(model, tuple(ph.state_names)).map(int(mask.sum()))(
+            phase_states_at(ph, t[mask]).T, step)
+        q[mask], qd[mask] = (np.asarray(v, dtype=float).T for v in full)
+        u[mask] = phase_controls_at(ph, t[mask])
+    names = tuple(gait.samples.points)
+    pts = np.asarray(points_function(model, names).map(t.size)(q.T), dtype=float)
+    pts = pts.reshape(2, t.size, len(names))  # (xy, sample, point)
+    points = {name: pts[:, :, j].T for j, name in enumerate(names)}
+    return replace(gait, samples=GaitSamples(t=t, q=q, qd=qd, u=u, points=points))
+
+
+def test_time_rounding_around_the_heel_strike_is_built_on_purpose() -> None:
+    t, at = _times_around(np.linspace(0.0, 1.0, 11), 0.5)
+    assert t.size == 11 and np.all(np.diff(t) > 0.0)
+    assert t[at["at"]] == 0.5
+    assert t[at["before"]] < 0.5 < t[at["after"]]
+    assert t[at["after"]] - 0.5 < 1e-15 and 0.5 - t[at["before"]] < 1e-15
+
+
+@pytest.mark.parametrize("options", [FAST, GaitOptions.paper(speed=0.9)],
+                         ids=["30 m/min", "54 m/min"])
+def test_samples_at_and_a_rounding_error_around_the_heel_strike(solved: SolveFn,
+                                                                options: GaitOptions) -> None:
+    """A sample at the heel-strike instant, and one a rounding error before it, hold the
+    pre-impact velocity (single support); one a rounding error after it holds the post-impact
+    velocity (double support). verify assigns them so and passes."""
+    gait = solved(options).gait
+    strike = next(e for e in gait.events if e.name == "heel_strike")
+    assert gait.phases[0].t[-1] == strike.t
+    t, at = _times_around(gait.samples.t, strike.t)
+    resampled = _resampled(gait, t)
+    s = resampled.samples
+    for side in ("before", "at"):
+        np.testing.assert_allclose(s.qd[at[side]], strike.qd_before, atol=1e-6)
+    np.testing.assert_allclose(s.qd[at["after"]], strike.qd_after, atol=1e-6)
+    assert np.max(np.abs(strike.qd_after - strike.qd_before)) > 0.01  # a real jump
+    report = verify_gait(resampled)
+    assert report.passed, [(c.id, c.value, c.where) for c in report.checks if not c.passed]
 
 
 def test_fast_gait_forces_between_knots_are_non_negative(solved: SolveFn,
                                                          reference: RefFn) -> None:
     """The 30 m/min gait's normal forces, recomputed with Pinocchio on the dense samples of
     each phase (single support: t <= heel strike; double support: t > heel strike), are
-    non-negative. Its samples include one at the heel-strike instant, holding the
-    pre-impact velocity (it belongs to single support)."""
+    non-negative, with a sample placed exactly at the heel-strike instant (it holds the
+    pre-impact velocity and belongs to single support)."""
     gait = solved(FAST).gait
     assert gait.success
     ref = reference(gait.model)
-    s = gait.samples
     strike = next(e for e in gait.events if e.name == "heel_strike")
-    at_strike = np.flatnonzero(np.abs(s.t - strike.t) < 1e-12)
-    assert at_strike.size == 1
-    np.testing.assert_allclose(s.qd[at_strike[0]], strike.qd_before, atol=1e-9)
-    lowest = lowest_sample_normal_force(ref, gait)
+    t, at = _times_around(gait.samples.t, strike.t)
+    resampled = _resampled(gait, t)
+    s = resampled.samples
+    lowest = lowest_sample_normal_force(ref, resampled)
     assert lowest >= -1e-3
     # Double-support forces at the pre-impact sample are what a check must not use.
-    wrong = contact_forces(ref, s.q[at_strike[0]], s.qd[at_strike[0]], s.u[at_strike[0]],
+    wrong = contact_forces(ref, s.q[at["at"]], s.qd[at["at"]], s.u[at["at"]],
                            ("tip_1", "tip_2"))
     assert np.min(wrong[:, 1]) < -100.0
     assert {ph.name for ph in gait.phases} == {SINGLE, DOUBLE}
 
 
-def test_a_sample_a_rounding_error_after_the_heel_strike_is_in_double_support(
-        solved: SolveFn) -> None:
-    """At 54 m/min (ankle + impulse) a dense sample lies 6e-17 s after the heel strike: the
-    record evaluated it in double support (post-impact velocity), and verify must too."""
-    gait = solved(GaitOptions.paper(speed=0.9)).gait
-    s, strike = gait.samples, gait.phases[0].t[-1]
-    k = int(np.argmin(np.abs(s.t - strike)))
-    assert 0.0 < s.t[k] - strike < 1e-12
-    np.testing.assert_allclose(s.qd[k], gait.events[0].qd_after, atol=1e-9)
-    report = verify_gait(gait)
-    assert report.passed, [(c.id, c.value, c.where) for c in report.checks if not c.passed]
-
-
 def test_verify_passes_on_the_fast_gait(solved: SolveFn) -> None:
     report = verify_gait(solved(FAST).gait)
     assert report.passed, [(c.id, c.value, c.where) for c in report.checks if not c.passed]
-    assert report.check("samples.normal_force").value == 0.0
+    # Between knots the normal forces may dip by the solve's interior-point leftover (about
+    # 1e-5 N); 1 mN is far from it and far below the check's limit.
+    assert report.check("samples.normal_force").value < 1e-3
 
 
 # -- the ids are documented and used ------------------------------------------------------------

@@ -99,7 +99,7 @@ def test_step_time_fixed_with_the_speed_given_and_free(
     timed = solved(GaitOptions.paper(step_time=0.75)).gait
     by_length = solved(GaitOptions.paper(step_length=0.15)).gait
     assert timed.success and timed.step_length == pytest.approx(0.15, abs=1e-9)
-    assert timed.cost_value == pytest.approx(by_length.cost_value, rel=1e-6)
+    assert timed.cost_value == pytest.approx(by_length.cost_value, rel=1e-5)
     walk = solved(GaitOptions.paper(speed=None, step_time=0.8)).gait
     assert walk.success
     assert walk.parameters["step_time"] == pytest.approx(0.8, abs=1e-7)
@@ -158,7 +158,7 @@ def test_single_support_fraction_one_has_no_double_support(
     assert v1[1] >= -1e-9
     acting = ("hip_1", "knee_1", "hip_2", "knee_2")
     state, control = periodicity_errors(gait, controls=acting)
-    assert state < 1e-7 and control < 1e-7
+    assert state < 1e-6 and control < 1e-6  # 10 x the solve's tol 1e-7
     assert_physics(ref, gait)
     _verified(gait)
 
@@ -168,7 +168,7 @@ def test_periodic_states_only(solved: SolveFn, default_gait: Gait, reference: Re
     assert gait.success
     acting = control_names(gait.model, SINGLE, ankle=True)
     state, control = periodicity_errors(gait, controls=acting)
-    assert state < 1e-7
+    assert state < 1e-6
     # Dropping control periodicity relaxes the problem, and the optimum uses that freedom.
     assert control > 1e-2
     assert gait.cost_value <= default_gait.cost_value * (1 - 1e-3)

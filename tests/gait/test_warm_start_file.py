@@ -27,7 +27,7 @@ def test_warm_start_from_a_file_restarts_with_its_multipliers(
     first = warm.solver["stages"][0]
     assert first["name"] == "warm start" and first["success"]
     assert first["iterations"] <= 20  # 41 from the trajectories alone (measured)
-    assert warm.cost_value == pytest.approx(cold.cost_value, rel=1e-6)
+    assert warm.cost_value == pytest.approx(cold.cost_value, rel=1e-5)
 
 
 def test_the_restart_point_is_used_only_where_it_fits(default_gait_file: Path) -> None:
