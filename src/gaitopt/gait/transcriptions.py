@@ -30,6 +30,7 @@ from gaitopt.fileio import write_bytes_atomic
 from gaitopt.gait.formulation import problem_for
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.ocp import Guess, Result, Transcription, WarmStart, transcribe
+from gaitopt.process_memory import memory_budget_bytes, release_freed_memory, resident_bytes
 from gaitopt.robot.model import RobotModel
 
 #: A grid: knots per phase (single support, double support), uniform, or one array of
@@ -85,25 +86,22 @@ class NlpStructure:
                    options=tuple(shaping))
 
 
+#: The process-wide cache, the least recently used first. It keeps the process within its
+#: memory budget (:func:`gaitopt.process_memory.memory_budget_bytes`, ``$GAITOPT_MEMORY_MB``):
+#: a transcription evaluated as one expanded SX graph (the compressed form, whose exact Hessian
+#: of the whole mesh is derived) takes 0.2-0.6 GB once its solver is built on the walk's
+#: small grids and 1.28 GB for the five-link walk in full coordinates on 40 + 10 knots, where a
+#: point-wise one takes 5-16 MB; a count of entries suits neither. Sweeps reuse the entries
+#: point after point, so an entry goes only when a new one is made while the process is over
+#: its budget.
 _CACHE: dict[NlpStructure, Transcription] = {}
-#: How many large transcriptions evaluated as one expanded SX graph (the compressed form:
-#: the exact Hessian of the whole mesh is derived) this process keeps, the least recently
-#: used going first. Such a transcription of the five-link walk in full coordinates on
-#: 40 + 10 knots takes 1.28 GB once its solver is built (0.4-0.6 GB on 16 + 6 knots), where a
-#: point-wise one takes 5-16 MB: a process that solved several variants kept them all. The
-#: four variants of tests/gait/test_full_coordinates.py's fine-grid comparison (compressed,
-#: 40 + 10, checked on 60 + 15) peaked at 13.0 GB, with this bound at 5.8 GB, in the same
-#: 207 s. Smaller ones (:data:`LARGE_EXPANDED`) and point-wise ones are all kept: sweeps
-#: reuse them point after point.
-MAX_LARGE_EXPANDED = 2
-#: The NLP size (variables) from which an expanded transcription counts as large: the
-#: paper's 8 + 5 grid has 183-481, a 16 + 6 grid 300-800 (reduced, full).
-LARGE_EXPANDED = 1000
 
 
 def clear_cache() -> None:
-    """Forget every cached transcription (a benchmark's fresh start)."""
+    """Forget every cached transcription (a benchmark's fresh start) and hand the freed
+    memory back to the system."""
     _CACHE.clear()
+    release_freed_memory()
 
 
 def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
@@ -215,17 +213,22 @@ def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,
             build_solver=False, functions=functions)
         if functions is None:
             save_functions(path, _CACHE[key].functions)
-        _forget_large_expanded()
+        _keep_within_budget(key)
     return _CACHE[key]
 
 
-def _forget_large_expanded() -> None:
-    """Drop the least recently used large expanded transcriptions beyond
-    :data:`MAX_LARGE_EXPANDED` (a caller still holding one keeps it alive)."""
-    large = [k for k, tr in _CACHE.items()
-             if k.compiled != "points" and tr.layout.size >= LARGE_EXPANDED]
-    for k in large[:max(0, len(large) - MAX_LARGE_EXPANDED)]:
-        del _CACHE[k]
+def _keep_within_budget(newest: NlpStructure) -> None:
+    """While the process's resident memory exceeds its budget, drop the least recently used
+    transcription other than ``newest`` and hand the freed memory back to the system (a
+    caller still holding one keeps it alive)."""
+    budget = memory_budget_bytes()
+    if resident_bytes() <= budget:
+        return
+    for key in [k for k in _CACHE if k != newest]:
+        del _CACHE[key]
+        release_freed_memory()
+        if resident_bytes() <= budget:
+            return
 
 
 def cosine_knots(n: int) -> np.ndarray:
