@@ -23,6 +23,7 @@ import os
 import resource
 import sys
 import warnings
+from collections.abc import Callable
 
 #: The default budget of resident memory, MB, within which the caches keep the process (one
 #: solve's own working memory may exceed it for its duration).
@@ -66,14 +67,16 @@ def memory_budget_bytes() -> int:
 
 
 @functools.cache
-def _malloc_trim() -> ctypes._CFuncPtr | None:  # type: ignore[name-defined]
+def _malloc_trim() -> Callable[[int], int] | None:
+    """glibc's ``malloc_trim``, or ``None`` where the C library has none."""
     name = ctypes.util.find_library("c")
     if name is None:
         return None
     try:
-        return ctypes.CDLL(name).malloc_trim  # type: ignore[no-any-return]
+        trim: Callable[[int], int] = ctypes.CDLL(name).malloc_trim
     except (OSError, AttributeError):  # not glibc
         return None
+    return trim
 
 
 def release_freed_memory() -> None:
