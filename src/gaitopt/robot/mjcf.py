@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,12 +47,13 @@ from numpy.typing import NDArray
 
 from gaitopt.robot.errors import ModelError
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf import ContactSpec
 from gaitopt.robot.urdf_plane import IN_PLANE, PLANE
 
 __all__ = ["CoordinateMap", "MjcfImport", "import_mjcf", "is_mjcf", "model_from_mjcf"]
 
+#: The start of an MJCF file: an XML declaration and comments, then ``<mujoco``.
+_MJCF_START = re.compile(r"\A(?:\ufeff)?\s*(?:<\?.*?\?>\s*|<!--.*?-->\s*)*<mujoco\b", re.S)
 INSTALL_HINT = "pip install 'gaitopt[mujoco]'"
 #: A hinge that is not limited gets these bounds (one turn each way), as a URDF continuous joint.
 UNLIMITED = (-2.0 * math.pi, 2.0 * math.pi)
@@ -69,19 +71,16 @@ def _mujoco(label: str) -> Any:
 
 
 def is_mjcf(path: str | os.PathLike[str]) -> bool:
-    """Whether a file is MJCF: its name ends in ``.xml`` or its root element is ``<mujoco``."""
-    if os.fspath(path).lower().endswith(".xml"):
-        return True
+    """Whether a file is MJCF: its root element is ``<mujoco`` (after an XML declaration and
+    comments), or it is empty or cannot be read and its name ends in ``.xml``."""
     try:
         with open(path, "rb") as f:
             head = f.read(4096).decode("utf-8", "replace")
     except OSError:
-        return False
-    while head.lstrip().startswith(("<?", "<!--")):  # an XML declaration or a comment
-        head = head.lstrip()
-        head = head[head.find("?>" if head.startswith("<?") else "-->") + 2:] if (
-            "?>" in head or "-->" in head) else ""
-    return head.lstrip().startswith("<mujoco")
+        head = ""
+    if _MJCF_START.match(head) is not None:
+        return True
+    return not head.strip() and os.fspath(path).lower().endswith(".xml")
 
 
 @dataclass(frozen=True)
