@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from gaitopt.robot.errors import ModelError
 from gaitopt.robot.mjcf import UNLIMITED, CoordinateMap, MjcfImport
 from gaitopt.robot.schema import model_from_dict
+from gaitopt.robot.symmetry import SymmetryError, model_symmetry
 from gaitopt.robot.urdf import ContactSpec
 from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP, direction_and_length, link_point
 
@@ -217,6 +218,10 @@ class Builder:
         model = model_from_dict(data, source=self.label)
         armature = tuple(float(m.dof_armature[d]) for d in cmap.dof_index)
         self.dropped(cmap)
+        try:
+            self.notes.append(f"symmetry: {model_symmetry(model).describe()}")
+        except SymmetryError as exc:
+            self.notes.append(f"symmetry: none ({exc})")
         return MjcfImport(model, cmap, armature, tuple(self.notes))
 
     def link_parts(self, link: Link) -> tuple[float, Vec, float]:
