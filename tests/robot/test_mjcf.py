@@ -241,3 +241,53 @@ def test_mjcf_is_recognised(tmp_path: Path) -> None:
     urdf.write_text("<robot name='r'/>")
     assert is_mjcf(DM_WALKER) and is_mjcf(renamed) and is_mjcf(tmp_path / "missing.xml")
     assert not is_mjcf(urdf) and not is_mjcf(tmp_path / "missing.urdf")
+
+
+def test_inferred_heels_and_toes_sit_on_the_foot_capsules(
+        imported: tuple[Path, MjcfImport]) -> None:
+    # heel_k and toe_k are the ends of the bottom line of foot k's capsule at qpos0: at any
+    # state, in the capsule's own frame (axis z, half length h, radius r), they lie at z = -h
+    # and +h (either way round) and at distance r from the axis.
+    path, imp = imported
+    model = imp.model
+    assert [c.name for c in model.contacts] == ["heel_1", "toe_1", "heel_2", "toe_2"]
+    assert model.symmetry is not None
+    assert model.symmetry.contacts == (("heel_1", "heel_2"), ("toe_1", "toe_2"))
+    for q, qd in random_states(model.nq, seed=3)[:10]:
+        m, d = mujoco_state(path, imp, q, qd)
+        for c in model.contacts:
+            b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, c.link)
+            g = next(i for i in range(m.ngeom) if m.geom_bodyid[i] == b)
+            r, h = m.geom_size[g][:2]
+            x, z = np.asarray(point_position(model, q, c.link,
+                                             model.link(c.link).local_point(*c.at))).ravel()
+            world = np.array([x, d.geom_xpos[g][1], z])
+            local = d.geom_xmat[g].reshape(3, 3).T @ (world - d.geom_xpos[g])
+            assert abs(abs(local[2]) - h) < 1e-12 and abs(np.hypot(*local[:2]) - r) < 1e-12
+
+
+def test_cli_imports_walker2d_and_prints_what_it_assumed(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from gaitopt.cli import cli
+    from gaitopt.robot import load_model
+
+    out = tmp_path / "walker2d.yaml"
+    result = CliRunner().invoke(cli, ["model", "import", str(walker2d_path()), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[:2] == [f"wrote {out}", "model walker2d: 7 links, 4 contact points, 6 "
+                         "actuators, total mass 23.6771 kg"]
+    for start in ("base: torso", "contacts: heel_1 at (0, -0.06), toe_1 at (0.2, -0.06)",
+                  "actuators: 6 motors", "armature: dropped", "damping: dropped",
+                  "symmetry: thigh <-> thigh_left"):
+        assert any(line.startswith(start) for line in lines), (start, lines)
+    assert load_model(out) == import_mjcf(walker2d_path()).model
+    result = CliRunner().invoke(cli, ["model", "import", str(walker2d_path()), "-o", "-",
+                                      "--contact", "tip=foot:-0.2,0.1"])
+    assert result.exit_code == 0, result.output
+    assert "contacts: from --contact (the geoms are not used): tip on foot" in result.stderr
+    assert "name: tip" in result.stdout and "heel_1" not in result.stdout
+    assert "at: [0.0, 0.0]" in result.stdout  # (-0.2, 0.1) in the foot body: the ankle
+    result = CliRunner().invoke(cli, ["model", "import", str(tmp_path / "none.xml")])
+    assert result.exit_code == 2 and "MuJoCo cannot compile it" in result.output

@@ -209,17 +209,27 @@ class Builder:
         if len(coords) != m.nv:
             raise self.fail("", m.nv, f"{len(coords)} degrees of freedom (those of the robot)",
                             problem=f"{m.nv - len(coords)} degrees of freedom outside it")
-        from gaitopt.robot.mjcf_contacts import contact_points
+        from gaitopt.robot.mjcf_contacts import contact_points, leg_symmetry
 
-        contacts = contact_points(self, links, link_of, specs)
+        contacts = contact_points(self, links, link_of, specs, name)
         data = self.to_dict(links, contacts, name)
         data["actuators"] = self.actuators(links, cmap)
         data["gravity"] = self.gravity()
+        symmetry = None if specs else leg_symmetry(data)
         model = model_from_dict(data, source=self.label)
+        if symmetry is not None:
+            try:
+                model = model_from_dict({**data, "symmetry": symmetry}, source=self.label)
+            except ModelError as exc:  # the legs' actuators do not pair up
+                self.notes.append(f"symmetry: not declared ({exc.args[0].split(': ', 2)[-1]})")
         armature = tuple(float(m.dof_armature[d]) for d in cmap.dof_index)
         self.dropped(cmap)
         try:
-            self.notes.append(f"symmetry: {model_symmetry(model).describe()}")
+            how = model_symmetry(model).describe()
+            if model.symmetry is not None:  # declared here, not in the MJCF file
+                how = how.replace("declared in the model file", "declared by the import: "
+                                  "the two legs from the base to the feet with contacts")
+            self.notes.append(f"symmetry: {how}")
         except SymmetryError as exc:
             self.notes.append(f"symmetry: none ({exc})")
         return MjcfImport(model, cmap, armature, tuple(self.notes))

@@ -1,25 +1,43 @@
-"""Contact points of the MJCF import: from ``--contact NAME=BODY:X,Z`` or inferred from the
-foot geoms (the leaf links' capsules, spheres, boxes and cylinders as planar shapes)."""
+"""Contact points of the MJCF import: from ``--contact NAME=BODY:X,Z``, or inferred from the
+foot geoms by :func:`gaitopt.robot.contact_inference.infer_contacts`.
+
+The geoms of the bodies that make up a leaf link (a link no other link hangs from) become
+planar shapes in that link's gaitopt frame (x, y in m, origin at its joint, parallel to the
+world at ``qpos0``), from MuJoCo's ``geom_xpos`` and ``geom_xmat`` at ``qpos0`` (so
+``geom_pos``, ``geom_quat`` and ``fromto`` as compiled) and ``geom_size``:
+
+- a sphere, or a capsule or cylinder whose axis is the plane normal: a :class:`Circle`;
+- a capsule whose axis lies in the plane: a :class:`Capsule` (ends ``c +- h a``, a its axis);
+- a cylinder whose axis lies in the plane: a :class:`Rectangle` with half sizes ``(h, r)``;
+- a box with one axis along the normal: a :class:`Rectangle` with the other two half sizes.
+
+Anything else (a mesh, an ellipsoid, a shape tilted out of the plane) is skipped with a note,
+and so are visual geoms (``contype`` and ``conaffinity`` both 0).
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import math
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gaitopt.robot.contact_inference import Capsule, Circle, Rectangle, Shape, infer_contacts
+from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf import ContactSpec
+from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP
 
 if TYPE_CHECKING:
     from gaitopt.robot.mjcf_build import Builder, Link, Vec
 
 
 def contact_points(builder: Builder, links: list[Link], link_of: dict[int, int],
-                   specs: list[ContactSpec]) -> list[tuple[str, int, Vec]]:
+                   specs: list[ContactSpec], name: str | None) -> list[tuple[str, int, Vec]]:
     """``(name, link index, gaitopt (x, y) relative to the link origin)`` per contact point:
-    the ``specs`` when given (a point ``(X, Z)`` m in MuJoCo body BODY's frame), else none."""
+    the ``specs`` when given (a point ``(X, Z)`` m in MuJoCo body BODY's frame), else those
+    inferred from the leaf links' geoms (the module docstring)."""
     if not specs:
-        builder.notes.append("contacts: none (give them with --contact NAME=BODY:X,Z)")
-        return []
+        return inferred(builder, links, link_of, name)
     m, d, mj = builder.m, builder.d, builder.mj
     out: list[tuple[str, int, Vec]] = []
     for spec in specs:
@@ -36,6 +54,95 @@ def contact_points(builder: Builder, links: list[Link], link_of: dict[int, int],
         world = d.xpos[b] + d.xmat[b].reshape(3, 3) @ local
         k = link_of[b]
         out.append((spec.name, k, builder.xy(world - links[k].origin)))
-    builder.notes.append("contacts: from --contact: " + ", ".join(
+    builder.notes.append("contacts: from --contact (the geoms are not used): " + ", ".join(
         f"{s.name} on {s.link}" for s in specs))
     return out
+
+
+def inferred(builder: Builder, links: list[Link], link_of: dict[int, int], name: str | None
+             ) -> list[tuple[str, int, Vec]]:
+    """The contact points :func:`infer_contacts` finds on the leaf links' geoms."""
+    m = builder.m
+    parents = {link.parent for link in links}
+    leaves = {b: k for b, k in link_of.items() if k not in parents}
+    shapes: list[Shape] = []
+    skipped: list[str] = []
+    for g in range(m.ngeom):
+        k = leaves.get(int(m.geom_bodyid[g]))
+        if k is None or (m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0):
+            continue
+        shape = geom_shape(builder, g, links[k])
+        if isinstance(shape, str):
+            skipped.append(f"{builder.name('geom', g)} ({shape})")
+        else:
+            shapes.append(shape)
+    model = model_from_dict(builder.to_dict(links, [], name), source=builder.label)
+    found = infer_contacts(model, shapes, source=builder.label)
+    builder.notes.extend(f"contacts: {line}" for line in found.lines())
+    if skipped:
+        builder.notes.append(f"contacts: geoms skipped (not a planar sphere, capsule, cylinder "
+                             f"or box): {', '.join(skipped)}")
+    if not found.contacts:
+        builder.notes.append("contacts: none (give them with --contact NAME=BODY:X,Z)")
+    index = {link.name: k for k, link in enumerate(links)}
+    return [(c.name, index[c.link], np.array(model.link(c.link).local_point(*c.at)))
+            for c in found.contacts]
+
+
+def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
+    """Geom ``g`` as a planar shape in ``link``'s gaitopt frame, or why it cannot be one."""
+    m, d, mj = builder.m, builder.d, builder.mj
+    kind = int(m.geom_type[g])
+    size = m.geom_size[g]
+    center = builder.xy(d.geom_xpos[g] - link.origin)
+    c = (float(center[0]), float(center[1]))
+    axes = builder.plane @ d.geom_xmat[g].reshape(3, 3)  # columns: the geom's axes, gaitopt
+    axes = np.where(np.abs(axes) < SNAP, 0.0, axes)      # rounding dust of the quaternion
+    normal = [abs(abs(float(axes[2, i])) - 1.0) <= AXIS_TOL for i in range(3)]
+    in_plane = [abs(float(axes[2, i])) <= AXIS_TOL for i in range(3)]
+    geom = mj.mjtGeom
+    if kind == int(geom.mjGEOM_SPHERE):
+        return Circle(link.name, c, float(size[0]))
+    if kind in (int(geom.mjGEOM_CAPSULE), int(geom.mjGEOM_CYLINDER)):
+        r, h = float(size[0]), float(size[1])
+        if normal[2]:
+            return Circle(link.name, c, r)
+        if not in_plane[2]:
+            return "its axis is tilted out of the plane"
+        a = axes[:2, 2]
+        if kind == int(geom.mjGEOM_CAPSULE):
+            ends = tuple((float(center[0] + s * h * a[0]), float(center[1] + s * h * a[1]))
+                         for s in (-1.0, 1.0))
+            return Capsule(link.name, (ends[0], ends[1]), r)
+        return Rectangle(link.name, c, (h, r), math.atan2(float(a[1]), float(a[0])))
+    if kind == int(geom.mjGEOM_BOX):
+        if not any(normal):
+            return "no axis along the plane normal"
+        i, j = (n for n in range(3) if not normal[n])
+        return Rectangle(link.name, c, (float(size[i]), float(size[j])),
+                         math.atan2(float(axes[1, i]), float(axes[0, i])))
+    return mj.mjtGeom(kind).name[7:].lower()
+
+
+def leg_symmetry(data: dict[str, Any]) -> dict[str, list[list[str]]] | None:
+    """The left/right symmetry of inferred contacts (heel_1/toe_1 on one leg, heel_2/toe_2 on
+    the other, which gaitopt cannot infer from the first two contacts): the links of the two
+    chains from the base to the two links carrying contacts, paired in order, and the contacts
+    paired in order; None unless there are two such chains, separate and of equal length,
+    with as many contacts each."""
+    parent = {link["name"]: link["parent"] for link in data["links"]}
+    carriers = list(dict.fromkeys(c["link"] for c in data["contacts"]))
+    if len(carriers) != 2:
+        return None
+    chains = []
+    for leaf in carriers:
+        chain = [leaf]
+        while parent[chain[-1]] is not None and parent[parent[chain[-1]]] is not None:
+            chain.append(parent[chain[-1]])
+        chains.append(chain[::-1])
+    names = [[c["name"] for c in data["contacts"] if c["link"] == leaf] for leaf in carriers]
+    if (len(chains[0]) != len(chains[1]) or set(chains[0]) & set(chains[1])
+            or len(names[0]) != len(names[1])):
+        return None
+    return {"links": [list(p) for p in zip(*chains, strict=True)],
+            "contacts": [list(p) for p in zip(*names, strict=True)]}
