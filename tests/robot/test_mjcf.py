@@ -35,10 +35,17 @@ def imported(request: pytest.FixtureRequest) -> tuple[Path, MjcfImport]:
     return path, import_mjcf(path)
 
 
-def mujoco_state(path: Path, imp: MjcfImport, q: np.ndarray, qd: np.ndarray
+def compiled(source: Path | str) -> object:
+    """MuJoCo's model of a file or of MJCF text."""
+    if isinstance(source, Path):
+        return mujoco.MjModel.from_xml_path(str(source))
+    return mujoco.MjModel.from_xml_string(source)
+
+
+def mujoco_state(source: Path | str, imp: MjcfImport, q: np.ndarray, qd: np.ndarray
                  ) -> tuple[object, object]:
     """MuJoCo's model and data after ``mj_forward`` at gaitopt's (q, qd)."""
-    m = mujoco.MjModel.from_xml_path(str(path))
+    m = compiled(source)
     d = mujoco.MjData(m)
     d.qpos[:] = imp.coordinates.qpos_from_q(q)
     d.qvel[:] = imp.coordinates.qvel_from_qd(qd)
@@ -56,19 +63,25 @@ def random_states(nq: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def test_mass_matrix_and_bias_equal_mujocos(imported: tuple[Path, MjcfImport]) -> None:
-    # M + diag(armature) = P M_mujoco P^T and bias = P qfrc_bias (armature is dropped)
-    path, imp = imported
+def dynamics_errors(source: Path | str, imp: MjcfImport) -> tuple[float, float]:
+    """The largest entry of ``M + diag(armature) - P M_mujoco P^T`` and of
+    ``bias - P qfrc_bias`` over the random states (armature is dropped by the import)."""
     p = imp.coordinates.velocity_matrix()
     worst_m = worst_b = 0.0
     for q, qd in random_states(imp.model.nq, seed=24):
-        m, d = mujoco_state(path, imp, q, qd)
+        m, d = mujoco_state(source, imp, q, qd)
         full = np.zeros((m.nv, m.nv))
         mujoco.mj_fullM(m, d, full)
         ours = np.asarray(crba(imp.model, q)) + np.diag(imp.armature)
         worst_m = max(worst_m, float(np.max(np.abs(ours - p @ full @ p.T))))
         bias = np.asarray(bias_forces(imp.model, q, qd)).ravel()
         worst_b = max(worst_b, float(np.max(np.abs(bias - p @ d.qfrc_bias))))
+    return worst_m, worst_b
+
+
+def test_mass_matrix_and_bias_equal_mujocos(imported: tuple[Path, MjcfImport]) -> None:
+    path, imp = imported
+    worst_m, worst_b = dynamics_errors(path, imp)
     print(f"{path.name}: max |M error| {worst_m:.2e}, max |bias error| {worst_b:.2e}")
     assert worst_m <= 1e-9 and worst_b <= 1e-9
 
@@ -291,3 +304,22 @@ def test_cli_imports_walker2d_and_prints_what_it_assumed(tmp_path: Path) -> None
     assert "at: [0.0, 0.0]" in result.stdout  # (-0.2, 0.1) in the foot body: the ankle
     result = CliRunner().invoke(cli, ["model", "import", str(tmp_path / "none.xml")])
     assert result.exit_code == 2 and "MuJoCo cannot compile it" in result.output
+
+
+def test_axis_x_armature_and_a_static_body() -> None:
+    # The same one-legged robot turned to walk along -y (hinges about x, plane y-z), with
+    # armature on the hip and an obstacle fixed to the world: the dynamics still equal
+    # MuJoCo's, the armature is reported per coordinate and the obstacle is not the robot.
+    text = (one_leg().replace('axis="1 0 0"/>', 'axis="0 -1 0"/>')
+            .replace('<joint name="rooty" type="hinge" axis="0 1 0"/>',
+                     '<joint name="rooty" type="hinge" axis="1 0 0"/>')
+            .replace('axis="0 1 0" range', 'axis="-1 0 0" armature="0.02" range')
+            .replace('pos="0 0.1 -0.2"', 'pos="0.1 0.05 -0.2"')
+            .replace("<worldbody>", '<worldbody><body name="obstacle" pos="2 0 0">'
+                     '<geom type="box" size="0.1 0.1 0.1"/></body>'))
+    imp = import_mjcf(text, axis="x")
+    assert imp.coordinates.sign == (1.0, 1.0, -1.0, 1.0)
+    assert imp.armature == (0.0, 0.0, 0.0, 0.02)
+    assert "static bodies (fixed to the world, not the robot): obstacle" in imp.notes
+    worst_m, worst_b = dynamics_errors(text, imp)
+    assert worst_m <= 1e-9 and worst_b <= 1e-9

@@ -51,12 +51,13 @@ def merge_parts(parts: Sequence[tuple[float, Vec, float]]) -> tuple[float, Vec, 
     return mass, com, sum(ik + mk * float(np.sum((ck - com) ** 2)) for mk, ck, ik in parts)
 
 
-def _values(values: dict[str, float], unit: str) -> str:
-    """``0.01 kg m^2 on a, b; 0.02 kg m^2 on c`` (joints grouped by value, in order)."""
-    groups: dict[float, list[str]] = {}
+def _values(values: dict[str, float] | dict[str, str], unit: str) -> str:
+    """``0.01 kg m^2 on a, b; 0.02 kg m^2 on c`` (names grouped by value, in order)."""
+    groups: dict[float | str, list[str]] = {}
     for name, v in values.items():
         groups.setdefault(v, []).append(name)
-    return "; ".join(f"{v:g} {unit} on {', '.join(names)}" for v, names in groups.items())
+    return "; ".join(f"{v if isinstance(v, str) else format(v, 'g')} {unit} on "
+                     f"{', '.join(names)}" for v, names in groups.items())
 
 
 class Builder:
@@ -148,14 +149,24 @@ class Builder:
         return b, sorted(coords, key=lambda c: c[1])
 
     def base_note(self, base: int, coords: list[tuple[int, int, float, float]]) -> str:
-        """``base: torso (rootx -> x, rootz -> y, rooty -> angle = -rooty)``."""
-        parts = []
-        for j, k, sign, _ in coords:
-            q = self.name("joint", j)
-            target = ("x", "y", "angle")[k]
-            parts.append(f"{target} = {'' if sign > 0 else '-'}{q}")
-        return (f"base: {self.name('body', base)}, the floating base ({', '.join(parts)}; "
-                "offsets: its origin at qpos0, the root hinge's anchor)")
+        """``base: torso (x = rootx, y = rootz, angle = -rooty; ...)``."""
+        parts = [f"{('x', 'y', 'angle')[k]} = {'' if sign > 0 else '-'}{self.name('joint', j)}"
+                 for j, k, sign, _ in coords]
+        x, y = (coords[0][3], coords[1][3])
+        return (f"base: {self.name('body', base)} ({', '.join(parts)}; its origin is "
+                f"{self.name('joint', coords[2][0])}'s anchor, at ({x:g}, {y:g}) m at qpos0)")
+
+    def joints_note(self, coords: list[tuple[int, int, float, float]]) -> str:
+        """``joints: 6 hinges; about -y (angle = qpos - qpos0): a, b; about +y ...``."""
+        groups: dict[float, list[str]] = {1.0: [], -1.0: []}
+        for j, _, sign, _ in coords:
+            groups[sign].append(self.name("joint", j))
+        parts = [f"about -{self.axis} (angle = qpos - qpos0; limits and torques as MuJoCo's): "
+                 f"{', '.join(groups[1.0])}"] if groups[1.0] else []
+        if groups[-1.0]:
+            parts.append(f"about +{self.axis} (angles, limits and torques change sign): "
+                         f"{', '.join(groups[-1.0])}")
+        return f"joints: {len(coords)} hinges; " + "; ".join(parts)
 
     # -- the model ---------------------------------------------------------------------------
     def build(self, specs: list[ContactSpec], name: str | None) -> MjcfImport:
@@ -200,6 +211,12 @@ class Builder:
                 "name": self.name("joint", j), "at": at, "limits": [lo, hi]}))
             link_of[b] = len(links) - 1
             coords.append((j, len(coords), sign, 0.0))
+        self.notes.append(self.joints_note(coords[3:]))
+        static = [self.name("body", b) for b in range(1, m.nbody)
+                  if b not in link_of and b not in self.ancestors(base)]
+        if static:
+            self.notes.append(f"static bodies (fixed to the world, not the robot): "
+                              f"{', '.join(static)}")
         cmap = CoordinateMap(
             names=tuple(self.name("joint", j) for j, _, _, _ in coords),
             qpos_index=tuple(int(m.jnt_qposadr[j]) for j, _, _, _ in coords),
@@ -283,7 +300,7 @@ class Builder:
         m, mj = self.m, self.mj
         coord_of = {cmap.dof_index[i]: i for i in range(3, len(cmap.sign))}
         out: list[dict[str, Any]] = []
-        shown = []
+        shown: dict[str, str] = {}
         for a in range(m.nu):
             name = self.name("actuator", a)
             j = int(m.actuator_trnid[a, 0])
@@ -316,9 +333,9 @@ class Builder:
             bounds = sorted((scale * lo + 0.0, scale * hi + 0.0))
             out.append({"name": name if name != f"actuator{a}" else cmap.names[i],
                         "joint": cmap.names[i], "limits": bounds})
-            shown.append(f"{out[-1]['name']} [{bounds[0]:g}, {bounds[1]:g}]")
-        self.notes.append(f"actuators: {len(out)} motors, torque bounds gear x ctrlrange (N m): "
-                          + (", ".join(shown) or "none"))
+            shown[out[-1]["name"]] = f"[{bounds[0]:g}, {bounds[1]:g}]"
+        self.notes.append(f"actuators: {len(out)} motors on hinges, in MuJoCo's order, torque "
+                          "bounds gear x ctrlrange: " + (_values(shown, "N m") or "none"))
         return out
 
     def gravity(self) -> list[float]:
