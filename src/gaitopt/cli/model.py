@@ -146,9 +146,10 @@ def _write_output(text: str, output: Path | None, default: Path, force: bool) ->
               help="Model file to write; '-' for standard output (default: the URDF's name "
                    "with .yaml, here).")
 @click.option("--contact", "contacts", multiple=True, metavar="NAME=LINK:X,Z",
-              help="Add a contact point NAME on URDF link LINK at (X, Z) m in that link's "
-                   "frame (Y, Z with --axis x). Repeatable; contact frames that gaitopt "
-                   "exported are read back without it.")
+              help="Add a contact point NAME on URDF link (or MJCF body) LINK at (X, Z) m in "
+                   "that link's frame (Y, Z with --axis x). Repeatable; contact frames that "
+                   "gaitopt exported are read back without it; for MJCF it replaces the heel "
+                   "and toe points inferred from the foot geoms.")
 @click.option("--axis", type=click.Choice(["y", "x"]), default="y", show_default=True,
               help="The common joint axis: y (the sagittal plane is URDF x-z) or x (y-z).")
 @click.option("--name", help="Model name (default: the URDF robot's name).")

@@ -24,8 +24,8 @@ from gaitopt.robot.urdf import ContactSpec
 from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP, direction_and_length, link_point
 
 Vec = NDArray[np.float64]
-#: gaitopt x and y: which in-plane axis each base slide must move along.
-PLANE_AXES = ("x", "y")
+#: For each common hinge axis, the MuJoCo axes of gaitopt x and y: the base slides' axes.
+SLIDE_AXES = {"y": ("x", "z"), "x": ("y", "z")}
 
 
 @dataclass
@@ -119,8 +119,9 @@ class Builder:
         m, mj = self.m, self.mj
         roots = [b for b in range(1, m.nbody) if m.body_jntnum[b] > 0
                  and all(m.body_jntnum[a] == 0 for a in self.ancestors(b))]
-        allowed = (f"one body with two slide joints along x and z and then a hinge about "
-                   f"{self.axis} (the floating base), its descendants the robot")
+        along = SLIDE_AXES[self.axis]
+        allowed = (f"one body with two slide joints along {along[0]} and {along[1]} and then a "
+                   f"hinge about {self.axis} (the floating base), its descendants the robot")
         if len(roots) != 1:
             names = [self.name("body", b) for b in roots]
             raise self.fail("worldbody", names, allowed, problem=f"{len(roots)} bodies with "
@@ -141,7 +142,7 @@ class Builder:
             k = int(np.argmax(np.abs(g)))
             if k == 2 or abs(abs(g[k]) - 1.0) > AXIS_TOL:
                 raise self.fail(where, text, allowed, problem=f"slide "
-                                f"{self.name('joint', j)!r} is not along x or z")
+                                f"{self.name('joint', j)!r} is not along {along[0]} or {along[1]}")
             coords.append((j, k, 1.0 if g[k] > 0 else -1.0, float(origin[k])))
         if sorted(c[1] for c in coords) != [0, 1]:
             raise self.fail(where, text, allowed, problem="both slides along one axis")
@@ -238,7 +239,7 @@ class Builder:
             try:
                 model = model_from_dict({**data, "symmetry": symmetry}, source=self.label)
             except ModelError as exc:  # the legs' actuators do not pair up
-                self.notes.append(f"symmetry: not declared ({exc.args[0].split(': ', 2)[-1]})")
+                self.notes.append(f"symmetry: not declared ({exc})")
         armature = tuple(float(m.dof_armature[d]) for d in cmap.dof_index)
         self.dropped(cmap)
         try:
