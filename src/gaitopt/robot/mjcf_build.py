@@ -80,8 +80,12 @@ class Builder:
     def name(self, kind: str, i: int) -> str:
         """The MuJoCo name of object ``i`` of ``kind`` (body, joint, actuator, geom), or
         ``KIND<i>`` for an unnamed one."""
+        return self.given_name(kind, i) or f"{kind}{i}"
+
+    def given_name(self, kind: str, i: int) -> str | None:
+        """The MuJoCo name of object ``i`` of ``kind``, None if it has none."""
         obj = getattr(self.mj.mjtObj, f"mjOBJ_{kind.upper()}")
-        return self.mj.mj_id2name(self.m, obj, i) or f"{kind}{i}"
+        return self.mj.mj_id2name(self.m, obj, i) or None
 
     def xy(self, v: Vec) -> Vec:
         """gaitopt (x, y) of a MuJoCo world vector; rounding dust (|x| < SNAP m) becomes 0."""
@@ -332,7 +336,7 @@ class Builder:
             i = coord_of[dof]
             scale = cmap.sign[i] * float(m.actuator_gear[a, 0])
             bounds = sorted((scale * lo + 0.0, scale * hi + 0.0))
-            out.append({"name": name if name != f"actuator{a}" else cmap.names[i],
+            out.append({"name": self.given_name("actuator", a) or cmap.names[i],
                         "joint": cmap.names[i], "limits": bounds})
             shown[out[-1]["name"]] = f"[{bounds[0]:g}, {bounds[1]:g}]"
         self.notes.append(f"actuators: {len(out)} motors on hinges, in MuJoCo's order, torque "
