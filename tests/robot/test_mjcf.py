@@ -323,3 +323,25 @@ def test_axis_x_armature_and_a_static_body() -> None:
     assert "static bodies (fixed to the world, not the robot): obstacle" in imp.notes
     worst_m, worst_b = dynamics_errors(text, imp)
     assert worst_m <= 1e-9 and worst_b <= 1e-9
+
+
+def test_a_pitched_body_a_hinge_ref_and_a_welded_body() -> None:
+    # The leg body pitched 30 degrees about y (its frame is not the link's), its hinge with
+    # ref=20 degrees (qpos0 = 20 degrees: the angle is 0 there, the range is shifted) and
+    # a foot welded to it: still MuJoCo's dynamics, and the masses add.
+    text = (one_leg()
+            .replace('<body name="leg" pos="0 0.1 -0.2">',
+                     '<body name="leg" pos="0 0.1 -0.2" euler="0 30 0">')
+            .replace('range="-10 40"', 'range="-10 40" ref="20"')
+            .replace('size="0.04"/>', 'size="0.04"/><body name="foot" pos="0.1 0 -0.5">'
+                     '<geom type="box" size="0.1 0.03 0.02" euler="0 10 0"/></body>'))
+    imp = import_mjcf(text)
+    m = compiled(text)
+    leg = imp.model.link("leg")
+    assert leg.joint is not None
+    # about +y: gaitopt's angle is -(qpos - 20 deg), so [-10, 40] deg becomes [-20, 30] deg
+    np.testing.assert_allclose(leg.joint.limits, np.radians([-20.0, 30.0]), rtol=1e-14)
+    assert leg.mass == pytest.approx(float(m.body_mass[2] + m.body_mass[3]), rel=1e-15)
+    assert [link.name for link in imp.model.links] == ["torso", "leg"]
+    worst_m, worst_b = dynamics_errors(text, imp)
+    assert worst_m <= 1e-9 and worst_b <= 1e-9

@@ -18,12 +18,17 @@ from numpy.typing import NDArray
 
 from gaitopt.robot.errors import ModelError
 from gaitopt.robot.mjcf import UNLIMITED, CoordinateMap, MjcfImport
+from gaitopt.robot.model import BASE_ANGLE, BASE_COORDINATES
 from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.symmetry import SymmetryError, model_symmetry
 from gaitopt.robot.urdf import ContactSpec
 from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP, direction_and_length, link_point
 
 Vec = NDArray[np.float64]
+#: Rows of a plane matrix: gaitopt x and y (the plane) and z (its normal), as MuJoCo vectors.
+IN_PLANE_ROWS, NORMAL = slice(0, 2), 2
+#: The number of base coordinates (x, y, angle) at the start of q.
+N_BASE = len(BASE_COORDINATES)
 #: For each common hinge axis, the MuJoCo axes of gaitopt x and y: the base slides' axes.
 SLIDE_AXES = {"y": ("x", "z"), "x": ("y", "z")}
 
@@ -89,7 +94,7 @@ class Builder:
 
     def xy(self, v: Vec) -> Vec:
         """gaitopt (x, y) of a MuJoCo world vector; rounding dust (|x| < SNAP m) becomes 0."""
-        g = self.plane[:2] @ v + 0.0
+        g = self.plane[IN_PLANE_ROWS] @ v + 0.0
         return np.where(np.abs(g) < SNAP, 0.0, g)
 
     def joint_axis(self, j: int) -> Vec:
@@ -99,12 +104,16 @@ class Builder:
     def about_normal(self, j: int) -> float:
         """+1 for a hinge about gaitopt +z (MuJoCo -y), -1 about -z; else a ModelError."""
         g = self.joint_axis(j)
-        if abs(abs(g[2]) - 1.0) > AXIS_TOL:
+        if abs(abs(g[NORMAL]) - 1.0) > AXIS_TOL:
             raise self.fail(f"joint {self.name('joint', j)!r} axis",
                             " ".join(f"{x:.6g}" for x in self.m.jnt_axis[j]),
                             f"a hinge axis along +-{self.axis} in the world at qpos0 (the "
                             "common hinge axis; the robot is planar)")
-        return 1.0 if g[2] > 0 else -1.0
+        return 1.0 if g[NORMAL] > 0 else -1.0
+
+    def kind(self, j: int) -> str:
+        """``slide``, ``hinge``, ``ball`` or ``free``: joint ``j``'s type."""
+        return str(self.mj.mjtJoint(int(self.m.jnt_type[j])).name).removeprefix("mjJNT_").lower()
 
     def joints_of(self, b: int) -> list[int]:
         start = int(self.m.body_jntadr[b])
@@ -134,32 +143,32 @@ class Builder:
         joints = self.joints_of(b)
         kinds = [int(m.jnt_type[j]) for j in joints]
         slide, hinge = int(mj.mjtJoint.mjJNT_SLIDE), int(mj.mjtJoint.mjJNT_HINGE)
-        text = ", ".join(f"{self.name('joint', j)} ({mj.mjtJoint(k).name[6:].lower()})"
-                         for j, k in zip(joints, kinds, strict=True))
+        text = ", ".join(f"{self.name('joint', j)} ({self.kind(j)})" for j in joints)
         where = f"body {self.name('body', b)!r} joints"
         if kinds != [slide, slide, hinge]:
             raise self.fail(where, text, allowed, problem=f"got {text}")
         coords: list[tuple[int, int, float, float]] = []
-        origin = self.xy(self.d.xanchor[joints[2]])
-        for j in joints[:2]:
+        *slides, hinge_joint = joints
+        origin = self.xy(self.d.xanchor[hinge_joint])
+        for j in slides:
             g = self.joint_axis(j)
-            k = int(np.argmax(np.abs(g)))
-            if k == 2 or abs(abs(g[k]) - 1.0) > AXIS_TOL:
+            k = int(np.argmax(np.abs(g)))  # gaitopt x (0) or y (1), not the normal
+            if k == NORMAL or abs(abs(g[k]) - 1.0) > AXIS_TOL:
                 raise self.fail(where, text, allowed, problem=f"slide "
                                 f"{self.name('joint', j)!r} is not along {along[0]} or {along[1]}")
             coords.append((j, k, 1.0 if g[k] > 0 else -1.0, float(origin[k])))
         if sorted(c[1] for c in coords) != [0, 1]:
             raise self.fail(where, text, allowed, problem="both slides along one axis")
-        coords.append((joints[2], 2, self.about_normal(joints[2]), 0.0))
+        coords.append((hinge_joint, BASE_ANGLE, self.about_normal(hinge_joint), 0.0))
         return b, sorted(coords, key=lambda c: c[1])
 
     def base_note(self, base: int, coords: list[tuple[int, int, float, float]]) -> str:
         """``base: torso (x = rootx, y = rootz, angle = -rooty; ...)``."""
         parts = [f"{('x', 'y', 'angle')[k]} = {'' if sign > 0 else '-'}{self.name('joint', j)}"
                  for j, k, sign, _ in coords]
-        x, y = (coords[0][3], coords[1][3])
+        (_, _, _, x), (_, _, _, y), (hinge_joint, _, _, _) = coords
         return (f"base: {self.name('body', base)} ({', '.join(parts)}; its origin is "
-                f"{self.name('joint', coords[2][0])}'s anchor, at ({x:g}, {y:g}) m at qpos0)")
+                f"{self.name('joint', hinge_joint)}'s anchor, at ({x:g}, {y:g}) m at qpos0)")
 
     def joints_note(self, coords: list[tuple[int, int, float, float]]) -> str:
         """``joints: 6 hinges; about -y (angle = qpos - qpos0): a, b; about +y ...``."""
@@ -182,7 +191,8 @@ class Builder:
                             problem=f"{m.neq} equality constraint(s)")
         base, base_coords = self.base()
         self.notes.append(self.base_note(base, base_coords))
-        links = [Link(self.name("body", base), -1, self.d.xanchor[base_coords[2][0]].copy(),
+        root_hinge = base_coords[BASE_ANGLE][0]
+        links = [Link(self.name("body", base), -1, self.d.xanchor[root_hinge].copy(),
                       bodies=[base])]
         link_of = {base: 0}
         coords = list(base_coords)
@@ -199,9 +209,7 @@ class Builder:
                 continue
             j = joints[0]
             if len(joints) > 1 or m.jnt_type[j] != hinge:
-                kinds = ", ".join(f"{self.name('joint', i)} "
-                                  f"({mj.mjtJoint(int(m.jnt_type[i])).name[6:].lower()})"
-                                  for i in joints)
+                kinds = ", ".join(f"{self.name('joint', i)} ({self.kind(i)})" for i in joints)
                 raise self.fail(f"body {self.name('body', b)!r} joints", kinds,
                                 f"one hinge about {self.axis} per body below the floating "
                                 "base (or none: welded to the parent)", problem=f"got {kinds}")
@@ -216,7 +224,7 @@ class Builder:
                 "name": self.name("joint", j), "at": at, "limits": [lo, hi]}))
             link_of[b] = len(links) - 1
             coords.append((j, len(coords), sign, 0.0))
-        self.notes.append(self.joints_note(coords[3:]))
+        self.notes.append(self.joints_note(coords[N_BASE:]))
         static = [self.name("body", b) for b in range(1, m.nbody)
                   if b not in link_of and b not in self.ancestors(base)]
         if static:
@@ -259,7 +267,7 @@ class Builder:
     def link_parts(self, link: Link) -> tuple[float, Vec, float]:
         """Mass, centre of mass (gaitopt x, y relative to the link origin) and inertia about
         the normal n through it: ``n^T ximat diag(body_inertia) ximat^T n`` per body, merged."""
-        n = self.plane[2]
+        n = self.plane[NORMAL]
         parts = []
         for b in link.bodies:
             mass = float(self.m.body_mass[b])
@@ -303,7 +311,7 @@ class Builder:
         ``sign * gear * [lo, hi]`` with [lo, hi] = ``gainprm[0] * ctrlrange`` (if
         ``ctrllimited``) intersected with ``forcerange`` (if ``forcelimited``)."""
         m, mj = self.m, self.mj
-        coord_of = {cmap.dof_index[i]: i for i in range(3, len(cmap.sign))}
+        coord_of = {cmap.dof_index[i]: i for i in range(N_BASE, len(cmap.sign))}
         out: list[dict[str, Any]] = []
         shown: dict[str, str] = {}
         for a in range(m.nu):
@@ -350,8 +358,8 @@ class Builder:
         if int(self.m.opt.disableflags) & int(self.mj.mjtDisableBit.mjDSBL_GRAVITY):
             g = np.zeros(3)
         out = self.xy(g)
-        if abs(float(self.plane[2] @ g)) > 0.0:
-            self.notes.append(f"gravity: its component {float(self.plane[2] @ g):g} m/s^2 "
+        if abs(float(self.plane[NORMAL] @ g)) > 0.0:
+            self.notes.append(f"gravity: its component {float(self.plane[NORMAL] @ g):g} m/s^2 "
                               "normal to the plane is dropped (no work in the plane)")
         return [float(out[0]), float(out[1])]
 

@@ -23,9 +23,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gaitopt.robot.contact_inference import Capsule, Circle, Rectangle, Shape, infer_contacts
+from gaitopt.robot.mjcf_build import IN_PLANE_ROWS, NORMAL
 from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf import ContactSpec
 from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP
+
+#: A capsule's or cylinder's axis is its frame's z axis (MuJoCo's convention).
+GEOM_AXIS = 2
 
 if TYPE_CHECKING:
     from gaitopt.robot.mjcf_build import Builder, Link, Vec
@@ -98,18 +102,19 @@ def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
     c = (float(center[0]), float(center[1]))
     axes = builder.plane @ d.geom_xmat[g].reshape(3, 3)  # columns: the geom's axes, gaitopt
     axes = np.where(np.abs(axes) < SNAP, 0.0, axes)      # rounding dust of the quaternion
-    normal = [abs(abs(float(axes[2, i])) - 1.0) <= AXIS_TOL for i in range(3)]
-    in_plane = [abs(float(axes[2, i])) <= AXIS_TOL for i in range(3)]
+    # per geom axis (x, y, z of the geom frame): along the plane normal, or in the plane
+    normal = [abs(abs(float(axes[NORMAL, i])) - 1.0) <= AXIS_TOL for i in range(3)]
+    in_plane = [abs(float(axes[NORMAL, i])) <= AXIS_TOL for i in range(3)]
     geom = mj.mjtGeom
     if kind == int(geom.mjGEOM_SPHERE):
         return Circle(link.name, c, float(size[0]))
     if kind in (int(geom.mjGEOM_CAPSULE), int(geom.mjGEOM_CYLINDER)):
         r, h = float(size[0]), float(size[1])
-        if normal[2]:
+        if normal[GEOM_AXIS]:
             return Circle(link.name, c, r)
-        if not in_plane[2]:
+        if not in_plane[GEOM_AXIS]:
             return "its axis is tilted out of the plane"
-        a = axes[:2, 2]
+        a = axes[IN_PLANE_ROWS, GEOM_AXIS]
         if kind == int(geom.mjGEOM_CAPSULE):
             ends = tuple((float(center[0] + s * h * a[0]), float(center[1] + s * h * a[1]))
                          for s in (-1.0, 1.0))
@@ -121,7 +126,7 @@ def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
         i, j = (n for n in range(3) if not normal[n])
         return Rectangle(link.name, c, (float(size[i]), float(size[j])),
                          math.atan2(float(axes[1, i]), float(axes[0, i])))
-    return mj.mjtGeom(kind).name[7:].lower()
+    return str(mj.mjtGeom(kind).name).removeprefix("mjGEOM_").lower()
 
 
 def leg_symmetry(data: dict[str, Any]) -> dict[str, list[list[str]]] | None:
