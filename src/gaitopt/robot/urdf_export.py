@@ -74,9 +74,9 @@ def urdf_from_model(model: RobotModel) -> str:
         ET.SubElement(j, "origin", xyz=_xyz(parent.local_point(*link.joint.at)),
                       rpy="0.0 0.0 0.0")
         ET.SubElement(j, "axis", xyz="0 -1 0")
-        bounds = {} if continuous else {"lower": _num(lower), "upper": _num(upper)}  # or inf
-        ET.SubElement(j, "limit", **bounds, effort=_num(effort.get(link.joint.name, 0.0)),
-                      velocity="0.0")
+        attrs = {} if continuous else {"lower": _num(lower), "upper": _num(upper)}  # or inf
+        attrs.update(effort=_num(effort.get(link.joint.name, 0.0)), velocity="0.0")
+        ET.SubElement(j, "limit", attrs)
     for c in model.contacts:
         robot.append(ET.Comment(f" gaitopt contact point {c.name!r} on {c.link!r} "))
         ET.SubElement(robot, "link", name=c.name)
