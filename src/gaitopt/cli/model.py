@@ -161,12 +161,15 @@ def model_import(urdf: Path, output: Path | None, contacts: tuple[str, ...], axi
 
     Joints about the common axis become gaitopt joints (angles CCW about gaitopt z = URDF -y);
     fixed joints merge links; the root link, or the link after a planar, floating or
-    prismatic-prismatic-revolute chain, is the floating base. See docs/urdf.md. In MJCF
-    (docs/mjcf.md) the body with slide, slide and hinge joints is the base, bodies without
-    joints merge, and --contact gives X,Z in a body's frame.
+    prismatic-prismatic-revolute chain, is the floating base. Without --contact (or contact
+    frames gaitopt exported), contacts are inferred from collision shapes on leaf links.
+    Prints what it assumed: the base, the actuators, the contacts, the symmetry. See
+    docs/urdf.md. In MJCF (docs/mjcf.md) the body with slide, slide and hinge joints is the
+    base, bodies without joints merge, contacts come from the foot geoms and --contact gives
+    X,Z in a body's frame.
     """
     from gaitopt.robot.mjcf import is_mjcf
-    from gaitopt.robot.urdf import model_from_urdf, parse_contact_option
+    from gaitopt.robot.urdf import import_urdf, parse_contact_option
 
     try:
         specs = [parse_contact_option(c) for c in contacts]
@@ -175,12 +178,15 @@ def model_import(urdf: Path, output: Path | None, contacts: tuple[str, ...], axi
     if is_mjcf(urdf):
         _import_mjcf(urdf, output, specs, axis, name, force)
         return
-    m = model_from_urdf(urdf, contacts=specs, axis=axis, name=name)
+    result = import_urdf(urdf, contacts=specs, axis=axis, name=name)
+    m = result.model
     header = f"# imported by `gaitopt model import` from {urdf.name}\n"
     _write_output(header + model_to_yaml(m), output, Path(f"{urdf.stem}.yaml"), force)
-    if output is None or str(output) != "-":
-        click.echo(f"model {m.name}: {len(m.links)} links, {len(m.contacts)} contact points, "
-                   f"{m.nu} actuators, total mass {_g(m.total_mass)} kg")
+    to_stderr = output is not None and str(output) == "-"  # keep the YAML on stdout clean
+    click.echo(f"model {m.name}: {len(m.links)} links, {len(m.contacts)} contact points, "
+               f"{m.nu} actuators, total mass {_g(m.total_mass)} kg", err=to_stderr)
+    for line in result.lines():
+        click.echo(line, err=to_stderr)
 
 
 def _import_mjcf(path: Path, output: Path | None, specs: list[Any], axis: str,
