@@ -345,3 +345,8 @@ def test_a_pitched_body_a_hinge_ref_and_a_welded_body() -> None:
     assert [link.name for link in imp.model.links] == ["torso", "leg"]
     worst_m, worst_b = dynamics_errors(text, imp)
     assert worst_m <= 1e-9 and worst_b <= 1e-9
+
+
+def test_an_unlimited_hinge_has_no_bounds() -> None:
+    imp = import_mjcf(one_leg().replace('range="-10 40"', 'limited="false"'))
+    assert imp.model.link("leg").joint.limits == (-np.inf, np.inf)  # type: ignore[union-attr]

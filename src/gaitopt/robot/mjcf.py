@@ -55,8 +55,8 @@ __all__ = ["CoordinateMap", "MjcfImport", "import_mjcf", "is_mjcf", "model_from_
 #: The start of an MJCF file: an XML declaration and comments, then ``<mujoco``.
 _MJCF_START = re.compile(r"\A(?:\ufeff)?\s*(?:<\?.*?\?>\s*|<!--.*?-->\s*)*<mujoco\b", re.S)
 INSTALL_HINT = "pip install 'gaitopt[mujoco]'"
-#: A hinge that is not limited gets these bounds (one turn each way), as a URDF continuous joint.
-UNLIMITED = (-2.0 * math.pi, 2.0 * math.pi)
+#: The limits of a hinge that is not limited: none, as a URDF continuous joint.
+UNLIMITED = (-math.inf, math.inf)
 
 
 def _mujoco(label: str) -> Any:

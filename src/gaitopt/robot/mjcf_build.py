@@ -20,8 +20,8 @@ from gaitopt.robot.errors import ModelError
 from gaitopt.robot.mjcf import UNLIMITED, CoordinateMap, MjcfImport
 from gaitopt.robot.model import BASE_ANGLE, BASE_COORDINATES
 from gaitopt.robot.schema import model_from_dict
-from gaitopt.robot.symmetry import SymmetryError, model_symmetry
 from gaitopt.robot.urdf import ContactSpec
+from gaitopt.robot.urdf_assumptions import declare_foot_symmetry, symmetry_note
 from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP, direction_and_length, link_point
 
 Vec = NDArray[np.float64]
@@ -221,7 +221,8 @@ class Builder:
             at = self.xy(origin - links[k].origin)
             links[k].points.append(at)
             links.append(Link(self.name("body", b), k, origin, bodies=[b], joint={
-                "name": self.name("joint", j), "at": at, "limits": [lo, hi]}))
+                "name": self.name("joint", j), "at": at,
+                "limits": [x if math.isfinite(x) else None for x in (lo, hi)]}))  # null: none
             link_of[b] = len(links) - 1
             coords.append((j, len(coords), sign, 0.0))
         self.notes.append(self.joints_note(coords[N_BASE:]))
@@ -239,29 +240,18 @@ class Builder:
         if len(coords) != m.nv:
             raise self.fail("", m.nv, f"{len(coords)} degrees of freedom (those of the robot)",
                             problem=f"{m.nv - len(coords)} degrees of freedom outside it")
-        from gaitopt.robot.mjcf_contacts import contact_points, leg_symmetry
+        from gaitopt.robot.mjcf_contacts import contact_points
 
         contacts = contact_points(self, links, link_of, specs, name)
         data = self.to_dict(links, contacts, name)
         data["actuators"] = self.actuators(links, cmap)
         data["gravity"] = self.gravity()
-        symmetry = None if specs else leg_symmetry(data)
+        if not specs:  # heel_1, toe_1, heel_2, toe_2 inferred: the feet's symmetry
+            declare_foot_symmetry(data, source=self.label)
         model = model_from_dict(data, source=self.label)
-        if symmetry is not None:
-            try:
-                model = model_from_dict({**data, "symmetry": symmetry}, source=self.label)
-            except ModelError as exc:  # the legs' actuators do not pair up
-                self.notes.append(f"symmetry: not declared ({exc})")
         armature = tuple(float(m.dof_armature[d]) for d in cmap.dof_index)
         self.dropped(cmap)
-        try:
-            how = model_symmetry(model).describe()
-            if model.symmetry is not None:  # declared here, not in the MJCF file
-                how = how.replace("declared in the model file", "declared by the import: "
-                                  "the two legs from the base to the feet with contacts")
-            self.notes.append(f"symmetry: {how}")
-        except SymmetryError as exc:
-            self.notes.append(f"symmetry: none ({exc})")
+        self.notes.append(symmetry_note(model, by_import="symmetry" in data))
         return MjcfImport(model, cmap, armature, tuple(self.notes))
 
     def link_parts(self, link: Link) -> tuple[float, Vec, float]:
@@ -275,10 +265,8 @@ class Builder:
                 axis = self.d.ximat[b].reshape(3, 3).T @ n  # n in the body's inertia frame
                 inertia = float(np.sum(self.m.body_inertia[b] * axis * axis))
                 parts.append((mass, self.xy(self.d.xipos[b] - link.origin), inertia))
-        if not parts:
-            raise self.fail(f"body {link.name!r}", 0.0, "a mass > 0 on every gaitopt link "
-                            "(a body with a hinge, with the bodies welded to it)",
-                            problem="no mass")
+        if not parts:  # massless: the schema checks that the mass matrix stays invertible
+            return 0.0, np.zeros(2), 0.0
         return merge_parts(parts)
 
     def to_dict(self, links: list[Link], contacts: list[tuple[str, int, Vec]],
@@ -288,9 +276,6 @@ class Builder:
         out: list[dict[str, Any]] = []
         for i, link in enumerate(links):
             mass, com, inertia = self.link_parts(link)
-            if not inertia > 0.0:
-                raise self.fail(f"body {link.name!r}", inertia,
-                                f"an inertia > 0 about {self.axis} (kg m^2)")
             direction, length = direction_and_length(link.points, com, base=i == 0)
             entry: dict[str, Any] = {"name": link.name,
                                      "parent": None if link.parent < 0 else links[link.parent].name}

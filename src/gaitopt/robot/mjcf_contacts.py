@@ -18,7 +18,7 @@ and so are visual geoms (``contype`` and ``conaffinity`` both 0).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -128,26 +128,3 @@ def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
                          math.atan2(float(axes[1, i]), float(axes[0, i])))
     return str(mj.mjtGeom(kind).name).removeprefix("mjGEOM_").lower()
 
-
-def leg_symmetry(data: dict[str, Any]) -> dict[str, list[list[str]]] | None:
-    """The left/right symmetry of inferred contacts (heel_1/toe_1 on one leg, heel_2/toe_2 on
-    the other, which gaitopt cannot infer from the first two contacts): the links of the two
-    chains from the base to the two links carrying contacts, paired in order, and the contacts
-    paired in order; None unless there are two such chains, separate and of equal length,
-    with as many contacts each."""
-    parent = {link["name"]: link["parent"] for link in data["links"]}
-    carriers = list(dict.fromkeys(c["link"] for c in data["contacts"]))
-    if len(carriers) != 2:
-        return None
-    chains = []
-    for leaf in carriers:
-        chain = [leaf]
-        while parent[chain[-1]] is not None and parent[parent[chain[-1]]] is not None:
-            chain.append(parent[chain[-1]])
-        chains.append(chain[::-1])
-    names = [[c["name"] for c in data["contacts"] if c["link"] == leaf] for leaf in carriers]
-    if (len(chains[0]) != len(chains[1]) or set(chains[0]) & set(chains[1])
-            or len(names[0]) != len(names[1])):
-        return None
-    return {"links": [list(p) for p in zip(*chains, strict=True)],
-            "contacts": [list(p) for p in zip(*names, strict=True)]}
