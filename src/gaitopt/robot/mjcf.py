@@ -23,6 +23,10 @@ base angle are 0 and every gaitopt link frame is parallel to the world.
   normal n of ``ximat diag(body_inertia) ximat^T`` (so ``body_ipos``, ``body_iquat`` and what
   MuJoCo computed from geoms). Points off the plane (dm_control's legs at y = +-0.05) are
   projected into it; for motion in the plane this is exact.
+* Actuators: one per motor on a hinge, in MuJoCo's order, torque bounds
+  ``sign gear gainprm[0] ctrlrange`` (intersected with ``gear forcerange``): u = gear ctrl.
+* Contact points: ``--contact`` points, else heels and toes inferred from the leaf links'
+  geoms (:mod:`gaitopt.robot.mjcf_contacts`, :mod:`gaitopt.robot.contact_inference`).
 * Coordinates: gaitopt ``q[i] = sign_i (qpos[a_i] - qpos0[a_i]) + offset_i`` and
   ``qd[i] = sign_i qvel[d_i]`` (:class:`CoordinateMap`); the offsets are the base origin's
   world position at ``qpos0``.
