@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import click
 from rich import box
@@ -13,6 +13,9 @@ from rich.text import Text
 from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model, model_to_yaml
 from gaitopt.robot.symmetry import SymmetryError, model_symmetry
+
+if TYPE_CHECKING:
+    from gaitopt.robot.urdf import ContactSpec
 
 # -- gaitopt model ---------------------------------------------------------------------------
 
@@ -189,7 +192,7 @@ def model_import(urdf: Path, output: Path | None, contacts: tuple[str, ...], axi
         click.echo(line, err=to_stderr)
 
 
-def _import_mjcf(path: Path, output: Path | None, specs: list[Any], axis: str,
+def _import_mjcf(path: Path, output: Path | None, specs: list[ContactSpec], axis: str,
                  name: str | None, force: bool) -> None:
     """``gaitopt model import`` of an MJCF file: the model file (what was assumed and dropped
     in its header comment), then the summary and those lines (on stderr with ``-o -``)."""
