@@ -52,7 +52,8 @@ def contact_points(builder: Builder, links: list[Link], link_of: dict[int, int],
         if b not in link_of:
             names = ", ".join(builder.name("body", i) for i in link_of)
             raise builder.fail(f"contact {spec.name!r}", spec.link, f"the name of a body of the "
-                               f"robot ({names})", problem=f"no body {spec.link!r}")
+                               f"robot ({names})", problem=f"no body {spec.link!r}" if b < 0
+                               else f"body {spec.link!r} is not part of the robot")
         local = np.zeros(3)
         local[builder.in_plane[0]], local[builder.in_plane[1]] = spec.point
         world = d.xpos[b] + d.xmat[b].reshape(3, 3) @ local
