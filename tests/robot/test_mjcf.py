@@ -114,7 +114,8 @@ def test_walker2d_coordinate_map() -> None:
     # rooty turns about +y: gaitopt's angle (CCW about z = -y) is -rooty; the legs' hinges
     # are about -y: as MuJoCo's. rootz has ref 1.25 (qpos0), the torso's height at qpos0.
     assert cm.sign == (1.0, 1.0, -1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
-    assert cm.offset == (0.0, 1.25, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    assert cm.offset == pytest.approx((0.0, 1.25, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+                                      abs=1e-12)
     qpos = np.array([0.3, 1.1, 0.2, -0.5, -0.4, 0.1, -0.2, -0.3, -0.1])
     np.testing.assert_array_equal(cm.q_from_qpos(qpos),
                                   [0.3, 1.1, -0.2, -0.5, -0.4, 0.1, -0.2, -0.3, -0.1])
@@ -130,11 +131,13 @@ def test_dm_walker_map_and_projection() -> None:
     cm = imp.coordinates
     assert cm.names[:3] == ("rootx", "rootz", "rooty")
     assert cm.qpos_index[:3] == (1, 0, 2)
-    assert cm.offset[:3] == (0.0, 1.3, 0.0)
+    assert cm.offset[:3] == pytest.approx((0.0, 1.3, 0.0), abs=1e-12)
     right, left = imp.model.link("right_thigh"), imp.model.link("left_thigh")
     assert right.joint is not None and left.joint is not None
-    assert right.joint.at == left.joint.at
-    assert (right.mass, right.com, right.inertia) == (left.mass, left.com, left.inertia)
+    assert right.joint.at == pytest.approx(left.joint.at, abs=1e-12)
+    assert right.mass == left.mass
+    assert right.com == pytest.approx(left.com, abs=1e-12)
+    assert right.inertia == pytest.approx(left.inertia, rel=1e-12)
 
 
 def test_walker2d_imports_what_mujoco_compiled() -> None:
@@ -146,10 +149,12 @@ def test_walker2d_imports_what_mujoco_compiled() -> None:
     assert [link.name for link in model.links] == [
         "torso", "thigh", "leg", "foot", "thigh_left", "leg_left", "foot_left"]
     assert [link.mass for link in model.links] == list(m.body_mass[1:])
-    assert model.link("thigh").inertia == m.body_inertia[2][1]  # about y, principal
+    # about y, a principal axis; through MuJoCo's kinematics: to 1e-12 (docs/testing.md)
+    assert model.link("thigh").inertia == pytest.approx(m.body_inertia[2][1], rel=1e-12)
     # the knee sits 0.25 m above the leg body's origin: 0.45 m below the hip
-    assert model.link("leg").joint.at == (0.45000000000000007, 0.0)  # type: ignore[union-attr]
-    assert model.link("thigh").joint.limits == (-150 * np.pi / 180, 0.0)  # type: ignore
+    assert model.link("leg").joint.at == pytest.approx((0.45, 0.0), abs=1e-12)  # type: ignore
+    assert model.link("thigh").joint.limits == pytest.approx(  # type: ignore[union-attr]
+        (-150 * np.pi / 180, 0.0), rel=1e-12)
     assert [a.limits for a in model.actuators] == [(-100.0, 100.0)] * 6
     assert [a.joint for a in model.actuators] == list(imp.coordinates.names[3:])
     assert imp.armature == (0.0,) * 3 + (0.01,) * 6
