@@ -3,6 +3,7 @@ dm_control's planar walker (``data/dm_control``, Apache-2.0)."""
 
 from __future__ import annotations
 
+import functools
 import sys
 from pathlib import Path
 
@@ -35,8 +36,9 @@ def imported(request: pytest.FixtureRequest) -> tuple[Path, MjcfImport]:
     return path, import_mjcf(path)
 
 
+@functools.lru_cache(maxsize=8)
 def compiled(source: Path | str) -> object:
-    """MuJoCo's model of a file or of MJCF text."""
+    """MuJoCo's model of a file or of MJCF text (compiled once per source)."""
     if isinstance(source, Path):
         return mujoco.MjModel.from_xml_path(str(source))
     return mujoco.MjModel.from_xml_string(source)
