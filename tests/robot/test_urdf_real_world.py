@@ -117,6 +117,20 @@ def test_kneed_compass_gait_mass_matrix_and_gravity_match_pinocchio() -> None:
                                    rtol=1e-10, atol=1e-9)
 
 
+def test_forward_dynamics_of_point_masses_inverts_the_inverse() -> None:
+    """The ABA works on the point-mass model: rnea(q, qd, aba(q, qd, tau)) = tau."""
+    from gaitopt.dynamics import aba
+
+    m = model_from_urdf(KCG)
+    rng = np.random.default_rng(12)
+    for _ in range(5):
+        q, qd, tau = (rng.uniform(-1.5, 1.5, m.nq), rng.normal(size=m.nq),
+                      rng.normal(size=m.nq))
+        qdd = np.asarray(aba(m, q, qd, tau)).ravel()
+        np.testing.assert_allclose(np.asarray(rnea(m, q, qd, qdd)).ravel(), tau,
+                                   rtol=1e-9, atol=1e-9)
+
+
 def test_kneed_compass_gait_round_trips_through_yaml_and_urdf() -> None:
     m = model_from_urdf(KCG)
     text = model_to_yaml(m)
