@@ -127,7 +127,9 @@ def check_positive_definite(model: RobotModel, *, source: str = "<model>") -> No
         else:
             i = link_of[coordinate]
             path = f"links[{i}].joint"
-            what = f"joint {name!r} (link {model.links[i].name!r} and the links below it)"
+            below = any(link.parent == model.links[i].name for link in model.links)
+            what = (f"joint {name!r} (link {model.links[i].name!r}"
+                    f"{' and the links below it' if below else ''})")
         raise ModelError(source, path, name, "a model whose mass matrix is positive definite: "
                          "every coordinate moves some mass or inertia (a point mass off its "
                          "joint, or a link inertia > 0)",

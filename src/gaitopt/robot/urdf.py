@@ -373,14 +373,15 @@ class _Importer:
             contacts.append((spec.name, k, self.in_plane(pos + rot @ local, exact)))
             taken.add(spec.name)
         ext = Extension(self.r, self.extension)
-        merged = {b.name: [u for u, (k, _, _, _) in frame.items() if k == i and u != b.name]
+        marked = [c for c, _, _ in contacts if c not in {spec.name for spec in specs}]
+        merged = {b.name: [u for u, (k, _, _, _) in frame.items()
+                           if k == i and u != b.name and u not in marked]
                   for i, b in enumerate(bodies)}
         notes = [base_note(base, chain, ("x", "y", base), merged[base])]
         fixed = [f"{u} -> {b}" for b, us in merged.items() if b != base for u in us]
         if fixed:
             notes.append(f"links fixed to others (merged, or dropped if massless): "
                          f"{', '.join(fixed)}")
-        given = [c for c, _, _ in contacts]
         inferred = None
         if not contacts:
             draft = model_from_dict(self.to_dict(bodies, [], name, ext, draft=True),
@@ -394,8 +395,10 @@ class _Importer:
         data = self.to_dict(bodies, contacts, name, ext)
         notes.extend(self.actuator_notes)
         if inferred is None:
-            notes.append(f"contacts: {', '.join(given)} (given: --contact, and frames "
-                         f"named {CONTACT_PREFIX}NAME)")
+            how = [f"{', '.join(marked)} from the frames {CONTACT_PREFIX}NAME"] if marked else []
+            if specs:
+                how.append(f"{', '.join(spec.name for spec in specs)} from --contact")
+            notes.append(f"contacts: {'; '.join(how)}")
         elif not inferred.contacts:
             notes.append("contacts: none (no collision shape on a leaf link; give them with "
                          "--contact NAME=LINK:X,Z)")
