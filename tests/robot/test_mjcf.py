@@ -227,6 +227,9 @@ def test_plus_y_hinge_flips_limits_and_torques_and_gravity_is_read() -> None:
      r"ctrlrange or forcerange'"),
     (('<body name="torso"', '<body name="other" pos="3 0 0"><joint type="slide"/>'
       '<geom size="0.1"/></body><body name="torso"'), r"worldbody: 2 bodies with joints"),
+    (('fromto="0 0 0 0 0 -0.5" size="0.04"/>', 'fromto="0 0 0 0 0 -0.5" size="0.04"/>'
+      '<geom name="sole" type="capsule" fromto="0 -0.1 -0.5 0.1 0.1 -0.5" size="0.02"/>'),
+     r"link 'leg' geom 'sole': its axis neither in the plane nor normal to it"),
 ])
 def test_what_is_refused(edit: tuple[str, str], message: str) -> None:
     with pytest.raises(ModelError, match=message):

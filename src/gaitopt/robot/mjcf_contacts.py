@@ -11,8 +11,9 @@ world at ``qpos0``), from MuJoCo's ``geom_xpos`` and ``geom_xmat`` at ``qpos0`` 
 - a cylinder whose axis lies in the plane: a :class:`Rectangle` with half sizes ``(h, r)``;
 - a box with one axis along the normal: a :class:`Rectangle` with the other two half sizes.
 
-Anything else (a mesh, an ellipsoid, a shape tilted out of the plane) is skipped with a note,
-and so are visual geoms (``contype`` and ``conaffinity`` both 0).
+A capsule, cylinder or box tilted out of the plane is refused, naming the geom and the link,
+as the URDF import does (``--contact`` avoids the geoms); meshes, ellipsoids and other types
+are skipped with a note, and so are visual geoms (``contype`` and ``conaffinity`` both 0).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from gaitopt.robot.contact_inference import Capsule, Circle, Rectangle, Shape, infer_contacts
+from gaitopt.robot.errors import ModelError
 from gaitopt.robot.mjcf_build import IN_PLANE_ROWS, NORMAL
 from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf import ContactSpec
@@ -94,6 +96,14 @@ def inferred(builder: Builder, links: list[Link], link_of: dict[int, int], name:
             for c in found.contacts]
 
 
+def tilted(builder: Builder, g: int, link: Link, which: str) -> ModelError:
+    """The error of a foot geom that is neither in the plane nor normal to it."""
+    return builder.fail(f"link {link.name!r} geom {builder.name('geom', g)!r}",
+                        "tilted out of the plane", f"a foot geom whose axes lie in the plane "
+                        f"or along its normal (+-{builder.axis}), or contacts given with "
+                        "--contact", problem=f"{which} neither in the plane nor normal to it")
+
+
 def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
     """Geom ``g`` as a planar shape in ``link``'s gaitopt frame, or why it cannot be one."""
     m, d, mj = builder.m, builder.d, builder.mj
@@ -114,7 +124,7 @@ def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
         if normal[GEOM_AXIS]:
             return Circle(link.name, c, r)
         if not in_plane[GEOM_AXIS]:
-            return "its axis is tilted out of the plane"
+            raise tilted(builder, g, link, "its axis")
         a = axes[IN_PLANE_ROWS, GEOM_AXIS]
         if kind == int(geom.mjGEOM_CAPSULE):
             ends = tuple((float(center[0] + s * h * a[0]), float(center[1] + s * h * a[1]))
@@ -123,7 +133,7 @@ def geom_shape(builder: Builder, g: int, link: Link) -> Shape | str:
         return Rectangle(link.name, c, (h, r), math.atan2(float(a[1]), float(a[0])))
     if kind == int(geom.mjGEOM_BOX):
         if not any(normal):
-            return "no axis along the plane normal"
+            raise tilted(builder, g, link, "none of its axes")
         i, j = (n for n in range(3) if not normal[n])
         return Rectangle(link.name, c, (float(size[i]), float(size[j])),
                          math.atan2(float(axes[1, i]), float(axes[0, i])))
