@@ -163,11 +163,15 @@ class Builder:
         return b, sorted(coords, key=lambda c: c[1])
 
     def base_note(self, base: int, coords: list[tuple[int, int, float, float]]) -> str:
-        """``base: torso (x = rootx, y = rootz, angle = -rooty; ...)``."""
-        parts = [f"{('x', 'y', 'angle')[k]} = {'' if sign > 0 else '-'}{self.name('joint', j)}"
+        """``floating base: body 'torso'; the MuJoCo joints ... became its coordinates ...``."""
+        joints = ", ".join(f"{self.name('joint', j)} ({self.kind(j)})"
+                           for j in self.joints_of(base))
+        names = ("x", "y", self.name("body", base))
+        parts = [f"{names[k]} = {'' if sign > 0 else '-'}{self.name('joint', j)}"
                  for j, k, sign, _ in coords]
         (_, _, _, x), (_, _, _, y), (hinge_joint, _, _, _) = coords
-        return (f"base: {self.name('body', base)} ({', '.join(parts)}; its origin is "
+        return (f"floating base: body {self.name('body', base)!r}; the MuJoCo joints {joints} "
+                f"became its coordinates {', '.join(parts)} (its origin: "
                 f"{self.name('joint', hinge_joint)}'s anchor, at ({x:g}, {y:g}) m at qpos0)")
 
     def joints_note(self, coords: list[tuple[int, int, float, float]]) -> str:
@@ -332,8 +336,8 @@ class Builder:
             out.append({"name": self.given_name("actuator", a) or cmap.names[i],
                         "joint": cmap.names[i], "limits": bounds})
             shown[out[-1]["name"]] = f"[{bounds[0]:g}, {bounds[1]:g}]"
-        self.notes.append(f"actuators: {len(out)} motors on hinges, in MuJoCo's order, torque "
-                          "bounds gear x ctrlrange: " + (_values(shown, "N m") or "none"))
+        self.notes.append(f"actuators: {_values(shown, 'N m') or 'none'} (gear x ctrlrange of "
+                          "MuJoCo's motors, in MuJoCo's order)")
         return out
 
     def gravity(self) -> list[float]:

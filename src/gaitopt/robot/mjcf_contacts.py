@@ -61,8 +61,8 @@ def contact_points(builder: Builder, links: list[Link], link_of: dict[int, int],
         world = d.xpos[b] + d.xmat[b].reshape(3, 3) @ local
         k = link_of[b]
         out.append((spec.name, k, builder.xy(world - links[k].origin)))
-    builder.notes.append("contacts: from --contact (the geoms are not used): " + ", ".join(
-        f"{s.name} on {s.link}" for s in specs))
+    builder.notes.append(f"contacts: {', '.join(s.name for s in specs)} from --contact (the "
+                         "geoms are not used)")
     return out
 
 
@@ -85,12 +85,16 @@ def inferred(builder: Builder, links: list[Link], link_of: dict[int, int], name:
             shapes.append(shape)
     model = model_from_dict(builder.to_dict(links, [], name), source=builder.label)
     found = infer_contacts(model, shapes, source=builder.label)
-    builder.notes.extend(f"contacts: {line}" for line in found.lines())
+    if found.contacts:
+        builder.notes.append(f"contacts: {', '.join(c.name for c in found.contacts)} (inferred "
+                             "from the foot geoms at qpos0; --contact overrides):")
+        builder.notes.extend(f"  {line}" for line in found.lines())
+    else:
+        builder.notes.append("contacts: none (no usable geom on a leaf link; give them with "
+                             "--contact NAME=BODY:X,Z)")
     if skipped:
-        builder.notes.append(f"contacts: geoms skipped (not a planar sphere, capsule, cylinder "
-                             f"or box): {', '.join(skipped)}")
-    if not found.contacts:
-        builder.notes.append("contacts: none (give them with --contact NAME=BODY:X,Z)")
+        builder.notes.append(f"  geoms skipped (not a sphere, capsule, cylinder or box): "
+                             f"{', '.join(skipped)}")
     index = {link.name: k for k, link in enumerate(links)}
     return [(c.name, index[c.link], np.array(model.link(c.link).local_point(*c.at)))
             for c in found.contacts]
