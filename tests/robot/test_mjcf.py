@@ -65,6 +65,16 @@ def random_states(nq: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def full_mass_matrix(m: object, d: object) -> np.ndarray:
+    """``mj_fullM``: MuJoCo 4 takes (m, d, dst), MuJoCo 3 (m, dst, qM); pyproject allows both."""
+    full = np.zeros((m.nv, m.nv))  # type: ignore[attr-defined]
+    try:
+        mujoco.mj_fullM(m, d, full)
+    except TypeError:
+        mujoco.mj_fullM(m, full, d.qM)  # type: ignore[attr-defined]
+    return full
+
+
 def dynamics_errors(source: Path | str, imp: MjcfImport) -> tuple[float, float]:
     """The largest entry of ``M + diag(armature) - P M_mujoco P^T`` and of
     ``bias - P qfrc_bias`` over the random states (armature is dropped by the import)."""
@@ -72,8 +82,7 @@ def dynamics_errors(source: Path | str, imp: MjcfImport) -> tuple[float, float]:
     worst_m = worst_b = 0.0
     for q, qd in random_states(imp.model.nq, seed=24):
         m, d = mujoco_state(source, imp, q, qd)
-        full = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, full)
+        full = full_mass_matrix(m, d)
         ours = np.asarray(crba(imp.model, q)) + np.diag(imp.armature)
         worst_m = max(worst_m, float(np.max(np.abs(ours - p @ full @ p.T))))
         bias = np.asarray(bias_forces(imp.model, q, qd)).ravel()
