@@ -77,7 +77,7 @@ def test_show_bad_file_exits_2_with_one_line(runner: CliRunner, tmp_path: Path) 
     assert result.exit_code == 2
     assert result.stdout == ""
     assert result.stderr.splitlines() == [
-        f"Error: {bad}: links[0].mass: got -2.0; allowed: a number > 0 (kg)"]
+        f"Error: {bad}: links[0].mass: got -2.0; allowed: a number >= 0 (kg)"]
     assert "Traceback" not in result.output
     assert isinstance(result.exception, SystemExit)
 
@@ -157,4 +157,4 @@ def test_real_process_prints_no_traceback(tmp_path: Path) -> None:
     assert proc.returncode == 2
     assert proc.stdout == ""
     assert proc.stderr.splitlines() == [
-        f"Error: {bad}: links[0].mass: got -2.0; allowed: a number > 0 (kg)"]
+        f"Error: {bad}: links[0].mass: got -2.0; allowed: a number >= 0 (kg)"]

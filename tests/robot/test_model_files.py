@@ -141,6 +141,18 @@ def rename_torso_x(d: dict[str, Any]) -> None:
             link["parent"] = "x"
 
 
+def massless_leaf(d: dict[str, Any]) -> None:
+    """shank_2 (links[4], on knee_2) without mass: knee_2 moves nothing."""
+    d["links"][4].update(mass=0.0, inertia=0.0)
+    del d["links"][4]["shape"]
+
+
+def point_mass_on_joint(d: dict[str, Any]) -> None:
+    """shank_2 a point mass at its own joint: knee_2 moves it nowhere."""
+    d["links"][4].update(com=[0.0, 0.0], inertia=0.0)
+    del d["links"][4]["shape"]
+
+
 # (id, mutation of five-link, field path, value as shown, text of what is allowed)
 ERROR_CASES: list[tuple[str, Mutation, str, str, str]] = [
     ("unknown top key", set_at(("colour",), "red"), "colour", "'colour'", "the keys format"),
@@ -148,25 +160,28 @@ ERROR_CASES: list[tuple[str, Mutation, str, str, str]] = [
      "the keys name, parent, joint"),
     ("unknown joint key", set_at(("links", 2, "joint", "axis"), 1), "links[2].joint.axis",
      "'axis'", "the keys name, at, limits"),
-    ("zero mass", set_at(("links", 1, "mass"), 0.0), "links[1].mass", "0.0", "a number > 0 (kg)"),
+    ("massless leaf", massless_leaf, "links[4].joint", "'knee_2'",
+     "a model whose mass matrix is positive definite"),
+    ("point mass on its joint", point_mass_on_joint, "links[4].joint", "'knee_2'",
+     "a model whose mass matrix is positive definite"),
     ("negative mass", set_at(("links", 3, "mass"), -7), "links[3].mass", "-7",
-     "a number > 0 (kg)"),
+     "a number >= 0 (kg)"),
     ("negative length", set_at(("links", 2, "length"), -0.5), "links[2].length", "-0.5",
      "a number > 0 (m)"),
-    ("zero inertia", set_at(("links", 4, "inertia"), 0), "links[4].inertia", "0",
-     "a number > 0 (kg m^2"),
+    ("negative inertia", set_at(("links", 4, "inertia"), -0.1), "links[4].inertia", "-0.1",
+     "a number >= 0 (kg m^2"),
     ("negative radius", set_at(("links", 0, "shape", "radius"), -0.12),
      "links[0].shape.radius", "-0.12", "a number > 0 (m)"),
     ("nan mass", set_at(("links", 1, "mass"), float("nan")), "links[1].mass", "nan",
-     "a number > 0 (kg)"),
+     "a number >= 0 (kg)"),
     ("inf length", set_at(("links", 1, "length"), float("inf")), "links[1].length", "inf",
      "a number > 0 (m)"),
     ("-inf gravity", set_at(("gravity",), [0.0, float("-inf")]), "gravity[1]", "-inf",
      "a finite number"),
     ("huge int", set_at(("links", 1, "mass"), 10**400), "links[1].mass", "1000",
-     "a number > 0 (kg)"),
+     "a number >= 0 (kg)"),
     ("text mass", set_at(("links", 1, "mass"), "heavy"), "links[1].mass", "'heavy'",
-     "a number > 0 (kg)"),
+     "a number >= 0 (kg)"),
     ("bool length", set_at(("links", 1, "length"), True), "links[1].length", "True",
      "a number > 0 (m)"),
     ("1e3 as text", set_at(("links", 1, "mass"), "1e3"), "links[1].mass", "'1e3'",
@@ -224,7 +239,7 @@ ERROR_CASES: list[tuple[str, Mutation, str, str, str]] = [
     ("missing joint at", delete_at(("links", 2, "joint", "at")), "links[2].joint.at",
      "missing", "'at' is required in a joint"),
     ("missing inertia and shape", delete_at(("links", 1, "shape")), "links[1].inertia",
-     "missing", "an 'inertia' (kg m^2, > 0) or a 'shape'"),
+     "missing", "an 'inertia' (kg m^2, >= 0) or a 'shape'"),
     ("joint on base", set_at(("links", 0, "joint"), {"name": "j", "at": [0, 0],
                                                      "limits": [0, 1]}),
      "links[0].joint", "{'name': 'j'", "no joint (or null) on the floating base"),
@@ -254,7 +269,7 @@ ERROR_CASES: list[tuple[str, Mutation, str, str, str]] = [
     ("description with control character", set_at(("description",), "a\x85b"),
      "description", "'a\\x85b'", "printable characters, new lines and tabs"),
     ("shape inertia overflows", set_at(("links", 1, "length"), 1e200), "links[1].shape",
-     "{'type': 'ellipsoid', 'radius': 0.07}", "a finite number > 0 kg m^2, not inf"),
+     "{'type': 'ellipsoid', 'radius': 0.07}", "a finite number >= 0 kg m^2, not inf"),
     ("com not a pair", set_at(("links", 2, "com"), 0.25), "links[2].com", "0.25",
      "a list of two numbers [along, across] in m"),
 ]

@@ -99,7 +99,7 @@ def test_random_valid_trees_load_and_round_trip(data: dict[str, Any]) -> None:
     for link, e in zip(model.links, data["links"], strict=True):
         assert link.parent == e["parent"] and link.mass == e["mass"]
         assert link.com == tuple(e.get("com", (e["length"] / 2, 0.0)))
-        assert link.inertia > 0 and math.isfinite(link.inertia)
+        assert link.inertia >= 0 and math.isfinite(link.inertia)
         if "inertia" in e:
             assert link.inertia == e["inertia"]
     for i in range(len(model.links)):

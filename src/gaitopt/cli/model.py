@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 from rich import box
@@ -12,6 +13,9 @@ from rich.text import Text
 from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.robot import RobotModel, builtin_names, builtin_text, load_model, model_to_yaml
 from gaitopt.robot.symmetry import SymmetryError, model_symmetry
+
+if TYPE_CHECKING:
+    from gaitopt.robot.urdf import ContactSpec
 
 # -- gaitopt model ---------------------------------------------------------------------------
 
@@ -140,38 +144,70 @@ def _write_output(text: str, output: Path | None, default: Path, force: bool) ->
 
 
 @model.command("import")
-@click.argument("urdf", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("urdf", metavar="FILE", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Model file to write; '-' for standard output (default: the URDF's name "
                    "with .yaml, here).")
 @click.option("--contact", "contacts", multiple=True, metavar="NAME=LINK:X,Z",
-              help="Add a contact point NAME on URDF link LINK at (X, Z) m in that link's "
-                   "frame (Y, Z with --axis x). Repeatable; contact frames that gaitopt "
-                   "exported are read back without it.")
+              help="Add a contact point NAME on URDF link (or MJCF body) LINK at (X, Z) m in "
+                   "that link's frame (Y, Z with --axis x). Repeatable; contact frames that "
+                   "gaitopt exported are read back without it; for MJCF it replaces the heel "
+                   "and toe points inferred from the foot geoms.")
 @click.option("--axis", type=click.Choice(["y", "x"]), default="y", show_default=True,
               help="The common joint axis: y (the sagittal plane is URDF x-z) or x (y-z).")
 @click.option("--name", help="Model name (default: the URDF robot's name).")
 @click.option("--force", is_flag=True, help="Overwrite an existing file.")
 def model_import(urdf: Path, output: Path | None, contacts: tuple[str, ...], axis: str,
                  name: str | None, force: bool) -> None:
-    """Read the planar robot in the URDF file URDF and write a gaitopt model file.
+    """Read the planar robot in FILE (URDF, or MJCF: a .xml or <mujoco> file, compiled by
+    MuJoCo) and write a gaitopt model file.
 
     Joints about the common axis become gaitopt joints (angles CCW about gaitopt z = URDF -y);
     fixed joints merge links; the root link, or the link after a planar, floating or
-    prismatic-prismatic-revolute chain, is the floating base. See docs/urdf.md.
+    prismatic-prismatic-revolute chain, is the floating base. Without --contact (or contact
+    frames gaitopt exported), contacts are inferred from collision shapes on leaf links.
+    Prints what it assumed: the base, the actuators, the contacts, the symmetry. See
+    docs/urdf.md. In MJCF (docs/mjcf.md) the body with slide, slide and hinge joints is the
+    base, bodies without joints merge, contacts come from the foot geoms and --contact gives
+    X,Z in a body's frame.
     """
-    from gaitopt.robot.urdf import model_from_urdf, parse_contact_option
+    from gaitopt.robot.mjcf import is_mjcf
+    from gaitopt.robot.urdf import import_urdf, parse_contact_option
 
     try:
         specs = [parse_contact_option(c) for c in contacts]
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    m = model_from_urdf(urdf, contacts=specs, axis=axis, name=name)
+    if is_mjcf(urdf):
+        _import_mjcf(urdf, output, specs, axis, name, force)
+        return
+    result = import_urdf(urdf, contacts=specs, axis=axis, name=name)
+    m = result.model
     header = f"# imported by `gaitopt model import` from {urdf.name}\n"
     _write_output(header + model_to_yaml(m), output, Path(f"{urdf.stem}.yaml"), force)
-    if output is None or str(output) != "-":
-        click.echo(f"model {m.name}: {len(m.links)} links, {len(m.contacts)} contact points, "
-                   f"{m.nu} actuators, total mass {_g(m.total_mass)} kg")
+    to_stderr = output is not None and str(output) == "-"  # keep the YAML on stdout clean
+    click.echo(f"model {m.name}: {len(m.links)} links, {len(m.contacts)} contact points, "
+               f"{m.nu} actuators, total mass {_g(m.total_mass)} kg", err=to_stderr)
+    for line in result.lines():
+        click.echo(line, err=to_stderr)
+
+
+def _import_mjcf(path: Path, output: Path | None, specs: list[ContactSpec], axis: str,
+                 name: str | None, force: bool) -> None:
+    """``gaitopt model import`` of an MJCF file: the model file (what was assumed and dropped
+    in its header comment), then the summary and those lines (on stderr with ``-o -``)."""
+    from gaitopt.robot.mjcf import import_mjcf
+
+    imp = import_mjcf(path, contacts=specs, axis=axis, name=name)
+    m = imp.model
+    header = (f"# imported by `gaitopt model import` from {path.name} (MJCF, compiled by "
+              "MuJoCo)\n" + "".join(f"# {line}\n" for line in imp.notes))
+    _write_output(header + model_to_yaml(m), output, Path(f"{path.stem}.yaml"), force)
+    to_stderr = output is not None and str(output) == "-"
+    click.echo(f"model {m.name}: {len(m.links)} links, {len(m.contacts)} contact points, "
+               f"{m.nu} actuators, total mass {_g(m.total_mass)} kg", err=to_stderr)
+    for line in imp.notes:
+        click.echo(line, err=to_stderr)
 
 
 __all__ = ["model", "model_tables"]

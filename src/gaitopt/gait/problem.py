@@ -20,6 +20,7 @@ continuity of controls between the phases and their periodicity with the legs re
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -173,7 +174,9 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     f = options.single_support_fraction
     two_phases = options.double_support
     r_max = min(leg.reach(-options.min_stance_knee_flexion) for leg in legs)
-    r_min = max(leg.reach(_limits(model, leg.knee)[0]) for leg in legs)
+    # the shortest reach within the knee's range: at its lower limit, or folded at -pi if the
+    # knee bends further (an unbounded knee's limit is -inf)
+    r_min = max(leg.reach(max(_limits(model, leg.knee)[0], -math.pi)) for leg in legs)
     rate = options.rate_bound
     mu = options.friction
     # Lower bound of the normal impulses on held tips at the events (the paper's maps: none).

@@ -49,8 +49,10 @@ class FieldReader:
                                 f"'{key}' is required in {what}")
         return value
 
-    def number(self, path: str, value: Any, allowed: str, *, positive: bool = False) -> float:
-        """A finite real number (> 0 if ``positive``); ``allowed`` describes it with units."""
+    def number(self, path: str, value: Any, allowed: str, *, positive: bool = False,
+               nonnegative: bool = False) -> float:
+        """A finite real number (> 0 if ``positive``, >= 0 if ``nonnegative``); ``allowed``
+        describes it with units."""
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             hint = ""
             if isinstance(value, str):
@@ -64,7 +66,7 @@ class FieldReader:
             x = float(value)
         except (OverflowError, ValueError, TypeError):
             raise self.fail(path, value, allowed) from None
-        if not math.isfinite(x) or (positive and x <= 0.0):
+        if not math.isfinite(x) or (positive and x <= 0.0) or (nonnegative and x < 0.0):
             raise self.fail(path, value, allowed)
         return x
 
@@ -85,10 +87,20 @@ class FieldReader:
         return (self.number(f"{path}[0]", value[0], f"a finite number; {allowed}"),
                 self.number(f"{path}[1]", value[1], f"a finite number; {allowed}"))
 
-    def bounds(self, path: str, value: Any, unit: str) -> tuple[float, float]:
-        lo, hi = self.pair(path, value, f"[lower, upper] in {unit}")
+    def bounds(self, path: str, value: Any, unit: str, *,
+               unbounded: bool = False) -> tuple[float, float]:
+        """``[lower, upper]`` with lower <= upper; with ``unbounded`` either may be null (no
+        bound), read as ``-inf`` (lower) or ``inf`` (upper)."""
+        what = f"[lower, upper] in {unit}" + (" (null: no bound)" if unbounded else "")
+        if unbounded and isinstance(value, list | tuple) and len(value) == 2:
+            lo, hi = (self.number(f"{path}[{i}]", v, f"a finite number or null; {what}")
+                      if v is not None else inf
+                      for i, (v, inf) in enumerate(zip(value, (-math.inf, math.inf),
+                                                       strict=True)))
+        else:
+            lo, hi = self.pair(path, value, what)
         if lo > hi:
-            raise self.fail(path, [lo, hi], f"[lower, upper] in {unit} with lower <= upper",
+            raise self.fail(path, [lo, hi], f"{what} with lower <= upper",
                             problem=f"lower bound above upper bound {show_value([lo, hi])}")
         return (lo, hi)
 

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -52,7 +53,9 @@ class Joint:
     """A revolute joint between a link and its parent.
 
     ``at`` is the joint position on the parent as ``(along, across)`` in metres (see the module
-    docstring); ``limits`` are the joint angle bounds in radians, ``lower <= upper``.
+    docstring); ``limits`` are the joint angle bounds in radians, ``lower <= upper``; ``-inf``
+    (lower) or ``inf`` (upper) is no bound (a continuous joint has both; a model file writes
+    them ``null``).
     """
 
     name: str
@@ -83,9 +86,11 @@ class Link:
         joint: the revolute joint to the parent; ``None`` for the floating base.
         direction: ``"up"`` or ``"down"``: the link axis in its own frame.
         length: metres, > 0.
-        mass: kilograms, > 0.
+        mass: kilograms, >= 0.
         com: centre of mass as ``(along, across)`` in metres.
-        inertia: rotational inertia about the centre of mass, about z, kg m^2, > 0.
+        inertia: rotational inertia about the centre of mass, about z, kg m^2, >= 0 (a point
+            mass has 0; the model as a whole must have a positive definite mass matrix, which
+            :mod:`gaitopt.robot.mass_matrix` checks when a model is loaded).
         shape: the shape the inertia was computed from (for the record), or ``None`` when the
             inertia was given directly.
     """
@@ -275,7 +280,8 @@ def model_to_dict(model: RobotModel) -> dict[str, Any]:
         entry: dict[str, Any] = {"name": link.name, "parent": link.parent}
         if link.joint is not None:
             entry["joint"] = {"name": link.joint.name, "at": list(link.joint.at),
-                              "limits": list(link.joint.limits)}
+                              "limits": [x if math.isfinite(x) else None
+                                         for x in link.joint.limits]}
         entry.update({"direction": link.direction, "length": link.length, "mass": link.mass,
                       "com": list(link.com), "inertia": link.inertia})
         if link.shape is not None:

@@ -20,6 +20,10 @@ rad, torques in N m, gravity in m/s^2. Points on a link are ``[along, across]`` 
     actuators:                # optional; the controls u, in this order
       - {name, joint: NAME | contact: NAME, limits: [lower, upper]}
 
+Joint limits may be ``null`` (no bound: ``-inf`` or ``inf`` in the model). Masses and inertias
+may be 0 (point masses, massless frames) as long as the model's mass matrix is positive
+definite (:mod:`gaitopt.robot.mass_matrix`, checked last).
+
 Every problem raises :class:`ModelError`, which names the source (file), the field path, the
 bad value and what is allowed. Validation never raises any other exception, whatever the data.
 """
@@ -33,6 +37,7 @@ from typing import Any
 from gaitopt.robot.errors import MISSING, ModelError, show_value
 from gaitopt.robot.fields import FieldReader, names_text
 from gaitopt.robot.inertia import INERTIA_RTOL, shape_inertia
+from gaitopt.robot.mass_matrix import check_positive_definite
 from gaitopt.robot.model import (
     FORMAT,
     VERSION,
@@ -107,6 +112,7 @@ class _Validator(FieldReader):
                     if top.get("symmetry") is not None else None)
         model = RobotModel(name=name, links=links, contacts=contacts, actuators=actuators,
                            gravity=gravity, description=description, symmetry=symmetry)
+        check_positive_definite(model, source=self.source)
         if symmetry is not None:
             from gaitopt.robot.symmetry import SymmetryError, swap_permutations
 
@@ -217,7 +223,7 @@ class _Validator(FieldReader):
             raise self.fail(f"{path}.direction", e["direction"],
                             "'up' or 'down' (the link axis in its own frame)")
         length = self.number(f"{path}.length", e["length"], "a number > 0 (m)", positive=True)
-        mass = self.number(f"{path}.mass", e["mass"], "a number > 0 (kg)", positive=True)
+        mass = self.number(f"{path}.mass", e["mass"], "a number >= 0 (kg)", nonnegative=True)
         com = (self.pair(f"{path}.com", e["com"], "[along, across] in m")
                if "com" in e else (length / 2.0, 0.0))
         joint = None
@@ -230,8 +236,8 @@ class _Validator(FieldReader):
         shape = self.shape(f"{path}.shape", e["shape"]) if "shape" in e else None
         if "inertia" in e:
             inertia = self.number(f"{path}.inertia", e["inertia"],
-                                  "a number > 0 (kg m^2, about the centre of mass)",
-                                  positive=True)
+                                  "a number >= 0 (kg m^2, about the centre of mass; 0 for a "
+                                  "point mass)", nonnegative=True)
             if shape is not None:
                 expected = shape_inertia(shape, mass, length)
                 if abs(inertia - expected) > INERTIA_RTOL * expected:
@@ -240,13 +246,13 @@ class _Validator(FieldReader):
                                     "only one of 'inertia' and 'shape')")
         elif shape is not None:
             inertia = shape_inertia(shape, mass, length)
-            if not (math.isfinite(inertia) and inertia > 0.0):
+            if not (math.isfinite(inertia) and inertia >= 0.0):
                 raise self.fail(f"{path}.shape", e["shape"],
                                 "a shape whose inertia (with this mass and length) is a finite "
-                                f"number > 0 kg m^2, not {inertia!r}")
+                                f"number >= 0 kg m^2, not {inertia!r}")
         else:
             raise self.fail(f"{path}.inertia", MISSING,
-                            "an 'inertia' (kg m^2, > 0) or a 'shape' to compute it from")
+                            "an 'inertia' (kg m^2, >= 0) or a 'shape' to compute it from")
         return Link(name=e["name"], parent=parent, joint=joint, direction=direction,
                     length=length, mass=mass, com=com, inertia=inertia, shape=shape)
 
@@ -263,7 +269,8 @@ class _Validator(FieldReader):
                             "coordinates of q)")
         self.unique(f"{path}.name", name, joint_names, "joint")
         at = self.pair(f"{path}.at", j["at"], "[along, across] in m on the parent link")
-        return Joint(name=name, at=at, limits=self.bounds(f"{path}.limits", j["limits"], "rad"))
+        return Joint(name=name, at=at, limits=self.bounds(f"{path}.limits", j["limits"], "rad",
+                                                          unbounded=True))
 
     def shape(self, path: str, raw: Any) -> Shape:
         if not isinstance(raw, Mapping) or "type" not in raw:

@@ -46,10 +46,21 @@ from typing import Any
 
 import numpy as np
 
+from gaitopt.robot.contact_inference import Shape, infer_contacts
 from gaitopt.robot.errors import ModelError
 from gaitopt.robot.inertia import INERTIA_RTOL, shape_inertia
-from gaitopt.robot.model import RobotModel, Shape
-from gaitopt.robot.schema import model_from_dict
+from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import Shape as LinkShape
+from gaitopt.robot.schema import DEFAULT_GRAVITY, model_from_dict
+from gaitopt.robot.urdf_assumptions import (
+    Actuated,
+    actuators_from_urdf,
+    base_note,
+    declare_foot_symmetry,
+    default_bound,
+    symmetry_note,
+)
+from gaitopt.robot.urdf_collision import planar_shape
 from gaitopt.robot.urdf_export import urdf_from_model
 from gaitopt.robot.urdf_plane import (
     AXIS_TOL,
@@ -60,10 +71,17 @@ from gaitopt.robot.urdf_plane import (
     is_identity,
     link_point,
 )
-from gaitopt.robot.urdf_xml import CONTACT_PREFIX, Extension, Reader, UJoint, ULink
+from gaitopt.robot.urdf_xml import (
+    CONTACT_PREFIX,
+    Extension,
+    Reader,
+    UJoint,
+    ULink,
+    transmission_joints,
+)
 
-__all__ = ["CONTACT_PREFIX", "ContactSpec", "model_from_urdf", "parse_contact_option",
-           "urdf_from_model"]
+__all__ = ["CONTACT_PREFIX", "ContactSpec", "UrdfImport", "import_urdf", "model_from_urdf",
+           "parse_contact_option", "urdf_from_model"]
 
 @dataclass(frozen=True)
 class ContactSpec:
@@ -106,6 +124,19 @@ class _Body:
     points: list[np.ndarray] = field(default_factory=list)  # joints and contacts (plane)
 
 
+def _standing(bodies: list[_Body]) -> tuple[float, float]:
+    """The total mass (kg) and the depth (m) of the lowest point (joints, contacts, centres
+    of mass) below the base origin at the standing pose (every frame world-parallel)."""
+    origin = [np.zeros(2) for _ in bodies]
+    depth = 0.0
+    for k, b in enumerate(bodies):  # parents come before their children
+        if b.joint is not None:
+            origin[k] = origin[b.parent] + b.joint["at"]
+        for p in [*b.points, *(c for _, c, _ in b.parts)]:
+            depth = max(depth, -float(origin[k][1] + p[1]))
+    return sum(m for b in bodies for m, _, _ in b.parts), depth
+
+
 def _read_source(source: str | os.PathLike[str]) -> tuple[str, str]:
     """The URDF text and the name to use in errors."""
     if isinstance(source, str) and source.lstrip().startswith("<"):
@@ -119,8 +150,28 @@ def _read_source(source: str | os.PathLike[str]) -> tuple[str, str]:
                          problem=f"cannot be read ({detail})") from None
 
 
+@dataclass(frozen=True)
+class UrdfImport:
+    """A URDF import: the model, and what the import assumed (:meth:`lines`)."""
+
+    model: RobotModel
+    notes: tuple[str, ...]
+
+    def lines(self) -> list[str]:
+        """What the import assumed, one topic a line (a topic may add indented lines): the
+        floating base, the links merged, the actuators, the contacts, the symmetry; a line
+        starting ``warning:`` for a choice the file did not make (a torque bound)."""
+        return list(self.notes)
+
+
 def model_from_urdf(source: str | os.PathLike[str], *, contacts: Iterable[ContactSpec] = (),
                     axis: str = "y", name: str | None = None) -> RobotModel:
+    """Read a planar robot from URDF text or a URDF file: :func:`import_urdf`'s model."""
+    return import_urdf(source, contacts=contacts, axis=axis, name=name).model
+
+
+def import_urdf(source: str | os.PathLike[str], *, contacts: Iterable[ContactSpec] = (),
+                axis: str = "y", name: str | None = None) -> UrdfImport:
     """Read a planar robot from URDF text or a URDF file (see the module docstring).
 
     Args:
@@ -143,7 +194,7 @@ def model_from_urdf(source: str | os.PathLike[str], *, contacts: Iterable[Contac
     if root.tag != "robot":
         raise ModelError(label, "", f"<{root.tag}>", "a <robot> element",
                          problem=f"the root element is <{root.tag}>")
-    return _Importer(Reader(label), root, PLANE[axis], axis).model(list(contacts), name)
+    return _Importer(Reader(label), root, PLANE[axis], axis).run(list(contacts), name)
 
 
 class _Importer:
@@ -164,6 +215,8 @@ class _Importer:
                                   problem="a second joint of this name")
             joint_names.add(j.name)
         self.extension = root.find("gaitopt")
+        self.transmissions = transmission_joints(reader, root)
+        self.actuator_notes: list[str] = []
         self.robot_name = root.get("name") or "robot"
         self.parent_joint: dict[str, UJoint] = {}
         self.children: dict[str, list[UJoint]] = {n: [] for n in self.links}
@@ -256,7 +309,7 @@ class _Importer:
         return cur, chain
 
     # -- the model ---------------------------------------------------------------------------
-    def model(self, specs: list[ContactSpec], name: str | None) -> RobotModel:
+    def run(self, specs: list[ContactSpec], name: str | None) -> UrdfImport:
         base, chain = self.base_chain()
         bodies = [_Body(base, -1, None)]
         # URDF link -> (its gaitopt link, its axes and origin in that link's frame, whether
@@ -319,39 +372,85 @@ class _Importer:
             local[i0], local[i1] = spec.point
             contacts.append((spec.name, k, self.in_plane(pos + rot @ local, exact)))
             taken.add(spec.name)
+        ext = Extension(self.r, self.extension)
+        marked = [c for c, _, _ in contacts if c not in {spec.name for spec in specs}]
+        merged = {b.name: [u for u, (k, _, _, _) in frame.items()
+                           if k == i and u != b.name and u not in marked]
+                  for i, b in enumerate(bodies)}
+        notes = [base_note(base, chain, ("x", "y", base), merged[base])]
+        fixed = [f"{u} -> {b}" for b, us in merged.items() if b != base for u in us]
+        if fixed:
+            notes.append(f"links fixed to others (merged, or dropped if massless): "
+                         f"{', '.join(fixed)}")
+        inferred = None
+        if not contacts:
+            draft = model_from_dict(self.to_dict(bodies, [], name, ext, draft=True),
+                                    source=self.r.source)
+            inferred = infer_contacts(draft, self.shapes(frame, bodies), source=self.r.source)
+            for c in inferred.contacts:
+                k = draft.link_index(c.link)
+                contacts.append((c.name, k, np.array(draft.link(c.link).local_point(*c.at))))
         for _, k, p in contacts:
             bodies[k].points.append(p)
-        return model_from_dict(self.to_dict(bodies, contacts, name), source=self.r.source)
+        data = self.to_dict(bodies, contacts, name, ext)
+        notes.extend(self.actuator_notes)
+        if inferred is None:
+            how = [f"{', '.join(marked)} from the frames {CONTACT_PREFIX}NAME"] if marked else []
+            if specs:
+                how.append(f"{', '.join(spec.name for spec in specs)} from --contact")
+            notes.append(f"contacts: {'; '.join(how)}")
+        elif not inferred.contacts:
+            notes.append("contacts: none (no collision shape on a leaf link; give them with "
+                         "--contact NAME=LINK:X,Z)")
+        else:
+            notes.append(f"contacts: {', '.join(c for c, _, _ in contacts)} (inferred from "
+                         "the collision shapes at the standing pose; --contact overrides):")
+            notes.extend(f"  {line}" for line in inferred.lines())
+            if ext.symmetry is None:
+                declare_foot_symmetry(data, source=self.r.source)
+        model = model_from_dict(data, source=self.r.source)
+        notes.append(symmetry_note(model, by_import=ext.symmetry is None
+                                   and model.symmetry is not None))
+        return UrdfImport(model, tuple(notes))
+
+    def shapes(self, frame: dict[str, tuple[int, np.ndarray, np.ndarray, bool]],
+               bodies: list[_Body]) -> list[Shape]:
+        """The collision shapes of every URDF link in its gaitopt link's frame."""
+        out = []
+        for link_name, (k, rot, pos, _) in frame.items():
+            for c in self.links[link_name].collisions:
+                shape = planar_shape(c, link=bodies[k].name, urdf_link=link_name, rot=rot,
+                                     pos=pos, plane=self.plane, source=self.r.source)
+                if shape is not None:
+                    out.append(shape)
+        return out
 
     def to_dict(self, bodies: list[_Body], contacts: list[tuple[str, int, np.ndarray]],
-                name: str | None) -> dict[str, Any]:
-        ext = Extension(self.r, self.extension)
+                name: str | None, ext: Extension, *, draft: bool = False) -> dict[str, Any]:
+        """The model as plain data; a ``draft`` (for contact inference) has no actuators and
+        no symmetry, and sets no :attr:`actuator_notes`."""
         links: list[dict[str, Any]] = []
         for i, b in enumerate(bodies):
-            mass = sum(m for m, _, _ in b.parts)
-            if not mass > 0.0:
-                raise self.r.fail(f"link {b.name!r}", 0.0, "a mass > 0 on every gaitopt link "
-                                  "(the base, or a URDF link after a revolute joint, with the "
-                                  "links fixed to it)", problem="no mass")
-            com = (b.parts[0][1] if len(b.parts) == 1 else
+            mass = sum(m for m, _, _ in b.parts)  # 0 for a massless link: the schema's
+            com = (np.zeros(2) if not b.parts else b.parts[0][1] if len(b.parts) == 1 else
                    sum((m * c for m, c, _ in b.parts), np.zeros(2)) / mass)
-            inertia = sum(i_ + m * float(np.sum((c - com) ** 2)) for m, c, i_ in b.parts)
-            if not inertia > 0.0:
-                raise self.r.fail(f"link {b.name!r}", inertia, "an inertia > 0 about the "
-                                  f"{self.axis} axis (kg m^2)")
+            inertia = sum((i_ + m * float(np.sum((c - com) ** 2)) for m, c, i_ in b.parts), 0.0)
             direction, length = ext.links.get(b.name) or direction_and_length(
                 b.points, com, base=i == 0)
             entry: dict[str, Any] = {"name": b.name,
                                      "parent": None if b.parent < 0 else bodies[b.parent].name}
             if b.joint is not None:
-                # the joint's position is a point on the parent (listed before its children)
+                # the joint's position is a point on the parent (listed before its children);
+                # an infinite limit is no bound (null)
                 entry["joint"] = {**b.joint, "at": link_point(b.joint["at"],
-                                                          links[b.parent]["direction"])}
+                                                          links[b.parent]["direction"]),
+                                  "limits": [x if math.isfinite(x) else None
+                                             for x in b.joint["limits"]]}
             entry.update({"direction": direction, "length": length, "mass": mass,
                           "com": link_point(com, direction), "inertia": inertia})
             shape = ext.shapes.get(b.name)
             if shape is not None:
-                s = Shape(type=shape["type"], radius=shape.get("radius"))
+                s = LinkShape(type=shape["type"], radius=shape.get("radius"))
                 expected = shape_inertia(s, mass, length)
                 if abs(expected - inertia) <= INERTIA_RTOL * expected:
                     entry["shape"] = shape
@@ -362,17 +461,22 @@ class _Importer:
             "contacts": [{"name": c, "link": bodies[k].name, "at": link_point(p, directions[
                 bodies[k].name])} for c, k, p in contacts],
         }
-        if ext.actuators is not None:
-            data["actuators"] = ext.actuators
-        else:
-            data["actuators"] = [
-                {"name": b.joint["name"], "joint": b.joint["name"], "limits": [-b.effort,
-                                                                               b.effort]}
-                for b in bodies if b.joint is not None and b.effort > 0.0]
         if ext.gravity is not None:
             data["gravity"] = ext.gravity
         if ext.description is not None:
             data["description"] = ext.description
+        if draft:
+            return data
+        if ext.actuators is not None:
+            data["actuators"] = ext.actuators
+            self.actuator_notes = [f"actuators: {', '.join(a['name'] for a in ext.actuators)} "
+                                   "(from the <gaitopt> element)"]
+        else:
+            joints = [Actuated(b.joint["name"], b.effort) for b in bodies if b.joint is not None]
+            gravity = math.hypot(*(ext.gravity or DEFAULT_GRAVITY))
+            data["actuators"], self.actuator_notes = actuators_from_urdf(
+                joints, self.transmissions, default_bound(*_standing(bodies), gravity),
+                reader=self.r, urdf_joints={j.name: j for j in self.joints})
         if ext.symmetry is not None:
             data["symmetry"] = ext.symmetry
         return data

@@ -7,6 +7,7 @@ equal model.
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 
 from gaitopt.robot.errors import ModelError
@@ -64,15 +65,18 @@ def urdf_from_model(model: RobotModel) -> str:
     for link in model.links[1:]:
         assert link.joint is not None and link.parent is not None
         parent = model.link(link.parent)
-        j = ET.SubElement(robot, "joint", name=link.joint.name, type="revolute")
+        lower, upper = link.joint.limits
+        continuous = math.isinf(lower) and math.isinf(upper)  # no bound: a continuous joint
+        j = ET.SubElement(robot, "joint", name=link.joint.name,
+                          type="continuous" if continuous else "revolute")
         ET.SubElement(j, "parent", link=link.parent)
         ET.SubElement(j, "child", link=link.name)
         ET.SubElement(j, "origin", xyz=_xyz(parent.local_point(*link.joint.at)),
                       rpy="0.0 0.0 0.0")
         ET.SubElement(j, "axis", xyz="0 -1 0")
-        ET.SubElement(j, "limit", lower=_num(link.joint.limits[0]),
-                      upper=_num(link.joint.limits[1]),
-                      effort=_num(effort.get(link.joint.name, 0.0)), velocity="0.0")
+        attrs = {} if continuous else {"lower": _num(lower), "upper": _num(upper)}  # or inf
+        attrs.update(effort=_num(effort.get(link.joint.name, 0.0)), velocity="0.0")
+        ET.SubElement(j, "limit", attrs)
     for c in model.contacts:
         robot.append(ET.Comment(f" gaitopt contact point {c.name!r} on {c.link!r} "))
         ET.SubElement(robot, "link", name=c.name)

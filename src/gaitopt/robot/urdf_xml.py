@@ -19,8 +19,10 @@ from gaitopt.robot.errors import ModelError
 
 #: Name prefix of the fixed joints that mark contact frames (``gaitopt_contact_tip_1``).
 CONTACT_PREFIX = "gaitopt_contact_"
-#: Limits (rad) given to a continuous joint: a full turn each way (gaitopt limits are finite).
-CONTINUOUS_LIMITS = (-2.0 * math.pi, 2.0 * math.pi)
+#: Limits (rad) of a continuous joint: none.
+CONTINUOUS_LIMITS = (-math.inf, math.inf)
+#: The collision geometries read (``<mesh>`` is read as a name only: no contact from it).
+GEOMETRIES = ("sphere", "box", "cylinder", "capsule", "mesh")
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
@@ -33,12 +35,29 @@ class ULink:
     mass: float = 0.0
     com: np.ndarray = field(default_factory=lambda: np.zeros(3))      # link frame, m
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # link axes, at com
+    collisions: list[UCollision] = field(default_factory=list)
+
+
+@dataclass
+class UCollision:
+    """A ``<collision>`` of a link: ``kind`` (one of :data:`GEOMETRIES`), its frame in the
+    link frame (``rot`` (3, 3), ``pos`` (3,), m) and its sizes (m): ``radius`` (sphere,
+    cylinder, capsule), ``length`` (cylinder, capsule: along the frame's z), ``size`` (box:
+    x, y, z)."""
+
+    kind: str
+    rot: np.ndarray
+    pos: np.ndarray
+    radius: float = 0.0
+    length: float = 0.0
+    size: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass
 class UJoint:
-    """A URDF joint; ``limits`` (rad) only for revolute (as written) and continuous
-    (:data:`CONTINUOUS_LIMITS`) joints, ``effort`` (N m) ``None`` without ``<limit>``."""
+    """A URDF joint; ``limits`` (rad) only for revolute (as written; ``inf``: no bound) and
+    continuous (:data:`CONTINUOUS_LIMITS`) joints, ``effort`` (N m) ``None`` without
+    ``<limit>``."""
 
     name: str
     type: str
@@ -72,17 +91,28 @@ class Reader:
     def fail(self, where: str, value: Any, allowed: str, problem: str | None = None) -> ModelError:
         return ModelError(self.source, where, value, allowed, problem=problem)
 
-    def number(self, where: str, text: str | None, default: float | None = None) -> float:
+    def number(self, where: str, text: str | None, default: float | None = None, *,
+               infinite: bool = False) -> float:
+        """A finite number, or with ``infinite`` also ``inf``, ``Inf``, ``+inf``, ``-inf``
+        (any case, as Drake writes unbounded limits)."""
+        allowed = "a number (inf or -inf: no bound)" if infinite else "a finite number"
         if text is None:
             if default is None:
-                raise self.fail(where, None, "a finite number", problem="missing")
+                raise self.fail(where, None, allowed, problem="missing")
             return default
         try:
             x = float(text)
         except ValueError:
             x = math.nan
-        if not math.isfinite(x):
-            raise self.fail(where, text, "a finite number")
+        if math.isnan(x) or (math.isinf(x) and not infinite):
+            raise self.fail(where, text, allowed)
+        return x
+
+    def size(self, where: str, text: str | None) -> float:
+        """A length >= 0 (m)."""
+        x = self.number(where, text)
+        if x < 0.0:
+            raise self.fail(where, text, "a size >= 0 (m)")
         return x
 
     def vector(self, where: str, text: str | None, default: tuple[float, ...]) -> np.ndarray:
@@ -109,6 +139,7 @@ class Reader:
     def link(self, elem: ET.Element) -> ULink:
         link = ULink(self.name("<link>", elem))
         where = f"link {link.name!r}"
+        link.collisions = [self.collision(where, c) for c in elem.findall("collision")]
         inertial = elem.find("inertial")
         if inertial is None:
             return link
@@ -133,6 +164,30 @@ class Reader:
         rot, link.com = self.origin(where + " inertial", inertial.find("origin"))
         link.inertia = rot @ local @ rot.T  # about the com, along the link frame's axes
         return link
+
+    def collision(self, where: str, elem: ET.Element) -> UCollision:
+        rot, pos = self.origin(f"{where} collision", elem.find("origin"))
+        geometry = elem.find("geometry")
+        shapes = [] if geometry is None else [
+            g for g in geometry if isinstance(g.tag, str)
+            and g.tag.rpartition("}")[2].rpartition(":")[2] in GEOMETRIES]
+        if not shapes:
+            raise self.fail(f"{where} collision", None, "a <geometry> with a sphere, box, "
+                            "cylinder, capsule or mesh", problem="no geometry")
+        g = shapes[0]
+        kind = g.tag.rpartition("}")[2].rpartition(":")[2]
+        at = f"{where} collision {kind}"
+        out = UCollision(kind, rot, pos)
+        if kind in ("sphere", "cylinder", "capsule"):
+            out.radius = self.size(f"{at} radius", g.get("radius"))
+        if kind in ("cylinder", "capsule"):
+            out.length = self.size(f"{at} length", g.get("length"))
+        if kind == "box":
+            size = self.vector(f"{at} size", g.get("size") or "", (0.0, 0.0, 0.0))
+            if np.any(size < 0.0):
+                raise self.fail(f"{at} size", g.get("size"), "three sizes >= 0 (m)")
+            out.size = (float(size[0]), float(size[1]), float(size[2]))
+        return out
 
     def joint(self, elem: ET.Element) -> UJoint:
         name = self.name("<joint>", elem)
@@ -164,8 +219,11 @@ class Reader:
             if effort < 0.0:
                 raise self.fail(f"{where} limit effort", effort, "an effort >= 0 (N m)")
             if kind == "revolute":
-                lo = self.number(f"{where} limit lower", limit.get("lower"), 0.0)
-                hi = self.number(f"{where} limit upper", limit.get("upper"), 0.0)
+                lo = self.number(f"{where} limit lower", limit.get("lower"), 0.0, infinite=True)
+                hi = self.number(f"{where} limit upper", limit.get("upper"), 0.0, infinite=True)
+                if lo == math.inf or hi == -math.inf:
+                    raise self.fail(f"{where} limit", f"lower {lo:g}, upper {hi:g}",
+                                    "lower < inf and upper > -inf (rad)")
                 if lo > hi:
                     raise self.fail(f"{where} limit", f"{lo:g} > {hi:g}", "lower <= upper (rad)")
                 limits = (lo, hi)
@@ -176,6 +234,25 @@ class Reader:
             limits = CONTINUOUS_LIMITS
         return UJoint(name, kind, ends[0], ends[1], rot, pos, axis / norm, limits, effort)
 
+
+
+def transmission_joints(r: Reader, root: ET.Element) -> list[tuple[str, str]]:
+    """``(joint, actuator)`` names of the ``<transmission>`` elements, in file order, in
+    either ROS format: ``<transmission><joint name=J>...</joint><actuator name=A>...``
+    (ros_control) or ``<transmission type="SimpleTransmission"><joint name=J/><actuator
+    name=A/>`` (the old one, Drake's); the actuator name is the joint's if none is given."""
+    out = []
+    for t in root.findall("transmission"):
+        where = f"transmission {t.get('name') or '(unnamed)'!r}"
+        joints = t.findall("joint")
+        if not joints:
+            raise r.fail(where, None, "a <joint name=...> in every <transmission>",
+                         problem="no <joint>")
+        actuator = t.find("actuator")
+        for j in joints:
+            name = r.name(f"{where} <joint>", j)
+            out.append((name, name if actuator is None else actuator.get("name") or name))
+    return out
 
 
 class Extension:
