@@ -354,10 +354,12 @@ class _Importer:
             notes.append(f"links fixed to others (merged, or dropped if massless): "
                          f"{', '.join(fixed)}")
         inferred = None
+        unused: list[str] = []
         if not contacts:
             draft = model_from_dict(model_data(bodies, [], name or self.robot_name, ext),
                                     source=self.r.source)
-            inferred = infer_contacts(draft, self.shapes(frame, bodies), source=self.r.source)
+            shapes, unused = self.shapes(frame, bodies)
+            inferred = infer_contacts(draft, shapes, source=self.r.source)
             for c in inferred.contacts:
                 k = draft.link_index(c.link)
                 contacts.append((c.name, k, np.array(draft.link(c.link).local_point(*c.at))))
@@ -376,10 +378,11 @@ class _Importer:
         elif not inferred.contacts:
             notes.append("contacts: none (no collision shape on a leaf link; give them with "
                          "--contact NAME=LINK:X,Z)")
+            notes.extend(f"  {line}" for line in unused)
         else:
             notes.append(f"contacts: {', '.join(c for c, _, _ in contacts)} (inferred from "
                          "the collision shapes at the standing pose; --contact overrides):")
-            notes.extend(f"  {line}" for line in inferred.lines())
+            notes.extend(f"  {line}" for line in [*inferred.lines(), *unused])
             if ext.symmetry is None:
                 declare_foot_symmetry(data, source=self.r.source)
         model = model_from_dict(data, source=self.r.source)
@@ -388,16 +391,31 @@ class _Importer:
         return UrdfImport(model, tuple(notes))
 
     def shapes(self, frame: dict[str, tuple[int, np.ndarray, np.ndarray, bool]],
-               bodies: list[Body]) -> list[Shape]:
-        """The collision shapes of every URDF link in its gaitopt link's frame."""
-        out = []
+               bodies: list[Body]) -> tuple[list[Shape], list[str]]:
+        """The collision shapes of the URDF links that make up leaf gaitopt links, in the
+        gaitopt link's frame (only feet matter: a shape elsewhere, even one tilted out of the
+        plane, is not read), and lines for what was not used."""
+        parents = {b.parent for b in bodies}
+        out, meshes, elsewhere = [], [], []
         for link_name, (k, rot, pos, _) in frame.items():
             for c in self.links[link_name].collisions:
+                if k in parents:
+                    elsewhere.append(link_name)
+                    continue
                 shape = planar_shape(c, link=bodies[k].name, urdf_link=link_name, rot=rot,
                                      pos=pos, plane=self.plane, source=self.r.source)
-                if shape is not None:
+                if shape is None:
+                    meshes.append(link_name)
+                else:
                     out.append(shape)
-        return out
+        notes = []
+        if meshes:
+            notes.append(f"meshes are not read (no contact from them): "
+                         f"{', '.join(dict.fromkeys(meshes))}")
+        if elsewhere:
+            notes.append(f"shapes on links that are not leaves are not feet: "
+                         f"{', '.join(dict.fromkeys(elsewhere))}")
+        return out, notes
 
     def actuators(self, bodies: list[Body], ext: Extension) -> tuple[list[dict[str, Any]],
                                                                    list[str]]:
