@@ -111,7 +111,7 @@ def _corrupt(gait: Gait, tmp_path: Path, edit: object) -> Path:
     (lambda d: d["parameters"].pop("liftoff_impulse"), "parameters", "liftoff_impulse"),
     (lambda d: d["solver"].update(success="yes"), "solver.success", "true or false"),
     (lambda d: d["solver"]["evaluations"].update(nlp_f=-3), "solver.evaluations.nlp_f", ">= 0"),
-    (lambda d: d["model"]["links"][1].update(mass=-7), "model.links[1].mass", "> 0"),
+    (lambda d: d["model"]["links"][1].update(mass=-7), "model.links[1].mass", ">= 0"),
     (lambda d: d["samples"]["u"][3].__setitem__(0, "x"), "samples.u", "numbers"),
 ])
 def test_corrupted_files_give_errors_naming_file_and_field(

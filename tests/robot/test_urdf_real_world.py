@@ -303,6 +303,21 @@ def test_a_cylinder_across_the_plane_is_a_circle_and_contact_overrides_inference
     assert [(c.name, c.at) for c in given.contacts] == [("p", (0.3, 0.0))]
 
 
+def test_shapes_that_are_not_feet_are_not_read_and_the_import_says_so() -> None:
+    """A thigh's collision cylinder tilted out of the plane is no foot: not refused; a mesh
+    on a foot gives nothing; both are said."""
+    thigh = ('<collision><origin xyz="0 0 -0.25" rpy="0.3 0.2 0"/><geometry><cylinder '
+             'radius="0.05" length="0.5"/></geometry></collision>')
+    mesh = '<collision><geometry><mesh filename="foot.stl"/></geometry></collision>'
+    text = biped(foot=SPHERE_FOOT + mesh).replace(
+        '<link name="thigh_1"><inertial>', f'<link name="thigh_1">{thigh}<inertial>')
+    result = import_urdf(text)
+    assert [c.name for c in result.model.contacts] == ["tip_1", "tip_2"]
+    lines = result.lines()
+    assert "  meshes are not read (no contact from them): shank_1, shank_2" in lines
+    assert "  shapes on links that are not leaves are not feet: thigh_1" in lines
+
+
 def test_no_collision_shape_on_a_leaf_says_how_to_give_contacts() -> None:
     result = import_urdf(biped())
     assert result.model.contacts == ()

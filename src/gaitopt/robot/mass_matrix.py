@@ -74,8 +74,9 @@ def mass_matrix(model: RobotModel, q: NDArray[np.float64]) -> NDArray[np.float64
 
 def sample_poses(model: RobotModel) -> list[NDArray[np.float64]]:
     """The standing pose (q = 0) and :data:`RANDOM_POSES` random poses (seeded: always the
-    same) with the base angle in [-pi, pi] and each joint within its limits (a span of one
-    turn where a bound is missing: [-pi, pi] for none, [lower, lower + 2 pi] for one)."""
+    same) with the base angle in [-pi, pi] and each joint within its limits, at most one turn
+    from its lower limit (M is periodic in every angle): [-pi, pi] without limits,
+    [upper - 2 pi, upper] without a lower one."""
     rng = np.random.default_rng(SEED)
     lo = np.full(model.nq, -math.pi)
     hi = np.full(model.nq, math.pi)
@@ -83,8 +84,8 @@ def sample_poses(model: RobotModel) -> list[NDArray[np.float64]]:
         assert link.joint is not None
         a, b = link.joint.limits
         c = model.coordinate_of_link(i)
-        if math.isfinite(a):
-            lo[c], hi[c] = a, b if math.isfinite(b) else a + 2.0 * math.pi
+        if math.isfinite(a):  # M is 2 pi periodic in each angle: one turn is enough
+            lo[c], hi[c] = a, min(b, a + 2.0 * math.pi)
         elif math.isfinite(b):
             lo[c], hi[c] = b - 2.0 * math.pi, b
     lo[[BASE_X, BASE_Y]] = hi[[BASE_X, BASE_Y]] = 0.0  # M does not depend on x, y
@@ -109,8 +110,14 @@ def check_positive_definite(model: RobotModel, *, source: str = "<model>") -> No
     names = model.coordinate_names
     link_of = {model.coordinate_of_link(i): i for i in range(1, len(model.links))}
     for k, q in enumerate(sample_poses(model)):
-        m = mass_matrix(model, q)
+        with np.errstate(over="ignore", invalid="ignore"):  # refused below if not finite
+            m = mass_matrix(model, q)
         d = np.diag(m).copy()
+        pose = "at the standing pose (q = 0)" if k == 0 else (
+            f"at the pose q = [{', '.join(f'{x:.3g}' for x in q)}]")
+        if not np.all(np.isfinite(m)):
+            raise ModelError(source, "links", "inf", "masses and distances whose mass matrix "
+                             "is finite", problem=f"the mass matrix overflows {pose}")
         if np.all(d > 0.0):
             scale = 1.0 / np.sqrt(d)
             values, vectors = np.linalg.eigh(m * np.outer(scale, scale))
@@ -119,8 +126,6 @@ def check_positive_definite(model: RobotModel, *, source: str = "<model>") -> No
             coordinate = int(np.argmax(np.abs(vectors[:, 0])))
         else:
             coordinate = int(np.argmin(d))
-        pose = "at the standing pose (q = 0)" if k == 0 else (
-            f"at the pose q = [{', '.join(f'{x:.3g}' for x in q)}]")
         name = names[coordinate]
         if coordinate not in link_of:
             path, what = "links[0]", f"the floating base's coordinate {name!r}"

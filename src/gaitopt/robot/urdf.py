@@ -40,7 +40,7 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -48,9 +48,7 @@ import numpy as np
 
 from gaitopt.robot.contact_inference import Shape, infer_contacts
 from gaitopt.robot.errors import ModelError
-from gaitopt.robot.inertia import INERTIA_RTOL, shape_inertia
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.model import Shape as LinkShape
 from gaitopt.robot.schema import DEFAULT_GRAVITY, model_from_dict
 from gaitopt.robot.urdf_assumptions import (
     Actuated,
@@ -60,6 +58,7 @@ from gaitopt.robot.urdf_assumptions import (
     default_bound,
     symmetry_note,
 )
+from gaitopt.robot.urdf_bodies import Body, model_data, standing
 from gaitopt.robot.urdf_collision import planar_shape
 from gaitopt.robot.urdf_export import urdf_from_model
 from gaitopt.robot.urdf_plane import (
@@ -67,9 +66,7 @@ from gaitopt.robot.urdf_plane import (
     IN_PLANE,
     PLANE,
     SNAP,
-    direction_and_length,
     is_identity,
-    link_point,
 )
 from gaitopt.robot.urdf_xml import (
     CONTACT_PREFIX,
@@ -111,31 +108,6 @@ def parse_contact_option(text: str) -> ContactSpec:
 
 
 # -- import ----------------------------------------------------------------------------------
-
-@dataclass
-class _Body:
-    """A gaitopt link under construction: URDF links merged by fixed joints."""
-
-    name: str
-    parent: int
-    joint: dict[str, Any] | None
-    effort: float = 0.0
-    parts: list[tuple[float, np.ndarray, float]] = field(default_factory=list)  # m, com, I
-    points: list[np.ndarray] = field(default_factory=list)  # joints and contacts (plane)
-
-
-def _standing(bodies: list[_Body]) -> tuple[float, float]:
-    """The total mass (kg) and the depth (m) of the lowest point (joints, contacts, centres
-    of mass) below the base origin at the standing pose (every frame world-parallel)."""
-    origin = [np.zeros(2) for _ in bodies]
-    depth = 0.0
-    for k, b in enumerate(bodies):  # parents come before their children
-        if b.joint is not None:
-            origin[k] = origin[b.parent] + b.joint["at"]
-        for p in [*b.points, *(c for _, c, _ in b.parts)]:
-            depth = max(depth, -float(origin[k][1] + p[1]))
-    return sum(m for b in bodies for m, _, _ in b.parts), depth
-
 
 def _read_source(source: str | os.PathLike[str]) -> tuple[str, str]:
     """The URDF text and the name to use in errors."""
@@ -216,7 +188,6 @@ class _Importer:
             joint_names.add(j.name)
         self.extension = root.find("gaitopt")
         self.transmissions = transmission_joints(reader, root)
-        self.actuator_notes: list[str] = []
         self.robot_name = root.get("name") or "robot"
         self.parent_joint: dict[str, UJoint] = {}
         self.children: dict[str, list[UJoint]] = {n: [] for n in self.links}
@@ -311,7 +282,7 @@ class _Importer:
     # -- the model ---------------------------------------------------------------------------
     def run(self, specs: list[ContactSpec], name: str | None) -> UrdfImport:
         base, chain = self.base_chain()
-        bodies = [_Body(base, -1, None)]
+        bodies = [Body(base, -1, None)]
         # URDF link -> (its gaitopt link, its axes and origin in that link's frame, whether
         # no rotation went into them: then points computed from them are exact)
         frame = {base: (0, self.base_rot, np.zeros(3), is_identity(self.base_rot))}
@@ -341,7 +312,7 @@ class _Importer:
                 lo, hi = (j.limits if sign > 0 else (-j.limits[1] + 0.0, -j.limits[0] + 0.0))
                 at = self.in_plane(pos, exact_p)
                 bodies[k].points.append(at)
-                bodies.append(_Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
+                bodies.append(Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
                                     effort=j.effort or 0.0))
                 frame[j.child] = (len(bodies) - 1, rot, np.zeros(3), is_identity(rot))
             else:
@@ -383,17 +354,22 @@ class _Importer:
             notes.append(f"links fixed to others (merged, or dropped if massless): "
                          f"{', '.join(fixed)}")
         inferred = None
+        unused: list[str] = []
         if not contacts:
-            draft = model_from_dict(self.to_dict(bodies, [], name, ext, draft=True),
+            draft = model_from_dict(model_data(bodies, [], name or self.robot_name, ext),
                                     source=self.r.source)
-            inferred = infer_contacts(draft, self.shapes(frame, bodies), source=self.r.source)
+            shapes, unused = self.shapes(frame, bodies)
+            inferred = infer_contacts(draft, shapes, source=self.r.source)
             for c in inferred.contacts:
                 k = draft.link_index(c.link)
                 contacts.append((c.name, k, np.array(draft.link(c.link).local_point(*c.at))))
         for _, k, p in contacts:
             bodies[k].points.append(p)
-        data = self.to_dict(bodies, contacts, name, ext)
-        notes.extend(self.actuator_notes)
+        data = model_data(bodies, contacts, name or self.robot_name, ext)
+        data["actuators"], actuator_notes = self.actuators(bodies, ext)
+        if ext.symmetry is not None:
+            data["symmetry"] = ext.symmetry
+        notes.extend(actuator_notes)
         if inferred is None:
             how = [f"{', '.join(marked)} from the frames {CONTACT_PREFIX}NAME"] if marked else []
             if specs:
@@ -402,10 +378,11 @@ class _Importer:
         elif not inferred.contacts:
             notes.append("contacts: none (no collision shape on a leaf link; give them with "
                          "--contact NAME=LINK:X,Z)")
+            notes.extend(f"  {line}" for line in unused)
         else:
             notes.append(f"contacts: {', '.join(c for c, _, _ in contacts)} (inferred from "
                          "the collision shapes at the standing pose; --contact overrides):")
-            notes.extend(f"  {line}" for line in inferred.lines())
+            notes.extend(f"  {line}" for line in [*inferred.lines(), *unused])
             if ext.symmetry is None:
                 declare_foot_symmetry(data, source=self.r.source)
         model = model_from_dict(data, source=self.r.source)
@@ -414,69 +391,40 @@ class _Importer:
         return UrdfImport(model, tuple(notes))
 
     def shapes(self, frame: dict[str, tuple[int, np.ndarray, np.ndarray, bool]],
-               bodies: list[_Body]) -> list[Shape]:
-        """The collision shapes of every URDF link in its gaitopt link's frame."""
-        out = []
+               bodies: list[Body]) -> tuple[list[Shape], list[str]]:
+        """The collision shapes of the URDF links that make up leaf gaitopt links, in the
+        gaitopt link's frame (only feet matter: a shape elsewhere, even one tilted out of the
+        plane, is not read), and lines for what was not used."""
+        parents = {b.parent for b in bodies}
+        out, meshes, elsewhere = [], [], []
         for link_name, (k, rot, pos, _) in frame.items():
             for c in self.links[link_name].collisions:
+                if k in parents:
+                    elsewhere.append(link_name)
+                    continue
                 shape = planar_shape(c, link=bodies[k].name, urdf_link=link_name, rot=rot,
                                      pos=pos, plane=self.plane, source=self.r.source)
-                if shape is not None:
+                if shape is None:
+                    meshes.append(link_name)
+                else:
                     out.append(shape)
-        return out
+        notes = []
+        if meshes:
+            notes.append(f"meshes are not read (no contact from them): "
+                         f"{', '.join(dict.fromkeys(meshes))}")
+        if elsewhere:
+            notes.append(f"shapes on links that are not leaves are not feet: "
+                         f"{', '.join(dict.fromkeys(elsewhere))}")
+        return out, notes
 
-    def to_dict(self, bodies: list[_Body], contacts: list[tuple[str, int, np.ndarray]],
-                name: str | None, ext: Extension, *, draft: bool = False) -> dict[str, Any]:
-        """The model as plain data; a ``draft`` (for contact inference) has no actuators and
-        no symmetry, and sets no :attr:`actuator_notes`."""
-        links: list[dict[str, Any]] = []
-        for i, b in enumerate(bodies):
-            mass = sum(m for m, _, _ in b.parts)  # 0 for a massless link: the schema's
-            com = (np.zeros(2) if not b.parts else b.parts[0][1] if len(b.parts) == 1 else
-                   sum((m * c for m, c, _ in b.parts), np.zeros(2)) / mass)
-            inertia = sum((i_ + m * float(np.sum((c - com) ** 2)) for m, c, i_ in b.parts), 0.0)
-            direction, length = ext.links.get(b.name) or direction_and_length(
-                b.points, com, base=i == 0)
-            entry: dict[str, Any] = {"name": b.name,
-                                     "parent": None if b.parent < 0 else bodies[b.parent].name}
-            if b.joint is not None:
-                # the joint's position is a point on the parent (listed before its children);
-                # an infinite limit is no bound (null)
-                entry["joint"] = {**b.joint, "at": link_point(b.joint["at"],
-                                                          links[b.parent]["direction"]),
-                                  "limits": [x if math.isfinite(x) else None
-                                             for x in b.joint["limits"]]}
-            entry.update({"direction": direction, "length": length, "mass": mass,
-                          "com": link_point(com, direction), "inertia": inertia})
-            shape = ext.shapes.get(b.name)
-            if shape is not None:
-                s = LinkShape(type=shape["type"], radius=shape.get("radius"))
-                expected = shape_inertia(s, mass, length)
-                if abs(expected - inertia) <= INERTIA_RTOL * expected:
-                    entry["shape"] = shape
-            links.append(entry)
-        directions = {b.name: links[i]["direction"] for i, b in enumerate(bodies)}
-        data: dict[str, Any] = {
-            "name": name or self.robot_name, "links": links,
-            "contacts": [{"name": c, "link": bodies[k].name, "at": link_point(p, directions[
-                bodies[k].name])} for c, k, p in contacts],
-        }
-        if ext.gravity is not None:
-            data["gravity"] = ext.gravity
-        if ext.description is not None:
-            data["description"] = ext.description
-        if draft:
-            return data
+    def actuators(self, bodies: list[Body], ext: Extension) -> tuple[list[dict[str, Any]],
+                                                                   list[str]]:
+        """The actuators (model-file entries) and the lines that say where they came from."""
         if ext.actuators is not None:
-            data["actuators"] = ext.actuators
-            self.actuator_notes = [f"actuators: {', '.join(a['name'] for a in ext.actuators)} "
+            return ext.actuators, [f"actuators: {', '.join(a['name'] for a in ext.actuators)} "
                                    "(from the <gaitopt> element)"]
-        else:
-            joints = [Actuated(b.joint["name"], b.effort) for b in bodies if b.joint is not None]
-            gravity = math.hypot(*(ext.gravity or DEFAULT_GRAVITY))
-            data["actuators"], self.actuator_notes = actuators_from_urdf(
-                joints, self.transmissions, default_bound(*_standing(bodies), gravity),
-                reader=self.r, urdf_joints={j.name: j for j in self.joints})
-        if ext.symmetry is not None:
-            data["symmetry"] = ext.symmetry
-        return data
+        joints = [Actuated(b.joint["name"], b.effort) for b in bodies if b.joint is not None]
+        gravity = math.hypot(*(ext.gravity or DEFAULT_GRAVITY))
+        return actuators_from_urdf(joints, self.transmissions,
+                                   default_bound(*standing(bodies), gravity), reader=self.r,
+                                   urdf_joints={j.name: j for j in self.joints})

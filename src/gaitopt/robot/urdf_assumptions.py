@@ -75,7 +75,8 @@ def actuators_from_urdf(joints: Sequence[Actuated], transmissions: Sequence[tupl
             defaulted.append(a.joint)
         out.append({"name": a.joint, "joint": a.joint, "limits": [-bound, bound]})
         bounds.append(f"{a.joint} +-{bound:.4g}")
-    lines = [f"actuators: {', '.join(bounds) or 'none'} N m (from {source})"]
+    lines = [f"actuators: {', '.join(bounds)} N m (from {source})" if bounds else
+             f"actuators: none (from {source})"]
     if defaulted:
         lines.append(f"warning: no effort on {', '.join(defaulted)}: torque bound +-"
                      f"{default:.4g} N m (total mass x g x standing height; set <limit "
@@ -133,6 +134,8 @@ def symmetry_note(model: RobotModel, *, by_import: bool = False) -> str:
         symmetry = model_symmetry(model)
         swap_permutations(model)
     except SymmetryError as exc:
+        if len(model.contacts) < 2:
+            return f"symmetry: none ({exc})"
         return (f"symmetry: none: the legs are not mirror images ({exc}); a periodic gait "
                 "needs one")
     if by_import:
