@@ -11,6 +11,7 @@ import math
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg import expm
 from scipy.optimize import brentq
 
 from gaitopt.ocp import (
@@ -168,6 +169,29 @@ def smooth_lq(intervals: int = 8) -> Problem:
 def smooth_lq_state(t: NDArray[np.float64]) -> NDArray[np.float64]:
     """The exact optimal state of :func:`smooth_lq`."""
     return np.sinh(2.0 - t) / np.sinh(2.0)
+
+
+# --- 6b. a free final state, for costates ---
+# min int_0^T (x^2 + u^2) / 2 dt, x' = a x + u, x(0) = x0, x(T) free. With H = L + lambda f:
+# u = -lambda, lambda' = -x - a lambda, lambda(T) = 0, so z = (x, lambda) solves
+# z' = A z, A = [[a, -1], [-1, -a]]: z(t) = expm(A t) z(0) with lambda(0) = -Phi_21 x0 / Phi_22,
+# Phi = expm(A T) (equivalently lambda = P x with P the Riccati solution, P(T) = 0).
+def free_end_lq(a: float = 0.5, x0: float = 1.0, T: float = 1.0, intervals: int = 8) -> Problem:
+    """LQ problem with a free final state (costate 0 at T)."""
+    ph = Phase("lq", ["x"], ["u"], lambda x, u, p, t: a * x[0] + u[0], T,
+               initial_state={"x": x0},
+               lagrange=lambda x, u, p, t: (x[0] ** 2 + u[0] ** 2) / 2, intervals=intervals)
+    return Problem([ph])
+
+
+def free_end_lq_solution(t: NDArray[np.float64], a: float = 0.5, x0: float = 1.0,
+                         T: float = 1.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(x, lambda)`` (M,) each, the exact optimum of :func:`free_end_lq` at times ``t``."""
+    A = np.array([[a, -1.0], [-1.0, -a]])
+    phi = expm(A * T)
+    z0 = np.array([x0, -phi[1, 0] * x0 / phi[1, 1]])
+    z = np.stack([expm(A * tk) @ z0 for tk in np.atleast_1d(t)])
+    return z[:, 0], z[:, 1]
 
 
 # --- 7. a boundary layer for error estimates and mesh refinement ---

@@ -5,6 +5,7 @@ State a :class:`Problem` of :class:`Phase` objects, then ``tr = transcribe(probl
 """
 
 from gaitopt.ocp.bounds import Bounds
+from gaitopt.ocp.costate import costates, one_sided_costates
 from gaitopt.ocp.guess import Guess, PhaseGuess, WarmStart, warm_start_of
 from gaitopt.ocp.layout import ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.problem import (
@@ -49,7 +50,9 @@ __all__ = [
     "Result",
     "Transcription",
     "WarmStart",
+    "costates",
     "named",
+    "one_sided_costates",
     "refine",
     "refined_mesh",
     "transcribe",

@@ -1,0 +1,136 @@
+"""Costates from the defect multipliers (gaitopt.ocp.costate) against analytic costates.
+
+Sign convention H = L + lambda^T f. The known answers: the free-end LQ problem of
+``problems.free_end_lq`` (lambda from the Hamiltonian system, lambda(T) = 0), the fixed-end
+``smooth_lq`` (H = x^2 + u^2 + lambda u: lambda = -2u = 2 cosh(2 - t) / sinh 2 > 0) and the
+rest-to-rest double integrator (H = a^2 + l_s v + l_v a: l_s = -24, l_v = 24 t - 12, exact for
+Hermite-Simpson, whose states are cubic there).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+import problems as P
+import pytest
+
+from gaitopt.ocp import ProblemError, transcribe
+from gaitopt.ocp.costate import costates, one_sided_costates
+
+METHODS = ["trapezoidal", "hermite-simpson", "hermite-simpson-separated"]
+GRIDS = (4, 8, 16, 32)
+TOL = {"ipopt.tol": 1e-12}
+
+
+@functools.cache
+def free_end_errors(method: str) -> tuple[tuple[float, ...], ...]:
+    """Largest knot errors of lambda, of H_u = u + lambda at all knots and at the inner knots
+    on each grid of GRIDS."""
+    lam_err, hu_err, hu_inner = [], [], []
+    for n in GRIDS:
+        tr = transcribe(P.free_end_lq(intervals=n), method=method, options=TOL)
+        res = tr.solve()
+        assert res.success, res.summary()
+        ph = res.phase("lq")
+        lam = costates(tr, res)["lq"][:, 0]
+        _, exact = P.free_end_lq_solution(ph.t)
+        lam_err.append(float(np.max(np.abs(lam - exact))))
+        h_u = ph.u[:, 0] + lam  # H_u = L_u + f_u lambda
+        hu_err.append(float(np.max(np.abs(h_u))))
+        hu_inner.append(float(np.max(np.abs(h_u[1:-1]))))
+    return tuple(lam_err), tuple(hu_err), tuple(hu_inner)
+
+
+def orders(errors: tuple[float, ...]) -> list[float]:
+    return [math.log2(errors[i] / errors[i + 1]) for i in range(len(errors) - 1)]
+
+
+@pytest.mark.parametrize(("method", "order"), [("trapezoidal", 1.7), ("hermite-simpson", 3.5),
+                                               ("hermite-simpson-separated", 3.5)])
+def test_costate_error_falls_at_the_scheme_order(method: str, order: float) -> None:
+    errors = free_end_errors(method)[0]
+    # Measured (docs/ocp.md, "Costates"): 1.83-1.96 trapezoidal, 4.00 Hermite-Simpson.
+    assert min(orders(errors)) > order, (errors, orders(errors))
+    assert errors[-1] < (1e-3 if method == "trapezoidal" else 1e-7), errors
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_hamiltonian_is_stationary_in_the_control(method: str) -> None:
+    # An independent check of lambda: H_u = u + lambda -> 0 at the knots, at O(h^2) inside
+    # (for Hermite-Simpson too: the knot controls of its piecewise-linear control model are
+    # second order, while its costates are fourth order) and at the end knots but O(h) there
+    # for trapezoidal (its end controls balance lambda half an interval inside).
+    _, hu, inner = free_end_errors(method)
+    assert min(orders(inner)) > 1.7, (inner, orders(inner))
+    assert min(orders(hu)) > (0.9 if method == "trapezoidal" else 1.7), (hu, orders(hu))
+    assert inner[-1] < 5e-4, inner
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_sign_and_transversality(method: str) -> None:
+    tr = transcribe(P.free_end_lq(intervals=16), method=method, options=TOL)
+    res = tr.solve()
+    lam = costates(tr, res)["lq"][:, 0]
+    _, exact = P.free_end_lq_solution(res.phase("lq").t)
+    assert np.all(exact[:-1] > 0.05) and np.all(lam[:-1] > 0.0)  # H = L + lambda f, not -
+    assert abs(lam[-1]) < 1e-2  # lambda(T) = 0 at the free final state
+    tr = transcribe(P.smooth_lq(16), method=method, options=TOL)
+    res = tr.solve()
+    t = res.phase("lq").t
+    lam = costates(tr, res)["lq"][:, 0]
+    np.testing.assert_allclose(lam, 2 * np.cosh(2 - t) / np.sinh(2), atol=2e-2)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_vector_costates_by_state_order(method: str) -> None:
+    tr = transcribe(P.double_integrator(8), method=method, options=TOL)
+    res = tr.solve()
+    t = res.phase("move").t
+    exact = np.stack([np.full_like(t, -24.0), 24.0 * t - 12.0], axis=1)
+    lam = costates(tr, res)["move"]
+    atol = 1e-6 if method != "trapezoidal" else 2.0  # trapezoidal: O(h^2), 1.4 at h = 1/8
+    np.testing.assert_allclose(lam, exact, atol=atol)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_one_sided_estimates_agree_where_no_constraint_acts(method: str) -> None:
+    tr = transcribe(P.free_end_lq(intervals=10), method=method, options=TOL)
+    res = tr.solve()
+    plus, minus = one_sided_costates(tr, res)["lq"]
+    assert np.isnan(plus[-1]).all() and np.isnan(minus[0]).all()
+    np.testing.assert_allclose(plus[1:-1], minus[1:-1], atol=1e-8)
+
+
+def test_brachistochrone_costates_satisfy_the_free_time_conditions() -> None:
+    # Minimum time (Mayer tf, L = 0, free tf): H = -1 along the optimum, lambda_x and
+    # lambda_y constant (x, y do not enter f), and H_theta = 0 inside the control bounds.
+    tr = transcribe(P.brachistochrone(intervals=40), method="hermite-simpson", options=TOL)
+    res = tr.solve(P.brachistochrone_guess())
+    assert res.success, res.summary()
+    ph = res.phase("slide")
+    lam = costates(tr, res)["slide"]
+    H = np.sum(lam * ph.xdot, axis=1)
+    np.testing.assert_allclose(H, -1.0, atol=1e-4)
+    np.testing.assert_allclose(lam[:, :2], lam[:1, :2].repeat(lam.shape[0], 0), atol=1e-4)
+    th, v = ph.u[:, 0], ph.x[:, 2]
+    h_theta = v * (-lam[:, 0] * np.sin(th) + lam[:, 1] * np.cos(th)) + lam[:, 2] * 9.81 * \
+        np.cos(th)
+    np.testing.assert_allclose(h_theta[1:], 0.0, atol=1e-3)
+
+
+def test_every_phase_of_a_multiphase_problem() -> None:
+    tr = transcribe(P.two_phase_jump(), method="hermite-simpson-separated")
+    res = tr.solve()
+    lam = costates(tr, res)
+    assert set(lam) == {"before", "after"}
+    assert all(v.shape == (7, 2) and np.all(np.isfinite(v)) for v in lam.values())
+
+
+def test_a_result_of_another_transcription_is_refused() -> None:
+    res = transcribe(P.smooth_lq(8), method="trapezoidal").solve()
+    with pytest.raises(ProblemError, match="costates"):
+        costates(transcribe(P.smooth_lq(8), method="hermite-simpson"), res)
+    with pytest.raises(ProblemError, match="costates"):
+        costates(transcribe(P.smooth_lq(10), method="trapezoidal"), res)
