@@ -370,7 +370,8 @@ def _phase_to_dict(p: GaitPhase) -> dict[str, Any]:
             "contact_forces": {c: v.tolist() for c, v in p.contact_forces.items()},
             "state_names": list(p.state_names), "x": p.x.tolist(), "xdot": p.xdot.tolist(),
             "interpolation": dict(p.interpolation),
-            **({} if p.error_estimate is None else {"error_estimate": p.error_estimate.tolist()})}
+            **({} if p.error_estimate is None else {"error_estimate": p.error_estimate.tolist()}),
+            **({} if p.costates is None else {"costates": p.costates.tolist()})}
 
 
 def _dumps(value: Any, indent: int = 0) -> str:

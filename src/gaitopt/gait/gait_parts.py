@@ -64,6 +64,10 @@ class GaitPhase:
     #: Optional (K-1,) per-interval error estimate of the transcription (relative, >= 0; see
     #: :mod:`gaitopt.ocp.estimate`); ``None`` in files written before it existed.
     error_estimate: Array | None = None
+    #: Optional (K, n) costates at the knots by ``state_names`` (cost per unit of each state,
+    #: sign convention H = L + lambda^T f; :func:`gaitopt.ocp.costates`); ``None`` in files
+    #: written before it existed or when the transcription gives none.
+    costates: Array | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -97,6 +101,8 @@ class GaitPhase:
             if np.any(est < 0.0):
                 raise bad_field("error_estimate", "expected numbers >= 0")
             set_(self, "error_estimate", est)
+        if self.costates is not None:
+            set_(self, "costates", array_of("costates", self.costates, (k, n)))
 
     @property
     def duration(self) -> float:

@@ -23,6 +23,7 @@ from gaitopt.gait.accuracy import accuracy_record
 from gaitopt.gait.formulation import contact_sequence
 from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.record_costates import solution_costates
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.transcriptions import disk_cached, function_file
 from gaitopt.gait.walking import DOUBLE, SINGLE
@@ -138,6 +139,7 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
                                point_names(model))
         return _gait(solution, phase_records, events, samples)
     legs = reduced_biped(model).legs
+    lam = solution_costates(solution)
     phases: list[GaitPhase] = []
     for name in traj:
         ph = traj[name]
@@ -148,7 +150,8 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
             name=name, contacts=contacts, t=ph.t, q=q, qd=qd, qdd=qdd, u=u_full,
             contact_forces={c: forces[:, 2 * i:2 * i + 2] for i, c in enumerate(contacts)},
             state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot,
-            error_estimate=ph.error if np.all(np.isfinite(ph.error)) else None))
+            error_estimate=ph.error if np.all(np.isfinite(ph.error)) else None,
+            costates=lam.get(name)))
     events = _events(model, options, traj, step, impulse)
     samples = _samples(model, options, res, step)
     return _gait(solution, tuple(phases), events, samples)
