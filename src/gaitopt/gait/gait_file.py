@@ -285,7 +285,8 @@ class Gait:
 
     def plot(self, kind: str = "overview") -> Figure:
         """A Matplotlib figure: ``overview`` (angles, hip, torques over the step), ``torques``,
-        ``hip``, ``heights`` or ``poses`` (:func:`gaitopt.viz.notebook.gait_figure`)."""
+        ``hip``, ``heights``, ``poses`` or ``costates``
+        (:func:`gaitopt.viz.notebook.gait_figure`)."""
         from gaitopt.viz.notebook import gait_figure
 
         return gait_figure(self, kind)

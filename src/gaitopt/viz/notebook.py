@@ -22,6 +22,7 @@ from matplotlib.figure import Figure
 
 from gaitopt.fileio import write_bytes_atomic
 from gaitopt.viz.animation import animate_gait
+from gaitopt.viz.costate_figures import costates_figure
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
 from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import BOUND_LINE, EVENT_LINE, gait_style, new_figure
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from gaitopt.gait.gait_file import Gait
 
 #: Figure kinds of :func:`gait_figure`.
-KINDS = ("overview", "torques", "hip", "heights", "poses")
+KINDS = ("overview", "torques", "hip", "heights", "poses", "costates")
 
 _VERDICTS: weakref.WeakKeyDictionary[Gait, str] = weakref.WeakKeyDictionary()
 
@@ -97,7 +98,8 @@ def summary_html(gait: Gait, *, verify: bool = True) -> str:
 def gait_figure(gait: Gait, kind: str = "overview") -> Figure:
     """A figure of the gait: ``overview`` (joint angles, hip height and velocity, torques
     against time over one step), or one of the report's figures: ``torques`` (paper Figs.
-    7-8), ``hip`` (Fig. 5), ``heights`` (Fig. 6), ``poses`` (stick figures over the step)."""
+    7-8), ``hip`` (Fig. 5), ``heights`` (Fig. 6), ``poses`` (stick figures over the step),
+    ``costates`` (the recorded costates per phase, :mod:`gaitopt.viz.costate_figures`)."""
     label = f"{gait.speed * 60:.1f} m/min"
     if kind == "overview":
         return overview_figure(gait)
@@ -109,6 +111,8 @@ def gait_figure(gait: Gait, kind: str = "overview") -> Figure:
         return heights_figure([(label, gait)])
     if kind == "poses":
         return stick_strip_figure(gait)
+    if kind == "costates":
+        return costates_figure(gait)
     raise ValueError(f"kind: got {kind!r}; allowed: {', '.join(KINDS)}")
 
 

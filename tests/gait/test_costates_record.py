@@ -1,0 +1,32 @@
+"""The gait record's costates (gaitopt.gait.record_costates) on the paper's default gait."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record_costates import solution_costates
+from gaitopt.gait.transcriptions import transcription_for
+from gaitopt.ocp import costates
+from tests.gait.conftest import Solved
+
+
+def test_the_record_carries_the_final_solves_costates(default_solved: Solved) -> None:
+    sol, gait = default_solved.solution, default_solved.gait
+    res = sol.result
+    tr = transcription_for(sol.model, sol.options, tuple(m.size for m in res.mesh))
+    expected = costates(tr, res)
+    assert set(expected) == {ph.name for ph in gait.phases}
+    for ph in gait.phases:
+        assert ph.costates is not None
+        assert ph.costates.shape == (ph.t.size, len(ph.state_names))
+        np.testing.assert_array_equal(ph.costates, expected[ph.name])
+    assert solution_costates(sol).keys() == expected.keys()
+
+
+def test_the_costates_survive_the_file(default_gait_file: Path) -> None:
+    gait = Gait.load(default_gait_file)
+    assert all(ph.costates is not None and np.all(np.isfinite(ph.costates))
+               for ph in gait.phases)
