@@ -9,6 +9,7 @@ Hermite-Simpson, whose states are cubic there).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 
@@ -134,3 +135,31 @@ def test_a_result_of_another_transcription_is_refused() -> None:
         costates(transcribe(P.smooth_lq(8), method="hermite-simpson"), res)
     with pytest.raises(ProblemError, match="costates"):
         costates(transcribe(P.smooth_lq(10), method="trapezoidal"), res)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_costates_do_not_depend_on_the_nlp_scaling(method: str) -> None:
+    # Result keeps unscaled multipliers: the same costates with or without the NLP's scaling
+    # (state and defect scales 5, objective scale 7) as with none.
+    def solved(scaled: bool) -> dict[str, np.ndarray]:
+        problem = P.free_end_lq(intervals=12)
+        if scaled:
+            ph = dataclasses.replace(problem.phases[0], state_scales={"x": 5.0},
+                                     control_scales={"u": 3.0})
+            problem = dataclasses.replace(problem, phases=[ph], objective_scale=7.0)
+        tr = transcribe(problem, method=method, options=TOL, scaling=scaled)
+        return costates(tr, tr.solve())
+    np.testing.assert_allclose(solved(True)["lq"], solved(False)["lq"], atol=1e-8)
+
+
+def test_a_ratio_cost_scales_the_costates_by_its_denominator() -> None:
+    # J = (int L dt) / D with D = 2 + 0 * x(T) (an expression of the ends): lambda of J is
+    # lambda of int L dt divided by D, since the optimum does not move.
+    problem = P.free_end_lq(intervals=12)
+    ratio = dataclasses.replace(
+        problem, cost_denominator=lambda ends, p: 2.0 + 0.0 * ends["lq"].xf[0])
+    plain_tr = transcribe(problem, options=TOL)
+    ratio_tr = transcribe(ratio, options=TOL)
+    plain = costates(plain_tr, plain_tr.solve())["lq"]
+    np.testing.assert_allclose(costates(ratio_tr, ratio_tr.solve())["lq"], plain / 2.0,
+                               atol=1e-8)
