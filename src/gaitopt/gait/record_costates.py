@@ -24,7 +24,8 @@ def solution_costates(solution: WalkingSolution) -> Mapping[str, Array]:
     """``{phase: (K, n)}`` costates at the knots by the phase's state order, for the phases
     whose costates the transcription gives (not those with knot states, e.g. a placed floating
     base); empty for a failed solve or when the result does not fit the options' problem
-    (another cost, say)."""
+    (another cost, say), or when CasADi cannot evaluate them: a record never fails for its
+    costates."""
     res = solution.result
     if not res.success:
         return {}
@@ -41,6 +42,6 @@ def solution_costates(solution: WalkingSolution) -> Mapping[str, Array]:
         if same_mesh:
             try:
                 return costates(tr, res)
-            except ProblemError:
-                return {}
+            except (ProblemError, RuntimeError):  # CasADi's errors are RuntimeErrors: the
+                return {}                          # record is written without costates
     return {}
