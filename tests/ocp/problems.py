@@ -85,6 +85,24 @@ def cycloid(xf: float, yf: float) -> tuple[float, float, float]:
     return R, phi_f, phi_f * math.sqrt(R / G)
 
 
+def brachistochrone_costates(t: NDArray[np.float64], xf: float = 1.0,
+                             yf: float = 0.6) -> NDArray[np.float64]:
+    """The exact costates ``(lambda_x, lambda_y, lambda_v)`` (M, 3) of :func:`brachistochrone`
+    at times ``t`` (M,), with H = lambda^T f (L = 0, Mayer tf). Along the cycloid theta =
+    pi/2 - phi/2 and v = 2 sqrt(g R) sin(phi/2). Free tf and autonomous dynamics: H = -1;
+    x, y absent from f: lambda_x, lambda_y constant; v(tf) free: lambda_v(tf) = 0, so at tf
+    H_theta = 0 and H = -1 give lambda_x = -cos(theta_f) / v_f, lambda_y = -sin(theta_f) / v_f;
+    H_theta = 0 along the way gives lambda_v = v (lambda_x sin theta - lambda_y cos theta) /
+    (g cos theta) = 2 sqrt(R / g) (lambda_x cos(phi/2) - lambda_y sin(phi/2))."""
+    R, phi_f, _ = cycloid(xf, yf)
+    theta_f = math.pi / 2 - phi_f / 2
+    v_f = 2.0 * math.sqrt(G * R) * math.sin(phi_f / 2)
+    lx, ly = -math.cos(theta_f) / v_f, -math.sin(theta_f) / v_f
+    half = np.asarray(t, dtype=float) * math.sqrt(G / R) / 2
+    lv = 2.0 * math.sqrt(R / G) * (lx * np.cos(half) - ly * np.sin(half))
+    return np.stack([np.full_like(half, lx), np.full_like(half, ly), lv], axis=1)
+
+
 # --- 3. free final time ---
 # min T + int_0^T a^2 dt for the rest-to-rest double integrator over distance 1. For fixed T
 # the energy is 12 / T^3, so J(T) = T + 12 / T^3, minimal at T^4 = 36: T* = sqrt(6),
