@@ -190,3 +190,28 @@ def test_a_ratio_cost_scales_the_costates_by_its_denominator() -> None:
     plain = costates(plain_tr, plain_tr.solve())["lq"]
     np.testing.assert_allclose(costates(ratio_tr, ratio_tr.solve())["lq"], plain / 2.0,
                                atol=1e-8)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("kind", ["path", "bound"])
+def test_the_jump_at_a_knot_is_its_active_rows_multiplier(method: str, kind: str) -> None:
+    # With v <= 1.2 active over the middle of the move (a path row at knots and midpoints, or
+    # a box bound), stationarity in x_k reads lambda_k^+ - lambda_k^- = -(c_x^T pi_k + lam_x):
+    # the one-sided costates jump by the multiplier of the knot's own rows, exactly (the
+    # midpoint rows enter the interval terms, not the jump).
+    problem = P.with_path_constraint(20) if kind == "path" else P.with_state_bound(20)
+    tr = transcribe(problem, method=method, options=TOL)
+    res = tr.solve()
+    assert res.success, res.summary()
+    plus, minus = one_sided_costates(tr, res)["move"]
+    pl = tr.layout.phase("move")
+    if kind == "path":
+        rows = tr.path_rows("move", "speed")[:pl.knots]  # the knot rows come first
+        knot_multiplier = res.lam_g[rows]
+    else:
+        knot_multiplier = res.lam_x[pl.across_knots("state", "v")]
+    assert np.sum(np.abs(knot_multiplier[1:-1]) > 1e-3) >= 5  # active at several knots
+    jump = (plus - minus)[1:-1]
+    scale = np.max(np.abs(plus[:-1]))
+    np.testing.assert_allclose(jump[:, 0], 0.0, atol=1e-9 * scale)
+    np.testing.assert_allclose(jump[:, 1], -knot_multiplier[1:-1], atol=1e-9 * scale)
