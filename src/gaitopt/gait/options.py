@@ -10,7 +10,7 @@ torques free to jump at the events (``control_model="jumps"``), transcribed by s
 Hermite-Simpson (derivatives compiled per grid point). The paper's own setting, 8 + 5 knots
 with continuous and periodic controls in DIRCOL's compressed Hermite-Simpson form (the paper's
 NLP), is :meth:`GaitOptions.paper` (CLI: ``--paper-grid``). The measurements behind the
-choices are in ``docs/walking.md`` (section 6) and ``docs/benchmarks-gait.md``; every field
+choices are in ``docs/walking.md`` (section 6) and ``docs/results/benchmarks-gait.md``; every field
 is documented there.
 """
 
