@@ -44,7 +44,7 @@ napoleon_numpy_docstring = False
 napoleon_attr_annotations = True
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
-autodoc_default_options = {"members": True, "show-inheritance": True}
+autodoc_default_options = {"members": True}
 
 html_theme = "alabaster"
 html_title = f"gaitopt {__version__}"
