@@ -33,10 +33,10 @@ root_doc = "index"
 source_suffix = {".md": "markdown"}
 exclude_patterns = ["_build"]
 
-# Markdown: headings get anchors so that links like `walking.md#6-grid-convergence...` resolve
-# (GitHub's slugs, the form the pages use); `$...$` and `$$...$$` are left as text.
+# Markdown: headings down to level 4 get anchors, so that links like
+# `walking.md#6-grid-convergence-the-control-model-and-swing-clearance` resolve (GitHub's slugs,
+# the form the pages use and GitHub shows). No math extension: `$` is plain text.
 myst_heading_anchors = 4
-myst_enable_extensions = ["colon_fence"]
 
 # The docstrings are Google style (Args:, Returns:, Raises:, Attributes:).
 napoleon_google_docstring = True
