@@ -21,7 +21,7 @@ define run_pytest
 	exit $$status
 endef
 
-.PHONY: run costs test test-suite test-slow test-kernels lint bench clean
+.PHONY: run costs test test-suite test-slow test-kernels lint docs bench clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || { \
@@ -62,8 +62,13 @@ test-suite: $(STAMP)
 test-slow: $(STAMP)
 	$(call run_pytest,-n 2 -m slow)
 
+# The documentation site (docs/index.md; the API and CLI reference generated from the code)
+# into docs/_build/html; any Sphinx warning fails the build. CI runs it after `make test`.
+docs: $(STAMP)
+	$(BIN)/sphinx-build -W --keep-going -b html docs docs/_build/html
+
 bench: $(STAMP)
 	$(BIN)/python bench/dynamics.py
 
 clean:
-	rm -rf $(VENV) build .pytest_cache .mypy_cache .ruff_cache .hypothesis
+	rm -rf $(VENV) build docs/_build .pytest_cache .mypy_cache .ruff_cache .hypothesis

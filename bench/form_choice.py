@@ -5,7 +5,7 @@ For each variant and speed (cold solves from scratch with the default stages, as
 ``bench/gait_grid.py``) and each grid of ``--grids``, solves the compressed form
 (``hermite-simpson``) and the separated one (``hermite-simpson-separated``), then ``verify``;
 ``--fine`` solves the separated form once more on a fine grid (the two forms converge to the
-same limit, ``docs/benchmarks-gait.md``). Prints one row per point: for every grid and form
+same limit, ``docs/results/benchmarks-gait.md``). Prints one row per point: for every grid and form
 converged/verify, wall time and cost; the relative difference of the two forms on each grid;
 the grid error (the change of the cost from the first grid to the second, and to the fine
 grid). A form difference well inside the grid error means the two reach the same optimum

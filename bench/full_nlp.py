@@ -1,8 +1,8 @@
 """IPOPT's own time per iteration for variants of the full-coordinate walking NLP.
 
 Where the time of a full-coordinate warm start goes, and which changes of the NLP's structure
-shorten it (docs/benchmarks-gait.md, "Making the full-coordinate NLP smaller or sparser"). The
-script solves the five-link walk in full coordinates (paper control model, 12 m/min) or loads
+shorten it (docs/results/benchmarks-gait.md, "Making the full-coordinate NLP smaller or sparser").
+The script solves the five-link walk in full coordinates (paper control model, 12 m/min) or loads
 ``--gait FILE``, then warm-starts it at +5 % speed as ``bench/gait.py --targets`` does and
 records what IPOPT got in that solve: the NLP, its options, the start point, the bounds and
 the multipliers. It then solves that same start again for each variant below, every variant

@@ -5,7 +5,7 @@ events; its error estimate (3 x the change of the cost to the check grid, cosine
 after it) says it is within 1 % of the fine-grid limit, and a much finer grid confirms it
 (slow). The paper's
 setting stays available as :meth:`GaitOptions.paper` / ``--paper-grid`` and still gives the
-optima recorded since 2026-11-22 (README, docs/walking.md section 5).
+optima recorded since 2026-11-22 (docs/guide.md, docs/walking.md section 5).
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ def test_the_paper_preset_changes_the_grid_the_control_model_and_the_form_only()
 
 
 def test_the_paper_preset_reproduces_the_papers_optima(solved: SolveFn) -> None:
-    """The optima of the paper's setting recorded in the README and docs/walking.md section 5
+    """The optima of the paper's setting recorded in docs/guide.md and docs/walking.md section 5
     (2026-11-22): 487.94 N^2 m s at 12 m/min; speed free 11.1 m/min, 0.107 m, 486.3."""
     fixed = solved(GaitOptions.paper()).gait
     assert fixed.success and fixed.cost_value == pytest.approx(487.94, abs=0.02)

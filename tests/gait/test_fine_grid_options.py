@@ -2,7 +2,7 @@
 the two-phase walk solves its target and check grids with IPOPT's fast step computation (in
 either formulation) and, in full coordinates, with MUMPS's permuting scaling off; its coarse
 stages and every other problem keep IPOPT's and MUMPS's defaults (the measurements behind
-the choice: docs/benchmarks-gait.md, "MUMPS scaling" and "MUMPS ordering and IPOPT's step
+the choice: docs/results/benchmarks-gait.md, "MUMPS scaling" and "MUMPS ordering and IPOPT's step
 options")."""
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 (issue 12); ``gaitopt solve`` uses it by default far from 12 m/min.
 
 The measurements behind it (cold solves of the default grid against the sweep's optima) are
-in docs/benchmarks-gait.md, "Multistart".
+in docs/results/benchmarks-gait.md, "Multistart".
 """
 
 from __future__ import annotations

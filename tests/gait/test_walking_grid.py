@@ -5,7 +5,7 @@ time of each solve is attached to the test as a user property (``--junitxml`` wi
 ``-o junit_family=legacy`` shows it).
 
 ``bench/gait_grid.py`` runs the same grid as a script and prints the success rate, times,
-costs and the verify outcome as a table (figures in docs/benchmarks-gait.md).
+costs and the verify outcome as a table (figures in docs/results/benchmarks-gait.md).
 """
 
 from __future__ import annotations

@@ -118,7 +118,7 @@ def test_multistart_finds_the_lower_branch_at_high_speed(solved: SolveFn,
                                                          reference: RefFn) -> None:
     """Without ankle torques at 45 m/min the cold solve ends on a long-step local optimum;
     the continuation in speed from 12 m/min that ``multistart`` adds reaches the short-step
-    one, about 13 % cheaper (docs/benchmarks-gait.md), and ``multistart`` keeps it."""
+    one, about 13 % cheaper (docs/results/benchmarks-gait.md), and ``multistart`` keeps it."""
     options = GaitOptions.paper(speed=0.75, ankle=False, impulse=False)
     single = solved(options).gait
     multi = solved(options.replace(multistart=True)).gait

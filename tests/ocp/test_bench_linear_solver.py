@@ -1,6 +1,6 @@
 """bench/linear_solver.py: its option sets reach IPOPT (and only while asked), and its
 command-line sets parse or fail with a clear message. The figures are in
-docs/benchmarks-gait.md, sections "MUMPS scaling" and "MUMPS ordering and IPOPT's step
+docs/results/benchmarks-gait.md, sections "MUMPS scaling" and "MUMPS ordering and IPOPT's step
 options"."""
 
 from __future__ import annotations

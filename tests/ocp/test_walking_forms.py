@@ -4,7 +4,7 @@ The separated form must converge where the compressed one does. Without midpoint
 the compressed NLP with the midpoint states as variables (the same optimum); with them (the
 default) its states also respect their bounds at the midpoints, which costs a little on a
 coarse grid, and the costs of the two forms converge to the same limit as the grid is refined
-(docs/benchmarks-gait.md has the table at 8+5 ... 80+20 knots).
+(docs/results/benchmarks-gait.md has the table at 8+5 ... 80+20 knots).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from gaitopt.robot.biped import biped_of
 SEPARATED = "hermite-simpson-separated"
 MODEL = load_model("five-link")
 #: Bound on the relative cost difference of the two forms at 40 + 10 knots (measured 2.6e-4;
-#: docs/benchmarks-gait.md).
+#: docs/results/benchmarks-gait.md).
 FINE_GAP = 1e-3
 
 
@@ -99,7 +99,7 @@ def test_without_midpoint_bounds_the_separated_nlp_has_the_compressed_optimum() 
 def test_both_forms_converge_to_the_same_fine_grid_cost() -> None:
     """With midpoint bounds the separated form is more constrained on a coarse grid (its
     states respect their bounds between knots), so it costs a little more; the difference
-    vanishes as the grid is refined (docs/benchmarks-gait.md: 8+5 ... 80+20 knots)."""
+    vanishes as the grid is refined (docs/results/benchmarks-gait.md: 8+5 ... 80+20 knots)."""
     gaps = []
     for knots in ((8, 5), (40, 10)):
         com, sep = walk(knots, "hermite-simpson"), walk(knots, SEPARATED)

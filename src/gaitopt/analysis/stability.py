@@ -104,7 +104,7 @@ class StabilityReport:
 
     ``multipliers`` (complex, sorted by modulus, largest first); ``verdict`` "stable" if the
     spectral radius is < 1 - ``margin``, "unstable" if > 1 + ``margin``, else "marginal";
-    ``fixed_point``: "gait start" or "Newton fixed point"; ``residual``: max |P(y) - y| at the
+    ``fixed_point``: "gait start" or "Newton fixed point"; ``residual``: ``max |P(y) - y|`` at the
     analysed state (rad, m, rad/s, m/s) and ``start_residual`` at the gait's own start state;
     ``monodromy`` (2 nq, 2 nq) from the variational equations, ``section_monodromy`` on the
     tangent basis ``basis`` (2 nq, m); ``fd_agreement``: the finite-difference check (None if

@@ -53,7 +53,7 @@ def _speed(text: str) -> float | None:
 
 #: Speeds (m/s) this far from 12 m/min are solved with multistart unless told otherwise
 #: (15 m/min): the cold solves of 57 and 60 m/min end on the long-step branch, 19-25 % above
-#: the sweep's optimum (docs/benchmarks-gait.md, "Multistart").
+#: the sweep's optimum (docs/results/benchmarks-gait.md, "Multistart").
 FAR_FROM_REFERENCE = 0.25
 
 
@@ -123,7 +123,7 @@ def _step_time(text: str) -> float | None:
               help="hermite-simpson: DIRCOL's compressed form, the paper's NLP; "
                    "hermite-simpson-separated: the same scheme with the midpoint states as "
                    "variables (bounded like the knots), several times faster; see "
-                   "docs/benchmarks-gait.md [default: "
+                   "docs/results/benchmarks-gait.md [default: "
                    f"{GaitOptions().transcription}; with --paper-grid "
                    f"{GaitOptions.paper().transcription}].")
 @click.option("--periodic-controls/--periodic-states-only", default=True, show_default=True,

@@ -9,8 +9,9 @@ the few places where the two worlds differ:
   into a list of scalars, checking its length;
 * :func:`vector` and :func:`matrix` turn lists of scalars back into an ``np.ndarray`` when
   every entry is a number, or into a CasADi ``SX``/``MX`` otherwise;
-* :func:`spd_solve` solves small symmetric positive-definite systems by an ``L D L^T``
-  factorization written in scalars (no square roots, no pivoting), so it too works on both.
+* :func:`ldl_factor` and :func:`ldl_solve` (and :func:`spd_inverse`) solve small symmetric
+  positive-definite systems by an ``L D L^T`` factorization written in scalars (no square
+  roots, no pivoting), so they too work on both.
 """
 
 from __future__ import annotations

@@ -110,7 +110,7 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
         model: a :class:`RobotModel`, a built-in model name or a model file.
         options: the variant, targets and bounds (default: the paper's problem at 12 m/min).
         warm_start: a neighbouring gait to start from (the cold path is the fallback).
-        progress: called with a :class:`~gaitopt.gait.solve.StageReport` after every stage.
+        progress: called with a :class:`~gaitopt.gait.solution.StageReport` after every stage.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
 
     Raises:

@@ -63,7 +63,8 @@ def check_consistency(model: RobotModel, p: Mapping[str, float], phases: Sequenc
                       events: Sequence[Any], s: Any) -> None:
     """The parts of a gait agree with its ``model`` (``nq``, ``nu``, contact names) and with
     each other: parameters ``p`` (checked numbers) against the phases' span, phases joined in
-    time, events and samples inside the step. Raises :class:`GaitFileError` naming the field.
+    time, events and samples inside the step. Raises
+    :class:`~gaitopt.gait.gait_fields.GaitFileError` naming the field.
     """
     nq, nu = model.nq, model.nu
     contacts = [c.name for c in model.contacts]

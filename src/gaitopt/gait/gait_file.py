@@ -159,7 +159,7 @@ class Gait:
 
     @property
     def cost_value(self) -> float:
-        """The objective (paper eq. 4/5: energy per metre) as solved."""
+        """The objective as solved (paper eq. 4/5, energy per metre)."""
         return float(self.cost["value"])
 
     @property

@@ -18,8 +18,9 @@ Array = NDArray[np.float64]
 
 def phase_states_at(phase: GaitPhase, t: Array) -> Array:
     """Phase states (M, n) at times ``t`` (M,) by cubic Hermite interpolation of the knots:
-    the transcription's own interpolant (:meth:`gaitopt.ocp.hermite_simpson.HermiteSimpson.
-    state_at`, with s = (t - t_k)/h on the segment [t_k, t_k+1] of length h)."""
+    the transcription's own interpolant
+    (:meth:`gaitopt.ocp.hermite_simpson.HermiteSimpson.state_at`, with s = (t - t_k)/h on the
+    segment [t_k, t_k+1] of length h)."""
     if phase.interpolation["states"] != "cubic_hermite":
         raise ValueError(f"unsupported state interpolation {phase.interpolation['states']!r}")
     t = np.atleast_1d(np.asarray(t, dtype=float))

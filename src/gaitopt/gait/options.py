@@ -10,7 +10,7 @@ torques free to jump at the events (``control_model="jumps"``), transcribed by s
 Hermite-Simpson (derivatives compiled per grid point). The paper's own setting, 8 + 5 knots
 with continuous and periodic controls in DIRCOL's compressed Hermite-Simpson form (the paper's
 NLP), is :meth:`GaitOptions.paper` (CLI: ``--paper-grid``). The measurements behind the
-choices are in ``docs/walking.md`` (section 6) and ``docs/benchmarks-gait.md``; every field
+choices are in ``docs/walking.md`` (section 6) and ``docs/results/benchmarks-gait.md``; every field
 is documented there.
 """
 
@@ -102,7 +102,8 @@ class GaitOptions:
         torso_bounds: torso angle bounds (rad).
         rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates.
         max_impulse: upper bound of the liftoff impulse (N s).
-        tol: IPOPT tolerance; max_iter: IPOPT iteration limit per stage.
+        tol: IPOPT tolerance.
+        max_iter: IPOPT iteration limit per stage.
         continuation: use the automatic continuation from a naive start (else one solve).
         formulation: ``"reduced"`` (the paper's: polar hip coordinates and leg inverse
             kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
@@ -130,8 +131,10 @@ class GaitOptions:
         cost: ``"paper"`` (torque squared per metre), ``"work"`` (mechanical cost of
             transport) or ``"metabolic"`` (with efficiencies and a resting power); formulas in
             :mod:`gaitopt.gait.cost` and docs/costs.md.
-        efficiency_positive, efficiency_negative: muscle efficiencies of positive and negative
-            work (> 0; 0.25 and 1.2) of the metabolic cost.
+        efficiency_positive: muscle efficiency of positive work (> 0; 0.25) of the metabolic
+            cost.
+        efficiency_negative: muscle efficiency of negative work (> 0; 1.2) of the metabolic
+            cost.
         resting_power: resting metabolic power (W/kg, >= 0) of the metabolic cost.
         cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs.
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.

@@ -46,7 +46,7 @@ class MotionOutOfReachError(ValueError):
     verified); a finer grid enforces the reach more densely."""
 
 
-#: Version of the disk cache of :func:`_phase_functions` (part of its key).
+#: Version of the disk cache of ``_phase_functions`` (part of its key).
 RECORD_FORMAT = "record-reduced-1"
 
 

@@ -29,13 +29,13 @@ from gaitopt.robot.model import RobotModel
 Array = NDArray[np.float64]
 
 
-#: Version of the disk cache of :func:`_phase_function` (part of its key).
+#: Version of the disk cache of ``_phase_function`` (part of its key).
 RECORD_FORMAT = "record-full-1"
 
 
 def phase_function_file(model: RobotModel, held: tuple[str, ...], actuators: tuple[str, ...]
                         ) -> Path:
-    """Where :func:`_phase_function` of a phase is cached on disk: keyed by the model, the
+    """Where ``_phase_function`` of a phase is cached on disk: keyed by the model, the
     held points, the actuators, the gaitopt sources and CasADi's version
     (:func:`gaitopt.gait.transcriptions.function_file`)."""
     return function_file(RECORD_FORMAT, (model.content_hash(), held, actuators))

@@ -53,7 +53,8 @@ class StageReport:
 
 @dataclass(frozen=True)
 class WalkingSolution:
-    """The outcome of :func:`solve_walking`: the final OCP result and every stage."""
+    """The outcome of :func:`~gaitopt.gait.solve.solve_walking`: the final OCP result and
+    every stage."""
 
     model: RobotModel
     options: GaitOptions

@@ -144,8 +144,9 @@ MAX_REFINED_KNOTS = 400
 #: (:func:`~gaitopt.gait.stages.sequence_kind`): ``"target"`` (the target grid from the
 #: coarse solution), ``"check"`` (the check grid from the target grid's), ``"refinement"``
 #: (mesh refinement rounds); other moves start from the values only. Measured by
-#: bench/regrid.py (docs/benchmarks-gait.md): the heel-toe walk's check grid took 112 instead
-#: of 188 iterations at 12 m/min and 31 instead of 63 at 36 m/min (seven-link, 24 + 16 knots),
+#: bench/regrid.py (docs/results/benchmarks-gait.md): the heel-toe walk's check grid took 112
+#: instead of 188 iterations at 12 m/min and 31 instead of 63 at 36 m/min (seven-link,
+#: 24 + 16 knots),
 #: the same optima; on the two-phase walk it saved nothing, and the target grid move, which
 #: saved a fifth of that stage's iterations on the five-link walks, sent the heel-toe walk to
 #: a 0.5 % dearer optimum.

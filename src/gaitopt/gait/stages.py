@@ -58,7 +58,7 @@ PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
 #: five-link walk, 2 variants x 7 speeds (3-60 m/min): the fine stages took 698 instead of
 #: 837 iterations in full coordinates on 40 + 10 knots (7.8 instead of 9.0 s) and 741
 #: instead of 874 in the reduced formulation on the default grid, to the same optima
-#: (largest relative difference 8e-11; ``docs/benchmarks-gait.md``). A user's ``tol``
+#: (largest relative difference 8e-11; ``docs/results/benchmarks-gait.md``). A user's ``tol``
 #: above it applies instead, and a held stage that is the answer (speed and step length or
 #: step time given) keeps the user's.
 HELD_STAGE_TOL = 1e-5
@@ -104,7 +104,7 @@ def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
 #: release, the check grid, mesh refinement, a warm start) of the two-phase walk, in either
 #: formulation: IPOPT takes MUMPS's solution of each step's linear system as it is
 #: (``fast_step_computation``: no residuals, no refinement back-solve to check it). Measured
-#: by bench/linear_solver.py (docs/benchmarks-gait.md, "MUMPS ordering and IPOPT's step
+#: by bench/linear_solver.py (docs/results/benchmarks-gait.md, "MUMPS ordering and IPOPT's step
 #: options"): the fine stages took 0.92-0.94x the time on the reduced convergence grid
 #: (80/80 points, 4,769 against 4,783 iterations) and 0.88-0.92x on the full-coordinate
 #: sample (40/40, 2,481 against 2,482), the optima equal to 3e-12. Not for the heel-toe walk
@@ -116,7 +116,7 @@ WALK_FINE_GRID_OPTIONS: dict[str, Any] = {"ipopt.fast_step_computation": "yes"}
 #: Added to :data:`WALK_FINE_GRID_OPTIONS` for the walk in full coordinates: MUMPS without
 #: its permuting scaling (the MC64 matching, which MUMPS otherwise chooses itself, computes
 #: once per analysis and reuses; without it MUMPS scales at every factorization). Measured
-#: by bench/linear_solver.py (docs/benchmarks-gait.md, "MUMPS scaling"): on these stages the
+#: by bench/linear_solver.py (docs/results/benchmarks-gait.md, "MUMPS scaling"): on these stages the
 #: same iterations to the same optima (40/40 points, 3-60 m/min, both ankle variants,
 #: relative cost differences below 3e-13), each iteration cheaper: the target grid 0.92x,
 #: the check grid 0.88x on the default 16 + 6 grid, 0.81x on uniform 40 + 10. Not elsewhere:

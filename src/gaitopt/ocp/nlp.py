@@ -309,7 +309,7 @@ def _folded_knots(i: int, pf: PhaseFunction, pl: PhaseLayout, X: Any, U: Any, p:
     """The point outputs ``(xdot, path, L)`` at the K knots (then at the midpoints
     ``(Xm, Um, tm)``, if given) of a phase with knot states, those of knots 1..K-1 from
     :func:`~gaitopt.ocp.functions.knot_point` on the state variables ``X`` (n, K); and, as
-    :func:`_with_knot_states`, ``X`` with the knot states it returned, their indices in w
+    ``_with_knot_states``, ``X`` with the knot states it returned, their indices in w
     and their values."""
     plain_x, plain_u, plain_t = X[:, :1], U[:, :1], tk[:, :1]
     if midpoints is not None:

@@ -36,7 +36,7 @@ in CasADi's virtual machine. The outer functions are SX functions, always interp
 derivatives are derived for every mesh, and keeping the dynamics, the event maps and the
 knot states out of them is what keeps that cheap (the five-link biped at 60 + 15 knots, full
 coordinates: 0.19-0.28 s per transcription against 0.49-0.57 s with the ends function and the
-knot states in them; ``docs/benchmarks-gait.md``).
+knot states in them; ``docs/results/benchmarks-gait.md``).
 """
 
 from __future__ import annotations

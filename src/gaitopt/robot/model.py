@@ -187,7 +187,7 @@ class RobotModel:
 
     @property
     def nq(self) -> int:
-        """Number of generalized coordinates (= velocities): 3 for the base + one per joint."""
+        """Number of generalized coordinates (= velocities), 3 for the base + one per joint."""
         return 3 + len(self.links) - 1
 
     @property
@@ -207,7 +207,7 @@ class RobotModel:
 
     @property
     def coordinate_names(self) -> tuple[str, ...]:
-        """Names of the entries of ``q``: ``x, y, <base>``, then the joints."""
+        """Names of the entries of ``q`` (``x, y, <base>``, then the joints)."""
         return ("x", "y", self.base.name) + tuple(j.name for j in self.joints)
 
     def link_index(self, name: str) -> int:

@@ -1,7 +1,7 @@
 """Sweeps: many walking problems on a grid, solved in parallel by continuation, resumable.
 
-``run_sweep(spec, directory)`` solves every point of :class:`~gaitopt.study.plan.
-SweepSpec` (the grid and the warm-start chains are described there) on a
+``run_sweep(spec, directory)`` solves every point of
+:class:`~gaitopt.study.plan.SweepSpec` (the grid and the warm-start chains are described there) on a
 :class:`~gaitopt.study.executors.Backend` (local processes by default, a Dask cluster, or
 this process) and writes the sweep directory (``docs/outputs.md`` section 2):
 
