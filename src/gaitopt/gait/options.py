@@ -16,10 +16,11 @@ is documented there.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar, cast
 
 from gaitopt.robot.biped import Biped
 from gaitopt.units import format_speed
@@ -60,6 +61,59 @@ LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper", "transcription": "h
 
 class GaitOptionsError(ValueError):
     """A walking-problem option is out of range (names the field and what is allowed)."""
+
+
+class ModelFloat(float):
+    """A default number that follows the model: its value is the reference biped's (the
+    five-link biped's), and :func:`gaitopt.gait.model_defaults.options_for_model` replaces
+    it with the model's (:mod:`gaitopt.gait.model_scale`). A number given by the caller is
+    a plain ``float`` and stays."""
+
+    __slots__ = ()
+
+
+class ModelTuple(tuple):
+    """A default pair (bounds, knots) that follows the model, as :class:`ModelFloat`."""
+
+    __slots__ = ()
+
+
+class ModelStr(str):
+    """A default choice (gait, formulation) that follows the model, as :class:`ModelFloat`."""
+
+    __slots__ = ()
+
+
+_T = TypeVar("_T")
+
+
+def from_model(value: _T) -> _T:
+    """``value`` marked as a default that follows the model (:class:`ModelFloat`,
+    :class:`ModelTuple`, :class:`ModelStr`)."""
+    if isinstance(value, float):
+        return cast(_T, ModelFloat(value))
+    if isinstance(value, tuple):
+        return cast(_T, ModelTuple(value))
+    if isinstance(value, str):
+        return cast(_T, ModelStr(value))
+    raise TypeError(f"no model default of {type(value).__name__}")
+
+
+def follows_model(value: object) -> bool:
+    """Whether ``value`` is a default still to be chosen from the model (:func:`from_model`)."""
+    return isinstance(value, ModelFloat | ModelTuple | ModelStr)
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, ModelFloat):
+        return float(value)
+    if isinstance(value, ModelStr):
+        return str(value)
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return copy.deepcopy(value)
+    return value
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -164,29 +218,29 @@ class GaitOptions:
             section 6).
     """
 
-    speed: float | None = 0.2
-    speed_bounds: tuple[float, float] = (0.02, 1.5)
+    speed: float | None = from_model(0.2)
+    speed_bounds: tuple[float, float] = from_model((0.02, 1.5))
     step_length: float | None = None
-    step_length_bounds: tuple[float, float] = (0.02, 0.8)
+    step_length_bounds: tuple[float, float] = from_model((0.02, 0.8))
     step_time: float | None = None
     ankle: bool = True
     impulse: bool = True
     single_support_fraction: float = 0.85
-    knots: tuple[int, int] = (16, 6)
+    knots: tuple[int, int] = from_model((16, 6))
     transcription: Transcription = "hermite-simpson-separated"
     periodic_controls: bool = True
     friction: float | None = None
     unilateral_impulses: bool = True
     min_stance_knee_flexion: float = 0.1
     torso_bounds: tuple[float, float] = (-0.8, 0.8)
-    rate_bound: float = 15.0
-    max_impulse: float = 30.0
+    rate_bound: float = from_model(15.0)
+    max_impulse: float = from_model(30.0)
     tol: float = 1e-7
     max_iter: int = 1000
     continuation: bool = True
     multistart: bool = False
-    formulation: Formulation = "reduced"
-    gait: GaitKind = "walk"
+    formulation: Formulation = from_model("reduced")
+    gait: GaitKind = from_model("walk")
     contact_sequence: dict[str, Any] | None = None
     single_support_fraction_bounds: tuple[float, float] | None = None
     free_phase_fractions: bool = False
@@ -194,7 +248,7 @@ class GaitOptions:
     efficiency_positive: float = 0.25
     efficiency_negative: float = 1.2
     resting_power: float = 1.2
-    cost_smoothing: float = 0.01
+    cost_smoothing: float = from_model(0.01)
     cost_regularization: float = 0.0
     mesh_tol: float | None = None
     control_model: ControlModel = "jumps"
@@ -234,11 +288,7 @@ class GaitOptions:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for the gait file (``None`` means free)."""
-        data = dataclasses.asdict(self)
-        for key, value in data.items():
-            if isinstance(value, tuple):
-                data[key] = list(value)
-        return data
+        return {f.name: _plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
 
     @staticmethod
     def saved_defaults() -> dict[str, Any]:

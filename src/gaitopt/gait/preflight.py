@@ -1,0 +1,234 @@
+"""Can this model walk at all? Checks of the model before any solve, each a one-line answer.
+
+A model that cannot walk makes IPOPT fail after minutes with a diagnosis about torques and
+contact forces; these checks say in one line what in the model prevents it and what to
+change, before anything is solved (:func:`preflight`; ``gaitopt solve`` prints the first and
+exits with status 2, writing no gait file):
+
+1. **Unactuated leg joints** (:func:`unactuated_joints`): a joint on a leg (the chain from
+   the base to a contact point) with a range of motion and no actuator: nothing moves the
+   swing leg forward there (a hip without a motor), or holds the torso up.
+2. **Legs that cannot reach the ground** (:func:`unreachable_ground`): within its joint
+   limits and the torso bounds, a leg's first contact point cannot get below its hip
+   (``max_q (y_hip - y_c) <= 0``: the leg cannot stand under the body).
+3. **No step** (:func:`unplaceable_step`): the double-support pose of a short step, solved
+   as a small inverse-kinematics problem for both orders of the legs: the first contact
+   point of the rear leg at ``(0, 0)``, the front leg's at ``(s, 0)`` with ``s``
+   :data:`SHORT_STEP` leg lengths, the hip between them (``0 <= x_hip <= s``) and above the
+   ground, every contact point at ``y >= 0``, the torso within its bounds and every joint
+   within its limits. If no such pose exists for one order, one leg can never be in front of
+   the other: a hip range that allows only a backward swing (MuJoCo's Walker2d thigh range,
+   seen in gaitopt's sign convention) at the torso angles allowed.
+
+The inverse kinematics is ``scipy.optimize.least_squares`` within the bounds from a few
+starts; a pose is found when its residual is below :data:`PLACED` leg lengths.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from gaitopt.gait.model_defaults import legs_contacts
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
+from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
+
+Array = NDArray[np.float64]
+
+#: The step of the placement check, in characteristic leg lengths ``l``
+#: (:func:`gaitopt.gait.model_scale.leg_length`): 0.1 m on the five-link biped, whose
+#: optimal steps are 0.1-0.12 m.
+SHORT_STEP = 0.1
+#: Largest residual (in leg lengths) of a pose that counts as placed: 1 mm on 1 m legs.
+PLACED = 1e-3
+
+
+class UnwalkableModelError(GaitOptionsError):
+    """Something in the model prevents walking (:func:`preflight`); the message says what
+    and what to change."""
+
+
+def _leg_chains(model: RobotModel) -> list[tuple[str, tuple[int, ...]]]:
+    """(first contact point, link indices from below the base to its link) of each leg."""
+    out = []
+    for points in legs_contacts(model):
+        chain = model.chain(model.link_index(model.contact(points[0]).link))[1:]
+        out.append((points[0], chain))
+    return out
+
+
+def unactuated_joints(model: RobotModel) -> list[str]:
+    """A line for each joint on a leg that can move (``lower < upper``) but has no actuator."""
+    actuated = {a.joint for a in model.actuators if a.joint is not None}
+    out, seen = [], set()
+    for point, chain in _leg_chains(model):
+        for i in chain:
+            joint = model.links[i].joint
+            if joint is None or joint.name in actuated or joint.name in seen:
+                continue
+            if joint.limits[1] > joint.limits[0]:
+                seen.add(joint.name)
+                lo, hi = joint.limits
+                out.append(f"model {model.name!r}: joint {joint.name!r} on the leg of "
+                           f"{point!r} has no actuator, so nothing can swing that leg or hold "
+                           f"the body there; add one to the model's actuators (e.g. "
+                           f"{{name: {joint.name}, joint: {joint.name}, limits: [-50, 50]}}) "
+                           f"or lock the joint (limits [{lo:g}, {lo:g}])")
+    return out
+
+
+def _bounds(model: RobotModel, torso: tuple[float, float]) -> tuple[Array, Array]:
+    lo = np.array([-np.inf, -np.inf, torso[0]] + [j.limits[0] for j in model.joints])
+    hi = np.array([np.inf, np.inf, torso[1]] + [j.limits[1] for j in model.joints])
+    return lo, hi
+
+
+def _starts(model: RobotModel, lo: Array, hi: Array) -> list[Array]:
+    """Starting poses inside the box: every joint at 0, at the middle of its range, and at a
+    quarter and three quarters of it (clipped, finite)."""
+    out = []
+    for frac in (None, 0.5, 0.25, 0.75):
+        q = np.zeros(model.nq)
+        if frac is not None:
+            q[3:] = lo[3:] + frac * (hi[3:] - lo[3:])
+        q[2] = 0.0
+        out.append(np.clip(q, np.where(np.isfinite(lo), lo, -1e9),
+                           np.where(np.isfinite(hi), hi, 1e9)))
+    return out
+
+
+def _solve(residual: Callable[[Array], Array], starts: list[Array], lo: Array, hi: Array
+           ) -> tuple[Array, float]:
+    """The least-squares pose of smallest residual norm over ``starts``."""
+    from scipy.optimize import least_squares
+
+    best, best_norm = starts[0], np.inf
+    for q0 in starts:
+        q0 = np.clip(q0, lo + 1e-9, hi - 1e-9)
+        sol = least_squares(residual, q0, bounds=(lo, hi), xtol=1e-12, ftol=1e-12,
+                            gtol=1e-12, max_nfev=400)
+        norm = float(np.linalg.norm(residual(sol.x)))
+        if norm < best_norm:
+            best, best_norm = sol.x, norm
+        if best_norm <= 1e-9:
+            break
+    return best, best_norm
+
+
+def _position(model: RobotModel, q: Array, contact: str) -> Array:
+    from gaitopt.dynamics.kinematics import contact_position
+
+    return np.asarray(contact_position(model, list(q), contact), dtype=float).ravel()
+
+
+def _hip(model: RobotModel, q: Array, chain: tuple[int, ...]) -> Array:
+    from gaitopt.dynamics.kinematics import point_position
+
+    root = model.links[chain[0]]
+    at = root.joint.at if root.joint is not None else (0.0, 0.0)
+    return np.asarray(point_position(model, list(q), model.parent_index(chain[0]), at),
+                      dtype=float).ravel()
+
+
+def _ranges(model: RobotModel, chain: tuple[int, ...]) -> str:
+    joints = [model.links[i].joint for i in chain]
+    return ", ".join(f"{j.name} [{j.limits[0]:g}, {j.limits[1]:g}]" for j in joints
+                     if j is not None)
+
+
+def unreachable_ground(model: RobotModel, torso: tuple[float, float]) -> list[str]:
+    """A line for each leg whose first contact point cannot get below its hip with the
+    torso within ``torso`` (rad) and the joints within their limits."""
+    from scipy.optimize import minimize
+
+    lo, hi = _bounds(model, torso)
+    lo[BASE_X], hi[BASE_X], lo[BASE_Y], hi[BASE_Y] = 0.0, 0.0, 0.0, 0.0
+    out = []
+    for point, chain in _leg_chains(model):
+        def height(q: Array, point: str = point, chain: tuple[int, ...] = chain) -> float:
+            return float(_position(model, q, point)[1] - _hip(model, q, chain)[1])
+
+        best = min(float(minimize(height, np.clip(q0, lo, hi), method="L-BFGS-B",
+                                  bounds=list(zip(lo, hi, strict=True))).fun)
+                   for q0 in _starts(model, lo, hi))
+        if best >= 0.0:
+            out.append(f"model {model.name!r}: the leg of {point!r} cannot reach the ground: "
+                       f"within its joint limits ({_ranges(model, chain)} rad) and the torso "
+                       f"bounds [{torso[0]:g}, {torso[1]:g}] rad that point stays "
+                       f"{best:.3g} m above the hip; widen the ranges so the leg can hang "
+                       "down (all angles 0 is a straight leg pointing down)")
+    return out
+
+
+def unplaceable_step(model: RobotModel, torso: tuple[float, float],
+                     leg_length: float) -> list[str]:
+    """A line for each order of the legs in which no double-support pose of a step of
+    :data:`SHORT_STEP` ``leg_length`` exists (module docstring, check 3)."""
+    legs = _leg_chains(model)
+    if len(legs) != 2:
+        return []
+    step = SHORT_STEP * leg_length
+    lo, hi = _bounds(model, torso)
+    lo[BASE_X], hi[BASE_X] = 0.0, step
+    lo[BASE_Y] = 0.0
+    names = [c.name for c in model.contacts]
+    out = []
+    for (front, front_chain), (rear, _) in (legs, legs[::-1]):
+        def residual(q: Array, front: str = front, rear: str = rear) -> Array:
+            p_f, p_r = _position(model, q, front), _position(model, q, rear)
+            below = [min(float(_position(model, q, c)[1]), 0.0) for c in names]
+            return np.concatenate([p_r, p_f - np.array([step, 0.0]), below])
+
+        starts = []
+        for q0 in _starts(model, lo, hi):
+            q0 = q0.copy()
+            q0[BASE_X], q0[BASE_Y], q0[BASE_ANGLE] = step / 2.0, leg_length, 0.0
+            starts.append(q0)
+        _, norm = _solve(residual, starts, lo, hi)
+        if norm > PLACED * leg_length:
+            out.append(f"model {model.name!r}: the leg of {front!r} can never be in front of "
+                       f"the leg of {rear!r}: no pose within the joint limits "
+                       f"({_ranges(model, front_chain)} rad) and the torso bounds "
+                       f"[{torso[0]:g}, {torso[1]:g}] rad puts {front!r} {step:.3g} m ahead "
+                       f"of {rear!r} on the ground with the hip between them (the best misses "
+                       f"by {norm:.3g} m); widen the hip range forward (positive angles swing "
+                       "the thigh forward)")
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def _preflight(model: RobotModel, torso: tuple[float, float]) -> tuple[str, ...]:
+    from gaitopt.gait.model_scale import leg_length
+
+    problems = unactuated_joints(model) + unreachable_ground(model, torso)
+    if problems:
+        return tuple(problems)
+    try:
+        length = leg_length(model)
+    except ValueError as exc:
+        return (str(exc),)
+    return tuple(unplaceable_step(model, torso, length))
+
+
+def preflight(model: RobotModel, options: GaitOptions) -> tuple[str, ...]:
+    """What in ``model`` prevents walking (module docstring): one line per problem naming it
+    and what to change; empty if nothing does. Only models with two legs (one or two contact
+    points each) are checked; others are left to the contact sequence's own checks.
+    Cached per model and torso bounds."""
+    if len(legs_contacts(model)) != 2:
+        return ()
+    t = options.torso_bounds
+    return _preflight(model, (float(t[0]), float(t[1])))
+
+
+def refuse_unwalkable(model: RobotModel, options: GaitOptions) -> None:
+    """Raise :class:`UnwalkableModelError` with the first :func:`preflight` problem (and how
+    many more there are)."""
+    problems = preflight(model, options)
+    if problems:
+        more = (f" ({len(problems) - 1} more problem(s) of the same kind)"
+                if len(problems) > 1 else "")
+        raise UnwalkableModelError(problems[0] + more)
