@@ -73,10 +73,10 @@ def unactuated_joints(model: RobotModel) -> list[str]:
                 seen.add(joint.name)
                 lo, hi = joint.limits
                 out.append(f"model {model.name!r}: joint {joint.name!r} on the leg of "
-                           f"{point!r} has no actuator, so nothing can swing that leg or hold "
-                           f"the body there; add one to the model's actuators (e.g. "
-                           f"{{name: {joint.name}, joint: {joint.name}, limits: [-50, 50]}}) "
-                           f"or lock the joint (limits [{lo:g}, {lo:g}])")
+                           f"{point!r} (range [{lo:g}, {hi:g}] rad) has no actuator, so "
+                           "nothing can swing that leg or hold the body on it; add one to the "
+                           f"model's actuators, e.g. {{name: {joint.name}, joint: "
+                           f"{joint.name}, limits: [-TAU, TAU]}} (N m)")
     return out
 
 
@@ -100,37 +100,57 @@ def _starts(model: RobotModel, lo: Array, hi: Array) -> list[Array]:
     return out
 
 
-def _solve(residual: Callable[[Array], Array], starts: list[Array], lo: Array, hi: Array
-           ) -> tuple[Array, float]:
-    """The least-squares pose of smallest residual norm over ``starts``."""
+class _Points:
+    """The world positions (m) of every contact point and every leg's hip as compiled
+    functions of ``q`` (nq,), with their Jacobians: the checks evaluate them thousands of
+    times."""
+
+    def __init__(self, model: RobotModel) -> None:
+        import casadi as ca
+
+        from gaitopt.dynamics.kinematics import contact_position, point_position
+
+        q = ca.SX.sym("q", model.nq)
+        rows = [contact_position(model, q, c.name) for c in model.contacts]
+        for _, chain in _leg_chains(model):
+            root = model.links[chain[0]]
+            at = root.joint.at if root.joint is not None else (0.0, 0.0)
+            rows.append(point_position(model, q, model.parent_index(chain[0]), at))
+        p = ca.vertcat(*rows)
+        self.index = {c.name: i for i, c in enumerate(model.contacts)}
+        self.n_contacts = len(model.contacts)
+        self._f = ca.Function("points", [q], [p, ca.jacobian(p, q)])
+
+    def __call__(self, q: Array) -> tuple[Array, Array]:
+        """Positions ``(n_points, 2)`` (contacts in model order, then the hips by leg) and
+        their Jacobian ``(2 n_points, nq)``."""
+        p, jac = self._f(q)
+        return np.asarray(p, dtype=float).reshape(-1, 2), np.asarray(jac, dtype=float)
+
+
+@functools.lru_cache(maxsize=16)
+def _points(model: RobotModel) -> _Points:
+    return _Points(model)
+
+
+def _solve(residual: Callable[[Array], tuple[Array, Array]], starts: list[Array], lo: Array,
+           hi: Array) -> tuple[Array, float]:
+    """The least-squares pose of smallest residual norm over ``starts`` (``residual``
+    returns the residual and its Jacobian)."""
     from scipy.optimize import least_squares
 
     best, best_norm = starts[0], np.inf
     for q0 in starts:
         q0 = np.clip(q0, lo + 1e-9, hi - 1e-9)
-        sol = least_squares(residual, q0, bounds=(lo, hi), xtol=1e-12, ftol=1e-12,
-                            gtol=1e-12, max_nfev=400)
-        norm = float(np.linalg.norm(residual(sol.x)))
+        sol = least_squares(lambda q: residual(q)[0], q0, jac=lambda q: residual(q)[1],
+                            bounds=(lo, hi), xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                            max_nfev=200)
+        norm = float(np.linalg.norm(residual(sol.x)[0]))
         if norm < best_norm:
             best, best_norm = sol.x, norm
         if best_norm <= 1e-9:
             break
     return best, best_norm
-
-
-def _position(model: RobotModel, q: Array, contact: str) -> Array:
-    from gaitopt.dynamics.kinematics import contact_position
-
-    return np.asarray(contact_position(model, list(q), contact), dtype=float).ravel()
-
-
-def _hip(model: RobotModel, q: Array, chain: tuple[int, ...]) -> Array:
-    from gaitopt.dynamics.kinematics import point_position
-
-    root = model.links[chain[0]]
-    at = root.joint.at if root.joint is not None else (0.0, 0.0)
-    return np.asarray(point_position(model, list(q), model.parent_index(chain[0]), at),
-                      dtype=float).ravel()
 
 
 def _ranges(model: RobotModel, chain: tuple[int, ...]) -> str:
@@ -146,12 +166,18 @@ def unreachable_ground(model: RobotModel, torso: tuple[float, float]) -> list[st
 
     lo, hi = _bounds(model, torso)
     lo[BASE_X], hi[BASE_X], lo[BASE_Y], hi[BASE_Y] = 0.0, 0.0, 0.0, 0.0
+    points = _points(model)
     out = []
-    for point, chain in _leg_chains(model):
-        def height(q: Array, point: str = point, chain: tuple[int, ...] = chain) -> float:
-            return float(_position(model, q, point)[1] - _hip(model, q, chain)[1])
+    for leg, (point, chain) in enumerate(_leg_chains(model)):
+        rows = (points.index[point], points.n_contacts + leg)
 
-        best = min(float(minimize(height, np.clip(q0, lo, hi), method="L-BFGS-B",
+        def height(q: Array, rows: tuple[int, int] = rows) -> tuple[float, Array]:
+            """``y_point - y_hip`` (m) and its gradient."""
+            p, jac = points(q)
+            return (float(p[rows[0], 1] - p[rows[1], 1]),
+                    jac[2 * rows[0] + 1] - jac[2 * rows[1] + 1])
+
+        best = min(float(minimize(height, np.clip(q0, lo, hi), jac=True, method="L-BFGS-B",
                                   bounds=list(zip(lo, hi, strict=True))).fun)
                    for q0 in _starts(model, lo, hi))
         if best >= 0.0:
@@ -174,13 +200,21 @@ def unplaceable_step(model: RobotModel, torso: tuple[float, float],
     lo, hi = _bounds(model, torso)
     lo[BASE_X], hi[BASE_X] = 0.0, step
     lo[BASE_Y] = 0.0
-    names = [c.name for c in model.contacts]
+    points = _points(model)
+    n = points.n_contacts
     out = []
     for (front, front_chain), (rear, _) in (legs, legs[::-1]):
-        def residual(q: Array, front: str = front, rear: str = rear) -> Array:
-            p_f, p_r = _position(model, q, front), _position(model, q, rear)
-            below = [min(float(_position(model, q, c)[1]), 0.0) for c in names]
-            return np.concatenate([p_r, p_f - np.array([step, 0.0]), below])
+        f, r = points.index[front], points.index[rear]
+
+        def residual(q: Array, f: int = f, r: int = r) -> tuple[Array, Array]:
+            """Rear point at the origin, front point at ``(s, 0)``, no point below the
+            ground; and the Jacobian."""
+            p, jac = points(q)
+            below = p[:n, 1] < 0.0
+            heights = np.where(below, p[:n, 1], 0.0)
+            d_heights = jac[1:2 * n:2] * below[:, None]
+            value = np.concatenate([p[r], p[f] - np.array([step, 0.0]), heights])
+            return value, np.vstack([jac[2 * r:2 * r + 2], jac[2 * f:2 * f + 2], d_heights])
 
         starts = []
         for q0 in _starts(model, lo, hi):
@@ -229,6 +263,6 @@ def refuse_unwalkable(model: RobotModel, options: GaitOptions) -> None:
     many more there are)."""
     problems = preflight(model, options)
     if problems:
-        more = (f" ({len(problems) - 1} more problem(s) of the same kind)"
+        more = (f" (and {len(problems) - 1} more problem(s) like it)"
                 if len(problems) > 1 else "")
         raise UnwalkableModelError(problems[0] + more)
