@@ -225,7 +225,9 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                 lo, hi = limits[knee]
                 b[knee] = (lo, min(hi, -options.min_stance_knee_flexion))
         for n in model.coordinate_names:
-            b[f"{n}_rate"] = (-rate, rate)
+            # The base position's rates (m/s): the rate bound times the leg length ratio.
+            v = sc.length(rate) if n in ("x", "y") else rate
+            b[f"{n}_rate"] = (-v, v)
         return b
 
     phases: list[Phase] = []

@@ -14,11 +14,15 @@ exits with status 2, writing no gait file):
 3. **No step** (:func:`unplaceable_step`): the double-support pose of a short step, solved
    as a small inverse-kinematics problem for both orders of the legs: the first contact
    point of the rear leg at ``(0, 0)``, the front leg's at ``(s, 0)`` with ``s``
-   :data:`SHORT_STEP` leg lengths, the hip between them (``0 <= x_hip <= s``) and above the
-   ground, every contact point at ``y >= 0``, the torso within its bounds and every joint
+   :data:`SHORT_STEP` leg lengths, the hip midway (``x_hip = s / 2``: the symmetric
+   double-support pose a walk passes through and the naive guesses start from) and above
+   the ground, every contact point at ``y >= 0``, the torso within its bounds and every joint
    within its limits. If no such pose exists for one order, one leg can never be in front of
    the other: a hip range that allows only a backward swing (MuJoCo's Walker2d thigh range,
-   seen in gaitopt's sign convention) at the torso angles allowed.
+   seen in gaitopt's sign convention) at the torso angles allowed. (Kinematics decide: hips
+   in ``[-2, 0]`` still put the front point ahead of the hip when the torso may lean back by
+   about ``s / (2 l)`` rad or more, as the default +-0.8 rad allows; with the torso held
+   within +-0.02 rad they cannot.)
 
 The inverse kinematics is ``scipy.optimize.least_squares`` within the bounds from a few
 starts; a pose is found when its residual is below :data:`PLACED` leg lengths.
@@ -198,7 +202,9 @@ def unplaceable_step(model: RobotModel, torso: tuple[float, float],
         return []
     step = SHORT_STEP * leg_length
     lo, hi = _bounds(model, torso)
-    lo[BASE_X], hi[BASE_X] = 0.0, step
+    # The hip midway between the points (within a micrometre on 1 m legs: the bounds of
+    # least_squares must differ), above the ground.
+    lo[BASE_X], hi[BASE_X] = step / 2.0 - 1e-6 * leg_length, step / 2.0 + 1e-6 * leg_length
     lo[BASE_Y] = 0.0
     points = _points(model)
     n = points.n_contacts
@@ -227,7 +233,7 @@ def unplaceable_step(model: RobotModel, torso: tuple[float, float],
                        f"the leg of {rear!r}: no pose within the joint limits "
                        f"({_ranges(model, front_chain)} rad) and the torso bounds "
                        f"[{torso[0]:g}, {torso[1]:g}] rad puts {front!r} {step:.3g} m ahead "
-                       f"of {rear!r} on the ground with the hip between them (the best misses "
+                       f"of {rear!r} on the ground with the hip midway (the best misses "
                        f"by {norm:.3g} m); widen the hip range forward (positive angles swing "
                        "the thigh forward)")
     return out

@@ -217,7 +217,9 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             bounds[leg.knee] = _limits(model, leg.knee)
         for n in names:
             if n.endswith("_rate"):
-                bounds[n] = (-rate, rate)
+                # The hip's radial rate (m/s): the rate bound times the leg length ratio.
+                v = sc.length(rate) if n == "r_rate" else rate
+                bounds[n] = (-v, v)
         return {n: bounds[n] for n in names}
 
     paper_cost = options.cost == "paper" and options.cost_regularization == 0.0
