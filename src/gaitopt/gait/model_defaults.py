@@ -87,11 +87,12 @@ def default_gait(model: RobotModel) -> str:
 
 def gait_problem(model: RobotModel, gait: str) -> str | None:
     """Why ``model`` cannot do the built-in ``gait`` (one line naming the gait it can), or
-    None if it can (the walk and the run need one point per leg, the heel-toe walk two)."""
+    None if it can (the walk and the run need one point per leg, the heel-toe walk two) or
+    if no built-in gait fits (the gait's own checks then name what the model lacks)."""
     try:
         allowed = default_gait(model)
-    except GaitOptionsError as exc:
-        return f"gait = {gait!r}: {exc}"
+    except GaitOptionsError:
+        return None
     if gait == allowed or (gait == "run" and allowed == "walk"):
         return None
     also = " or 'run'" if allowed == "walk" else ""
@@ -122,8 +123,9 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
     the model's value; the values the caller gave stay.
 
     Raises:
-        GaitOptionsError: a given built-in gait the model cannot do (:func:`gait_problem`),
-            or no built-in gait fits and none was given.
+        GaitOptionsError: a given built-in gait the model cannot do (:func:`gait_problem`).
+            (When no built-in gait fits and none was given, the gait is the walk, and the
+            walk's own checks name what the model lacks.)
     """
     from gaitopt.gait.formulation import default_formulation
 
@@ -134,7 +136,12 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
         if follows_model(o.gait):
             changes["gait"] = gait
     elif follows_model(o.gait):
-        gait = changes["gait"] = default_gait(model)
+        try:
+            gait = changes["gait"] = default_gait(model)
+        except GaitOptionsError:
+            # No built-in gait fits (not two legs with one or two points each): the walk, whose
+            # own checks say what the model lacks (two contact points, one per leg).
+            gait = changes["gait"] = "walk"
     elif (why := gait_problem(model, gait)) is not None:
         raise GaitOptionsError(why)
     if follows_model(o.formulation):
