@@ -24,8 +24,9 @@ exits with status 2, writing no gait file):
    about ``s / (2 l)`` rad or more, as the default +-0.8 rad allows; with the torso held
    within +-0.02 rad they cannot.)
 
-The inverse kinematics is ``scipy.optimize.least_squares`` within the bounds from a few
-starts; a pose is found when its residual is below :data:`PLACED` leg lengths.
+The inverse kinematics is a bounded least-squares problem (Levenberg-Marquardt,
+:func:`_least_squares`) from a few starts; a pose is found when its residual is below
+:data:`PLACED` leg lengths.
 """
 
 from __future__ import annotations
@@ -48,6 +49,8 @@ Array = NDArray[np.float64]
 SHORT_STEP = 0.1
 #: Largest residual (in leg lengths) of a pose that counts as placed: 1 mm on 1 m legs.
 PLACED = 1e-3
+#: Most Levenberg-Marquardt steps of one inverse-kinematics solve (:func:`_least_squares`).
+MAX_STEPS = 300
 
 
 class UnwalkableModelError(GaitOptionsError):
@@ -137,21 +140,46 @@ def _points(model: RobotModel) -> _Points:
     return _Points(model)
 
 
+def _least_squares(residual: Callable[[Array], tuple[Array, Array]], q0: Array, lo: Array,
+                   hi: Array, enough: float = 0.0) -> Array:
+    """A local minimum of ``|r(q)|^2`` within ``lo <= q <= hi``, or the first point where it
+    is at most ``enough``: Levenberg-Marquardt steps on the variables not held at a bound by
+    the gradient, clipped into the box (a few hundred small systems; SciPy's optimizer takes
+    longer to import than these checks to run)."""
+    q, mu = np.clip(q0, lo, hi), 1e-3
+    r, jac = residual(q)
+    cost = float(r @ r)
+    for _ in range(MAX_STEPS):
+        grad = jac.T @ r
+        free = ~(((q <= lo) & (grad > 0.0)) | ((q >= hi) & (grad < 0.0)))
+        jf = jac[:, free]
+        step = np.zeros_like(q)
+        step[free] = -np.linalg.solve(jf.T @ jf + mu * np.eye(jf.shape[1]), jf.T @ r)
+        trial = np.clip(q + step, lo, hi)
+        r_trial, jac_trial = residual(trial)
+        cost_trial = float(r_trial @ r_trial)
+        if cost_trial < cost:
+            done = cost - cost_trial <= 1e-15 * (1.0 + cost)
+            q, r, jac, cost, mu = trial, r_trial, jac_trial, cost_trial, max(mu / 3.0, 1e-12)
+            if done or cost <= enough:
+                break
+        else:
+            mu *= 4.0
+            if mu > 1e10:
+                break
+    return q
+
+
 def _solve(residual: Callable[[Array], tuple[Array, Array]], starts: list[Array], lo: Array,
            hi: Array) -> tuple[Array, float]:
     """The least-squares pose of smallest residual norm over ``starts`` (``residual``
     returns the residual and its Jacobian)."""
-    from scipy.optimize import least_squares
-
     best, best_norm = starts[0], np.inf
     for q0 in starts:
-        q0 = np.clip(q0, lo + 1e-9, hi - 1e-9)
-        sol = least_squares(lambda q: residual(q)[0], q0, jac=lambda q: residual(q)[1],
-                            bounds=(lo, hi), xtol=1e-12, ftol=1e-12, gtol=1e-12,
-                            max_nfev=200)
-        norm = float(np.linalg.norm(residual(sol.x)[0]))
+        q = _least_squares(residual, q0, lo, hi)
+        norm = float(np.linalg.norm(residual(q)[0]))
         if norm < best_norm:
-            best, best_norm = sol.x, norm
+            best, best_norm = q, norm
         if best_norm <= 1e-9:
             break
     return best, best_norm
@@ -166,24 +194,34 @@ def _ranges(model: RobotModel, chain: tuple[int, ...]) -> str:
 def unreachable_ground(model: RobotModel, torso: tuple[float, float]) -> list[str]:
     """A line for each leg whose first contact point cannot get below its hip with the
     torso within ``torso`` (rad) and the joints within their limits."""
-    from scipy.optimize import minimize
-
     lo, hi = _bounds(model, torso)
     lo[BASE_X], hi[BASE_X], lo[BASE_Y], hi[BASE_Y] = 0.0, 0.0, 0.0, 0.0
     points = _points(model)
     out = []
     for leg, (point, chain) in enumerate(_leg_chains(model)):
         rows = (points.index[point], points.n_contacts + leg)
+        # Least squares of (y_point - y_hip + depth): minimises the point's height above the
+        # hip while it stays above -depth; depth is twice the farthest the point can be
+        # from the hip (the joint offsets down the chain and the point's offset).
+        offsets = [model.links[i].joint for i in chain[1:]]
+        reach = float(sum(np.hypot(*j.at) for j in offsets if j is not None)
+                      + np.hypot(*model.contact(point).at))
+        depth = 2.0 * reach
 
-        def height(q: Array, rows: tuple[int, int] = rows) -> tuple[float, Array]:
-            """``y_point - y_hip`` (m) and its gradient."""
+        def height(q: Array, rows: tuple[int, int] = rows, depth: float = depth
+                   ) -> tuple[Array, Array]:
             p, jac = points(q)
-            return (float(p[rows[0], 1] - p[rows[1], 1]),
-                    jac[2 * rows[0] + 1] - jac[2 * rows[1] + 1])
+            value = np.array([p[rows[0], 1] - p[rows[1], 1] + depth])
+            return value, (jac[2 * rows[0] + 1] - jac[2 * rows[1] + 1])[None, :]
 
-        best = min(float(minimize(height, np.clip(q0, lo, hi), jac=True, method="L-BFGS-B",
-                                  bounds=list(zip(lo, hi, strict=True))).fun)
-                   for q0 in _starts(model, lo, hi))
+        # Enough: the point below the hip by a thousandth of its reach.
+        enough = (depth - PLACED * reach) ** 2
+        best = np.inf
+        for q0 in _starts(model, lo, hi):
+            q = _least_squares(height, q0, lo, hi, enough)
+            best = min(best, float(height(q, depth=0.0)[0][0]))
+            if best < 0.0:
+                break
         if best >= 0.0:
             out.append(f"model {model.name!r}: the leg of {point!r} cannot reach the ground: "
                        f"within its joint limits ({_ranges(model, chain)} rad) and the torso "
