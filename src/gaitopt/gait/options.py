@@ -120,11 +120,23 @@ def _plain(value: Any) -> Any:
 class GaitOptions:
     """Every option of the walking problem (SI units).
 
+    Defaults that follow the model (:func:`from_model`: ``speed``, ``speed_bounds``,
+    ``step_length_bounds``, ``rate_bound``, ``max_impulse``, ``cost_smoothing``, ``knots``,
+    ``formulation``, ``gait``) hold the five-link biped's values here; a solve replaces each
+    one the caller did not give with the model's
+    (:func:`gaitopt.gait.model_defaults.options_for_model`: the gait its contact points
+    allow, Froude-scaled speeds and bounds), which for the five-link biped are the same
+    values exactly. A value given by the caller always stays.
+
     Attributes:
-        speed: average forward speed (m/s), or ``None`` for free (the optimal walk).
-        speed_bounds: bounds (m/s) when the speed is free.
+        speed: average forward speed (m/s), or ``None`` for free (the optimal walk). Default:
+            the gait's at equal Froude number (0.2 m/s for the five-link walk;
+            :data:`gaitopt.gait.model_defaults.DEFAULT_SPEEDS`).
+        speed_bounds: bounds (m/s) when the speed is free (default 0.02-1.5 m/s on 1 m legs,
+            times ``sqrt(g l / (9.81 * 1 m))``).
         step_length: step length (m), or ``None`` for free.
-        step_length_bounds: bounds (m) when the step length is free.
+        step_length_bounds: bounds (m) when the step length is free (default 0.02-0.8 m on
+            1 m legs, times ``l / 1 m``).
         step_time: step time ``L / v`` (s), or ``None`` for free. With a given speed it
             fixes the step length; with the speed free, the optimal walk of that step time.
             Give at most one of ``step_length`` and ``step_time``.
@@ -134,7 +146,8 @@ class GaitOptions:
             single-support gait (no double support, the trailing leg leaves at heel strike).
         knots: grid points per phase (single support, double support): 16 + 6 by default
             (the cost within 0.1 % of the fine-grid limit with ``control_model="jumps"``);
-            the paper's 8 + 5 with :meth:`paper`.
+            the paper's 8 + 5 with :meth:`paper`; 24 + 16 for steps of more than two phases
+            (:data:`gaitopt.gait.model_defaults.MULTI_PHASE_KNOTS`).
         transcription: ``"hermite-simpson-separated"`` (the default: the midpoint states
             as NLP variables, bounded like the knots; derivatives assembled from compiled
             functions of one grid point, several times faster per iteration),
@@ -153,15 +166,19 @@ class GaitOptions:
             and keeps the leg inverse kinematics away from its singularity at a straight knee
             (> 0 in the reduced formulation; >= 0 in the full one, where 0 lets the stance
             knee straighten up to its joint limit).
-        torso_bounds: torso angle bounds (rad).
-        rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates.
-        max_impulse: upper bound of the liftoff impulse (N s).
+        torso_bounds: torso angle bounds (rad; angles need no scaling between models).
+        rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates (default
+            15 rad/s on 1 m legs, times ``sqrt(l_ref / l)``; the radial and base rates, in
+            m/s, are this times ``l / l_ref``).
+        max_impulse: upper bound of the liftoff impulse (N s; default 30 N s for 42 kg on
+            1 m legs, times ``m sqrt(g l) / (m_ref sqrt(g_ref l_ref))``).
         tol: IPOPT tolerance; max_iter: IPOPT iteration limit per stage.
         continuation: use the automatic continuation from a naive start (else one solve).
         formulation: ``"reduced"`` (the paper's: polar hip coordinates and leg inverse
             kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
             with the held contact points as constraints: any model with two legs; a knee may
-            straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md.
+            straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md. Default:
+            reduced for the walk of a five-link-shaped biped, else full.
         single_support_fraction_bounds: ``None`` (the fraction is ``single_support_fraction``)
             or ``(lower, upper)``: the fraction is free within them, a decision parameter
             (``single_support_fraction`` is its first guess); full formulation, with double
@@ -176,7 +193,9 @@ class GaitOptions:
             ``single_support_fraction`` of the step, then flight; full formulation only, no
             liftoff impulse) or ``"heel-toe"`` (feet with heel and toe points: foot flat,
             heel off, double support, heel rocker; full formulation; see
-            :func:`gaitopt.gait.builtin_sequences.heel_toe_sequence`).
+            :func:`gaitopt.gait.builtin_sequences.heel_toe_sequence`). Default: what the
+            model's contact points allow, the walk with one per leg, the heel-toe walk with
+            two (:func:`gaitopt.gait.model_defaults.default_gait`).
         contact_sequence: a contact sequence as plain data (the gait file's
             ``contact_sequence``; :func:`gaitopt.gait.contact_sequence.sequence_from_dict`),
             which replaces ``gait``; full formulation only. A phase fraction is a number
@@ -187,7 +206,8 @@ class GaitOptions:
         efficiency_positive, efficiency_negative: muscle efficiencies of positive and negative
             work (> 0; 0.25 and 1.2) of the metabolic cost.
         resting_power: resting metabolic power (W/kg, >= 0) of the metabolic cost.
-        cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs.
+        cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs
+            (default 0.01 W for 42 kg on 1 m legs, carried over as a power).
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, take every distinct coarse optimum through the
