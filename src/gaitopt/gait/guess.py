@@ -39,6 +39,9 @@ Array = NDArray[np.float64]
 
 #: Samples per phase used to differentiate the guess curves.
 _FINE = 400
+#: Weight (1/m on the reference biped's 1 m legs) of the contact forces' columns in the
+#: least-squares torques of the guess (:func:`_torques`): forces are cheap.
+FORCE_WEIGHT = 100.0
 
 
 @dataclass(frozen=True)
@@ -90,12 +93,14 @@ def _knots(t0: float, duration: float, count: int) -> Array:
 
 def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple[str, ...],
              held: list[str]) -> Array:
-    """Least-``u'u`` torques (and any contact forces) realising ``qdd``."""
+    """Least-``u'u`` torques (and any contact forces) realising ``qdd``: forces are cheap in
+    the least-squares norm, their columns weighted by :data:`FORCE_WEIGHT` over the leg length
+    ratio (torques scale as ``m g l``, forces as ``m g``)."""
     m_q = np.asarray(crba(model, q), dtype=float)
     h = np.asarray(bias_forces(model, q, qd), dtype=float).reshape(-1)
     b_full = np.asarray(actuation_matrix(model, q, held), dtype=float)
     cols = [model.actuator_index(n) for n in controls]
-    force_scale = 100.0  # forces are cheap in the least-squares norm
+    force_scale = FORCE_WEIGHT / model_scale(model).length_factor
     a = b_full[:, cols]
     if held:
         j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(-1, model.nq)

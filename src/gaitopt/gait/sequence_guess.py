@@ -42,8 +42,9 @@ from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 
 #: Samples per phase of the inverse kinematics (rates are differentiated from them).
 SAMPLES = 60
-#: Weights of the inverse-kinematics residuals: held points, swinging points, base path,
-#: torso, joints.
+#: Weights of the inverse-kinematics residuals: held points, swinging points, base path (per
+#: metre on the reference biped's 1 m legs: distances are divided by ``l / l_ref``), torso,
+#: joints (per radian).
 W_HELD, W_SWING, W_BASE, W_TORSO, W_JOINT = 10.0, 1.0, 0.1, 0.3, 0.02
 #: The pose the joints are pulled toward (rad): knees slightly flexed so that the inverse
 #: kinematics stays on the knee-forward branch; other joints 0.
@@ -135,6 +136,7 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     lift = (lift if lift is not None else
             scale.length(min(0.05, 0.015 + 0.1 * step / scale.length_factor)))
     rows = _ground_points(seq, swap, step, total)
+    per_length = 1.0 / scale.length_factor  # distances in reference leg lengths
     names = [c.name for c in model.contacts]
     zero = np.zeros(model.nq)
     stand = -min(float(contact_position(model, zero, c)[1]) for c in names)
@@ -163,12 +165,12 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
                     if tgt is None:
                         continue
                     p = np.asarray(contact_position(model, qq, c), dtype=float).ravel()
-                    r.append(W_HELD * min(p[1], 0.0))   # never below the ground
+                    r.append(W_HELD * per_length * min(p[1], 0.0))   # never below the ground
                     if tgt[0] is not None:
-                        r.append(tgt[2] * (p[0] - tgt[0]))
-                    r.append(tgt[2] * (p[1] - tgt[1]))
-                r += [W_BASE * (qq[BASE_X] - base[0]), W_BASE * (qq[BASE_Y] - base[1]),
-                      W_TORSO * qq[BASE_ANGLE]]
+                        r.append(tgt[2] * per_length * (p[0] - tgt[0]))
+                    r.append(tgt[2] * per_length * (p[1] - tgt[1]))
+                r += [W_BASE * per_length * (qq[BASE_X] - base[0]),
+                      W_BASE * per_length * (qq[BASE_Y] - base[1]), W_TORSO * qq[BASE_ANGLE]]
                 r += list(W_JOINT * (qq[3:] - pose[3:]))
                 return np.array(r)
 
