@@ -244,3 +244,24 @@ def test_the_seven_link_default_command_converges_and_verifies(tmp_path: Path) -
     assert abs(estimate) <= 0.01 * gait.cost_value
     verified = CliRunner().invoke(cli, ["verify", str(out)])
     assert verified.exit_code == 0, verified.output
+
+
+@pytest.mark.parametrize(("model", "gait", "formulation"), [
+    ("five-link", "walk", "reduced"), ("seven-link", "heel-toe", "full")])
+def test_sweep_defaults_to_the_gait_the_model_allows(monkeypatch: pytest.MonkeyPatch,
+                                                     tmp_path: Path, model: str, gait: str,
+                                                     formulation: str) -> None:
+    """``gaitopt sweep --model M`` without ``--gait``: the same gait as ``gaitopt solve``."""
+    seen: dict[str, object] = {}
+
+    def capture(**kwargs: object) -> object:
+        seen.update(kwargs)
+        raise SystemExit(0)
+
+    monkeypatch.setattr("gaitopt.cli.study.make_spec", capture)
+    result = CliRunner().invoke(cli, ["sweep", "-o", str(tmp_path / "s"), "--model", model,
+                                      "--speeds", "30"])
+    assert result.exit_code == 0, result.output
+    problem = seen["problem"]
+    assert isinstance(problem, dict)
+    assert (problem["gait"], problem["formulation"]) == (gait, formulation)
