@@ -73,8 +73,8 @@ BAD_REQUESTS: dict[str, tuple[list[str], tuple[str, ...]]] = {
     "single support fraction zero": (["--single-support", "0"], ("single_support_fraction",)),
     "negative friction": (["--friction", "-0.5"], ("friction",)),
     "unknown model": (["--model", "no-such-model"], ("no-such-model",)),
-    "heel-toe without feet": (["--gait", "heel-toe"], ("heel-toe", "two contact points on the "
-                                                                  "foot")),
+    "heel-toe without feet": (["--gait", "heel-toe"], ("heel-toe", "one contact point on each "
+                                                                  "leg", "--gait walk")),
     "missing sequence file": (["--contact-sequence", "/no/such.yaml"], ("--contact-sequence",
                                                                         "No such file")),
 }
@@ -209,9 +209,9 @@ def test_warm_start_from_a_gait_file_solves_a_nearby_speed_in_one_stage(
 
 def test_a_coarse_grid_for_a_heel_toe_step_is_noted(no_solve: None, tmp_path: Path) -> None:
     """The seven-link heel-toe walk fails verify between knots on coarse grids
-    (docs/feet.md): the solve says so before it starts."""
+    (docs/feet.md): the solve says so before it starts (its default grid is 24 + 16)."""
     result = solve("--model", "seven-link", "--gait", "heel-toe", "--speed", "30m/min",
-                   "-o", str(tmp_path / "g.gait.json"))
+                   "--knots", "16,6", "-o", str(tmp_path / "g.gait.json"))
     text = " ".join(result.output.split())
     assert "full coordinates" in text
     assert "4-phase step on 16+6 knots is coarse" in text and "24,16" in text

@@ -87,18 +87,24 @@ def test_a_knee_less_walk_with_free_phase_fractions(solved: SolveFn, reference: 
 
 
 def test_a_step_the_legs_cannot_reach_is_a_clear_error(tmp_path: Path) -> None:
-    """Legs of 0.3 m cannot make a 0.75 m step: the generic guess says which point it cannot
-    hold where, and the solve stops with a one-line error before any NLP."""
+    """Legs of 0.3 m cannot make a 0.75 m step: the step length bounds that follow the model
+    (0.8 m on 1 m legs: 0.24 m) refuse it; with the bounds widened by hand the generic guess
+    says which point it cannot hold where, and the solve stops with a one-line error before
+    any NLP."""
     data = yaml.safe_load(COMPASS.read_text())
     for link in data["links"][1:]:
         link["length"], link["com"] = 0.3, [0.15, 0.0]
     for contact in data["contacts"]:
         contact["at"] = [0.3, 0.0]
     model = model_from_dict(data)
+    with pytest.raises(GaitOptionsError, match=r"step_length = 0.75 m: must lie in "
+                       r"step_length_bounds \[0.006, 0.24\] m"):
+        solve_gait(model, GaitOptions(formulation="full", step_length=0.75))
     with pytest.raises(GaitOptionsError, match=r"step_length = 0.75 m: every naive start puts "
                        r"a leg beyond its reach \(the legs of model 'compass' cannot hold "
-                       r"'tip_1'.*misses it by 0.07"):
-        solve_gait(model, GaitOptions(formulation="full", step_length=0.75))
+                       r"'tip_1'.*misses it by 0.0"):
+        solve_gait(model, GaitOptions(formulation="full", step_length=0.75, speed=0.2,
+                                      step_length_bounds=(0.02, 0.8)))
 
 
 def test_the_documented_model_is_this_one(compass: RobotModel) -> None:

@@ -114,11 +114,14 @@ def model_option(f: F) -> F:
 
 def knots_option(f: F) -> F:
     """``--knots SINGLE,DOUBLE`` (text or None: the default grid; see :func:`grid_choice`)."""
+    from gaitopt.gait.model_defaults import MULTI_PHASE_KNOTS
     from gaitopt.gait.options import GaitOptions
 
     return click.option("--knots", default=None,
                         help="Grid points per phase: single support, double support [default: "
-                             f"{','.join(map(str, GaitOptions().knots))}].")(f)
+                             f"{','.join(map(str, GaitOptions().knots))}; "
+                             f"{','.join(map(str, MULTI_PHASE_KNOTS))} for steps of more than "
+                             "two phases, e.g. the heel-toe walk].")(f)
 
 
 def paper_grid_option(f: F) -> F:

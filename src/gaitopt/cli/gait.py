@@ -28,8 +28,10 @@ from gaitopt.cli.base import (
     parse_pair,
     resting_power_option,
 )
-from gaitopt.gait.formulation import biped_for, checked_sequence, default_formulation
+from gaitopt.gait.formulation import biped_for, checked_sequence
 from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.model_defaults import MULTI_PHASE_KNOTS, options_for_model
+from gaitopt.gait.model_scale import model_scale
 from gaitopt.gait.options import (
     GAITS,
     TRANSCRIPTIONS,
@@ -37,12 +39,14 @@ from gaitopt.gait.options import (
     GaitOptionsError,
     validate_options,
 )
-from gaitopt.gait.solve import REFERENCE_SPEED, StageReport
+from gaitopt.gait.preflight import refuse_unwalkable
+from gaitopt.gait.solve import REFERENCE_SPEED, StageReport, reference_speed
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
 
 
 def _speed(text: str) -> float | None:
+    """The ``--speed`` text in m/s, or None for free."""
     if text.strip().lower() == "free":
         return None
     try:
@@ -53,22 +57,21 @@ def _speed(text: str) -> float | None:
 
 #: Speeds (m/s) this far from 12 m/min are solved with multistart unless told otherwise
 #: (15 m/min): the cold solves of 57 and 60 m/min end on the long-step branch, 19-25 % above
-#: the sweep's optimum (docs/results/benchmarks-gait.md, "Multistart").
+#: the sweep's optimum (docs/results/benchmarks-gait.md, "Multistart"). On the reference
+#: biped (1 m legs); another model's is this at equal Froude number.
 FAR_FROM_REFERENCE = 0.25
 
 
-def multistart_default(speed: float | None, formulation: str | None) -> bool:
+def multistart_default(speed: float | None, formulation: str | None,
+                       reference: float = REFERENCE_SPEED, far: float = FAR_FROM_REFERENCE
+                       ) -> bool:
     """Whether ``gaitopt solve`` uses multistart when neither ``--multistart`` nor
     ``--no-multistart`` is given: for the paper's walk in reduced coordinates (where it was
-    measured) at a given speed at least :data:`FAR_FROM_REFERENCE` from 12 m/min (the
-    speed-free optimal walk starts at 12 m/min)."""
+    measured) at a given speed at least ``far`` (:data:`FAR_FROM_REFERENCE` on the reference
+    biped) from the ``reference`` speed (12 m/min on the reference biped: the speed-free
+    optimal walk starts there; a model's: :func:`gaitopt.gait.solve.reference_speed`)."""
     return (formulation == "reduced" and speed is not None
-            and abs(speed - REFERENCE_SPEED) >= FAR_FROM_REFERENCE - 1e-12)
-
-
-#: The grid on which the seven-link heel-toe walk passes ``verify`` (docs/feet.md: 8+5 and
-#: 16+10 do not, 24+16 does at 30-80 m/min).
-FOUR_PHASE_KNOTS = (24, 16)
+            and abs(speed - reference) >= far - 1e-12)
 
 
 def read_sequence(path: Path) -> dict[str, Any]:
@@ -97,8 +100,11 @@ def _step_time(text: str) -> float | None:
 
 @cli.command("solve")
 @model_option
-@click.option("--speed", default="12m/min", show_default=True,
-              help="Average speed with a unit (12m/min, 0.2m/s) or 'free' (the optimal walk).")
+@click.option("--speed", default=None,
+              help="Average speed with a unit (12m/min, 0.2m/s) or 'free' (the optimal walk) "
+                   "[default: the model's, at equal Froude number v^2/(g l): 12 m/min for the "
+                   "five-link walk, 72.2 m/min for the seven-link heel-toe walk; "
+                   "docs/walking.md].")
 @click.option("--step-length", default="free", show_default=True,
               help="Step length in m, or 'free'.")
 @click.option("--step-time", default="free", show_default=True,
@@ -139,10 +145,11 @@ def _step_time(text: str) -> float | None:
                    "sequence, knees may straighten) [default: reduced for the five-link shape "
                    "and the walk, else full].", default=None)
 @min_knee_flexion_option
-@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default="walk",
-              show_default=True,
+@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default=None,
               help="The contact sequence: walk, run (stance then flight; needs --no-impulse) "
-                   "or heel-toe (feet with heel and toe points, e.g. --model seven-link).")
+                   "or heel-toe (feet with heel and toe points, e.g. --model seven-link) "
+                   "[default: what the model's feet allow: walk with one contact point per "
+                   "leg, heel-toe with two].")
 @click.option("--contact-sequence", "sequence_file",
               type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="A YAML file with a contact sequence (phases, events, anchors; "
@@ -178,7 +185,7 @@ def _step_time(text: str) -> float | None:
                                  "gait); the cold path is the fallback.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
-def solve_command(model_name: str, speed: str, step_length: str, step_time: str, ankle: bool,
+def solve_command(model_name: str, speed: str | None, step_length: str, step_time: str, ankle: bool,
                   impulse: bool,
                   single_support: float, knots: str | None, knot_spacing: str | None,
                   paper_grid: bool,
@@ -187,7 +194,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
                   free_fractions: bool,
-                  gait_kind: str, sequence_file: Path | None, cost: str,
+                  gait_kind: str | None, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
                   control_model: str | None, mesh_tol: float | None,
                   clearance: float | None, clearance_profile: str, compiled: bool,
@@ -207,21 +214,21 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         except GaitFileError as exc:
             raise UserError(f"--warm-start: {exc}") from None
     sequence = None if sequence_file is None else read_sequence(sequence_file)
-    if formulation is None:
-        formulation = default_formulation(model, gait_kind, sequence is not None)
+    # Options not given keep the defaults that follow the model (options_for_model below).
+    given: dict[str, Any] = {"speed": _speed(speed)} if speed is not None else {}
+    given |= {"formulation": formulation} if formulation is not None else {}
+    given |= {"gait": gait_kind} if gait_kind is not None else {}
     options = GaitOptions(
         contact_sequence=sequence,
-        speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
+        step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=impulse,
         single_support_fraction=single_support,
         **{**grid_choice(knots, control_model, paper_grid, knot_spacing),
-           **({"transcription": transcription} if transcription else {})},
+           **({"transcription": transcription} if transcription else {}),
+           **given},
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses,
-        multistart=(multistart_default(_speed(speed), formulation) if multistart is None
-                    else multistart),
-        formulation=formulation,  # type: ignore[arg-type]
-        gait=gait_kind, cost=cost,  # type: ignore[arg-type]
+        cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
         mesh_tol=mesh_tol, swing_clearance=clearance,
         clearance_profile=clearance_profile,  # type: ignore[arg-type]
@@ -235,10 +242,17 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
     try:
+        options = options_for_model(model, options)
+        refuse_unwalkable(model, options)
         validate_options(options, biped_for(model, options))
         sequence_used = checked_sequence(model, options)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
+    reference = reference_speed(model, options)
+    if multistart is None:
+        multistart = multistart_default(options.speed, options.formulation, reference,
+                                        model_scale(model).speed(FAR_FROM_REFERENCE))
+    options = options.replace(multistart=multistart)
     console.print(f"solving {options.variant} on model {model.name}: speed "
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
@@ -249,15 +263,17 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   + f", {options.formulation} coordinates")
 
     if (start is None and not options.multistart
-            and multistart_default(options.speed, options.formulation)):
-        console.print("note: far from 12 m/min a cold solve can end in a worse local optimum; "
+            and multistart_default(options.speed, options.formulation, reference,
+                                   model_scale(model).speed(FAR_FROM_REFERENCE))):
+        console.print(f"note: far from {format_speed(reference)} a cold solve can end in a "
+                      "worse local optimum; "
                       "--multistart (the default here) also tries the continuation in speed "
                       "and keeps the best")
     if (sequence_used is not None and len(sequence_used.phases) > 2
-            and tuple(options.knots) < FOUR_PHASE_KNOTS):
+            and tuple(options.knots) < MULTI_PHASE_KNOTS):
         console.print(f"note: a {len(sequence_used.phases)}-phase step on {options.knots[0]}+"
                       f"{options.knots[1]} knots is coarse; the heel-toe walk passes verify on "
-                      f"{FOUR_PHASE_KNOTS[0]},{FOUR_PHASE_KNOTS[1]} or finer (--knots; "
+                      f"{MULTI_PHASE_KNOTS[0]},{MULTI_PHASE_KNOTS[1]} or finer (--knots; "
                       "docs/feet.md)")
     if start is not None and not warm_start_usable(start, options):
         console.print(f"note: {warm_start} was solved with other ankle torques or another "

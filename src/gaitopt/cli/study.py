@@ -37,7 +37,7 @@ from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.cli.sweep_grid import make_spec, parse_speeds, parse_variants
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.gait.formulation import default_formulation
-from gaitopt.gait.options import GAITS, GaitOptions
+from gaitopt.gait.options import GAITS, GaitOptions, GaitOptionsError
 from gaitopt.study.driver import default_workers
 from gaitopt.study.grid_error import (
     CHECK_DIR,
@@ -92,9 +92,10 @@ def _workers_option(f: Any) -> Any:
 @formulation_option(help="The coordinates of every point (docs/formulations.md) [default: "
                          "reduced for the five-link shape and the walk, else full].",
                     default=None)
-@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default="walk",
-              show_default=True, help="The contact sequence of every point (heel-toe: feet, "
-                                      "e.g. --model seven-link).")
+@click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default=None,
+              help="The contact sequence of every point (heel-toe: feet, e.g. --model "
+                   "seven-link) [default: what the model's contact points allow: walk with "
+                   "one per leg, heel-toe with two].")
 @cost_option(help="The cost of every point (docs/costs.md).")
 @resting_power_option
 @control_model_option(help="Controls continuous and periodic (paper) or free to "
@@ -106,7 +107,7 @@ def _workers_option(f: Any) -> Any:
 @_workers_option
 def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, free: bool,
                   step_length: str, step_time: str, single_support: str, knots: str | None,
-                  paper_grid: bool, formulation: str | None, gait_kind: str, cost: str,
+                  paper_grid: bool, formulation: str | None, gait_kind: str | None, cost: str,
                   resting_power: float | None, control_model: str | None,
                   knot_spacing: str | None,
                   min_knee_flexion: float | None, workers: int | None,
@@ -118,11 +119,19 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     failed.
     """
     console = make_console()
-    if formulation is None:
+    if gait_kind is None or formulation is None:
         from gaitopt.gait.api import as_model
+        from gaitopt.gait.model_defaults import default_gait
 
         try:
-            formulation = default_formulation(as_model(model_name), gait_kind, False)
+            model = as_model(model_name)
+            if gait_kind is None:
+                try:
+                    gait_kind = default_gait(model)
+                except GaitOptionsError:  # no built-in gait fits: the walk's checks explain
+                    gait_kind = "walk"
+            if formulation is None:
+                formulation = default_formulation(model, gait_kind, False)
         except ValueError as exc:
             raise UserError(str(exc)) from None
     problem: dict[str, Any] = {"formulation": formulation, "cost": cost, "gait": gait_kind,

@@ -25,7 +25,9 @@ import os
 import numpy as np
 
 from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.model_defaults import options_for_model
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.preflight import refuse_unwalkable
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, PhaseGuess, WarmStart
@@ -69,9 +71,15 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
                         options: GaitOptions | None = None, *,
                         warm_start: Gait | None = None, progress: ProgressFn | None = None,
                         compiled: str | None = None) -> WalkingSolution:
-    """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`."""
+    """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`.
+
+    Raises:
+        UnwalkableModelError: something in the model prevents walking
+            (:func:`gaitopt.gait.preflight.preflight`); nothing was solved.
+    """
     robot = as_model(model)
-    opts = options or GaitOptions()
+    opts = options_for_model(robot, options or GaitOptions())
+    refuse_unwalkable(robot, opts)
     guess: Guess | WarmStart | None = None
     if warm_start is not None and warm_start_usable(warm_start, opts):
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
@@ -108,7 +116,9 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
 
     Args:
         model: a :class:`RobotModel`, a built-in model name or a model file.
-        options: the variant, targets and bounds (default: the paper's problem at 12 m/min).
+        options: the variant, targets and bounds (default: the paper's problem at 12 m/min
+            for the five-link biped; on another model the defaults that follow it, as
+            ``gaitopt solve --model M``: :mod:`gaitopt.gait.model_defaults`).
         warm_start: a neighbouring gait to start from (the cold path is the fallback).
         progress: called with a :class:`~gaitopt.gait.solution.StageReport` after every stage.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).

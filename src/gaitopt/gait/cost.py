@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 from gaitopt.dynamics.backend import Scalar, as_scalars, sqrt
 from gaitopt.gait.contact_sequence import sequence_from_dict
+from gaitopt.gait.model_scale import REFERENCE, ModelScale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot.model import RobotModel
 
@@ -148,9 +149,19 @@ def denominator(model: RobotModel, options: GaitOptions, p: Any) -> Scalar:
     return step if options.cost == "paper" else weight(model) * step
 
 
-def objective_scale(options: GaitOptions) -> float:
-    """The NLP minimises ``J / objective_scale``: about the size of the optimum."""
-    return 1000.0 if options.cost == "paper" else 0.1
+#: The objective scales on the reference biped (the five-link's 1 m legs, 42 kg): the paper's
+#: cost (N^2 m s) and the costs of transport (dimensionless, the same on every model).
+PAPER_OBJECTIVE_SCALE, TRANSPORT_OBJECTIVE_SCALE = 1000.0, 0.1
+
+
+def objective_scale(options: GaitOptions, scale: ModelScale = REFERENCE) -> float:
+    """The NLP minimises ``J / objective_scale``: about the size of the optimum
+    (:data:`PAPER_OBJECTIVE_SCALE` carried over to the model of ``scale`` as a paper cost,
+    ``(m g l)^2 sqrt(l / g) / l``; :data:`TRANSPORT_OBJECTIVE_SCALE` for the costs of
+    transport)."""
+    if options.cost == "paper":
+        return scale.paper_cost(PAPER_OBJECTIVE_SCALE)
+    return TRANSPORT_OBJECTIVE_SCALE
 
 
 def recompute_cost(gait: Any) -> float:

@@ -78,8 +78,10 @@ from gaitopt.gait.full_physics import (
     state_names,
     swap_state,
 )
+from gaitopt.gait.model_scale import model_scale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.phase_fractions import fraction_parameters, phase_share, remainder_bounds
+from gaitopt.gait.problem import LENGTH_SCALE
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
     BoundaryConstraint,
@@ -122,6 +124,9 @@ STEP_TIME = "step time L / v"
 #: The bounds of the free phase that takes the remainder of the step time (suffix of
 #: ``<phase>: ...``), when the other free fractions' bounds do not imply them.
 REMAINDER = "share within its bounds (the remainder of the step)"
+#: Bound (m) of the base position ``|x|`` and ``y`` on the reference biped (1 m legs; times
+#: ``l / l_ref`` on another model): generous, a step spans less.
+BASE_REACH = 3.0
 #: Bound on the projection controls (m/s and m/s^2 per unit of J^T): generous, they vanish.
 PROJECTION_BOUND = 10.0
 #: Scales of the rate states (rad/s, m/s) and of the projection controls in the NLP. Measured
@@ -204,11 +209,13 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
     names = state_names(model)
     weight = model.total_mass * 9.81
     rate = options.rate_bound
+    sc = model_scale(model)
     fractions = fraction_parameters(seq)
 
     def state_bounds(held: Sequence[str]) -> dict[str, tuple[float, float]]:
         b: dict[str, tuple[float, float]] = {
-            "x": (-3.0, 3.0), "y": (0.0, 3.0),
+            "x": (-sc.length(BASE_REACH), sc.length(BASE_REACH)),
+            "y": (0.0, sc.length(BASE_REACH)),
             model.base.name: (options.torso_bounds[0], options.torso_bounds[1])}
         for j, lim in limits.items():
             b[j] = lim
@@ -218,7 +225,9 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                 lo, hi = limits[knee]
                 b[knee] = (lo, min(hi, -options.min_stance_knee_flexion))
         for n in model.coordinate_names:
-            b[f"{n}_rate"] = (-rate, rate)
+            # The base position's rates (m/s): the rate bound times the leg length ratio.
+            v = sc.length(rate) if n in ("x", "y") else rate
+            b[f"{n}_rate"] = (-v, v)
         return b
 
     phases: list[Phase] = []
@@ -258,7 +267,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                 return vector(rows + speeds)
 
             path.append(PathConstraint(HELD, held_rows, lower=0.0, upper=0.0, at="knots",
-                                       scale=[0.1] * n_rows + [1.0] * n_rows))
+                                       scale=[sc.length(LENGTH_SCALE)] * n_rows
+                                       + [1.0] * n_rows))
         if held:
             def force_rows(x: Any, u: Any, p: Any, t: Any, held: tuple[str, ...] = held,
                            point: Any = point) -> Any:
@@ -285,7 +295,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                 return vector([as_scalars(contact_position(model, q, c), 2, "p")[1]
                                for c in points])
 
-            path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf, scale=0.1))
+            path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf,
+                                       scale=sc.length(LENGTH_SCALE)))
         if options.swing_clearance is not None and not phases and landing:
             path.append(_clearance_profile(model, options, landing, _share(seq, 0)))
 
@@ -352,7 +363,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                 return vector(rows)
 
             events.append(BoundaryConstraint(f"{ev.name}: {TOUCHDOWN}", touchdown, 0.0, 0.0,
-                                             scale=0.1))
+                                             scale=sc.length(LENGTH_SCALE)))
         after = seq.held_after(i)
         if after and (ev.touchdown or ev.impulse):
             def normal(ends: Mapping[str, Any], p: Any, i: int = i, src: str = src,
@@ -396,14 +407,12 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
         events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
                                          lower=-ca.inf, upper=ca.inf, scale=1.0))
 
-    from gaitopt.gait.problem import parameter_bounds
+    from gaitopt.gait.problem import parameter_bounds, parameters_of
 
     bounds = parameter_bounds(options)
     if not any(ev.impulse for ev in seq.events):
         bounds[IMPULSE] = (0.0, 0.0)
-    parameters = [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH], scale=0.5),
-                  Parameter(SPEED, *bounds[SPEED], scale=1.0),
-                  Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
+    parameters = parameters_of(bounds, sc)
     parameters += [Parameter(fp.name, fp.lower, fp.upper, scale=1.0, guess=fp.guess)
                    for fp in fractions]
     remainder = remainder_bounds(seq)
@@ -418,7 +427,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
         (lambda p: cost.parameter_cost(model, options, p)),
         mayer=None if options.cost == "paper" else _impulse_cost(model, options, seq, split),
         cost_denominator=lambda ends, p: cost.denominator(model, options, p),
-        objective_scale=cost.objective_scale(options))
+        objective_scale=cost.objective_scale(options, sc))
 
 
 def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
@@ -466,7 +475,8 @@ def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence
         return vector([as_scalars(contact_position(model, q, c), 2, "p")[1] - low
                        for c in points])
 
-    return PathConstraint(CLEARANCE_PROFILE, fn, lower=0.0, upper=ca.inf, scale=0.1)
+    return PathConstraint(CLEARANCE_PROFILE, fn, lower=0.0, upper=ca.inf,
+                          scale=model_scale(model).length(LENGTH_SCALE))
 
 
 def _step_share(share: Callable[[Any], Any]) -> Callable[[Any], Any]:

@@ -28,6 +28,7 @@ from gaitopt.dynamics.rnea import bias_forces
 from gaitopt.gait import walking
 from gaitopt.gait.full_physics import actuator_names
 from gaitopt.gait.full_physics import state_names as full_state_names
+from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp import Guess as OcpGuess
 from gaitopt.ocp import PhaseGuess as OcpPhaseGuess
@@ -38,6 +39,9 @@ Array = NDArray[np.float64]
 
 #: Samples per phase used to differentiate the guess curves.
 _FINE = 400
+#: Weight (1/m on the reference biped's 1 m legs) of the contact forces' columns in the
+#: least-squares torques of the guess (:func:`_torques`): forces are cheap.
+FORCE_WEIGHT = 100.0
 
 
 @dataclass(frozen=True)
@@ -70,9 +74,13 @@ class WalkingGuess:
         return OcpGuess(phases=phases, parameters=dict(self.parameters))
 
 
-def default_step_length(speed: float) -> float:
-    """A plausible step length (m) for a speed (m/s) to start from: grows with speed."""
-    return float(np.clip(0.06 + 0.35 * speed, 0.05, 0.5))
+def default_step_length(speed: float, scale: ModelScale = REFERENCE) -> float:
+    """A plausible step length (m) for a speed (m/s) to start from: grows with speed. On the
+    reference biped (legs of 1 m) ``clip(0.06 + 0.35 v, 0.05, 0.5)``; on another model the
+    same at equal Froude number, ``l * L_ref(v_ref)`` with ``v_ref`` the reference biped's
+    speed of that Froude number (``scale``: :func:`gaitopt.gait.model_scale.model_scale`)."""
+    v_ref = scale.to_reference_speed(speed)
+    return scale.length(float(np.clip(0.06 + 0.35 * v_ref, 0.05, 0.5)))
 
 
 def _smoothstep(s: Array) -> Array:
@@ -85,12 +93,14 @@ def _knots(t0: float, duration: float, count: int) -> Array:
 
 def _torques(model: RobotModel, q: Array, qd: Array, qdd: Array, controls: tuple[str, ...],
              held: list[str]) -> Array:
-    """Least-``u'u`` torques (and any contact forces) realising ``qdd``."""
+    """Least-``u'u`` torques (and any contact forces) realising ``qdd``: forces are cheap in
+    the least-squares norm, their columns weighted by :data:`FORCE_WEIGHT` over the leg length
+    ratio (torques scale as ``m g l``, forces as ``m g``)."""
     m_q = np.asarray(crba(model, q), dtype=float)
     h = np.asarray(bias_forces(model, q, qd), dtype=float).reshape(-1)
     b_full = np.asarray(actuation_matrix(model, q, held), dtype=float)
     cols = [model.actuator_index(n) for n in controls]
-    force_scale = 100.0  # forces are cheap in the least-squares norm
+    force_scale = FORCE_WEIGHT / model_scale(model).length_factor
     a = b_full[:, cols]
     if held:
         j = np.asarray(contact_jacobian(model, q, held), dtype=float).reshape(-1, model.nq)
@@ -117,7 +127,10 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
     t1, t2 = f * total, (1.0 - f) * total
     offset = step * (1.0 - f / 2.0)
     height = 0.995 * float(np.sqrt(max(r_max**2 - offset**2, 1e-4)))
-    lift = clearance if clearance is not None else min(0.04, 0.01 + 0.1 * step)
+    # The swing tip's arc: on the reference biped (1 m legs) min(0.04, 0.01 + 0.1 L) m.
+    scale = model_scale(model)
+    lift = (clearance if clearance is not None else
+            scale.length(min(0.04, 0.01 + 0.1 * step / scale.length_factor)))
 
     def hip(t: Array) -> Array:
         return np.stack([-step * f / 2.0 + v * t, np.full_like(t, height)], axis=1)
@@ -156,9 +169,12 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
 
-def default_running_step(speed: float) -> float:
-    """A plausible running step length (m) for a speed (m/s) to start from."""
-    return float(np.clip(0.35 * speed, 0.3, 1.2))
+def default_running_step(speed: float, scale: ModelScale = REFERENCE) -> float:
+    """A plausible running step length (m) for a speed (m/s) to start from: on the reference
+    biped ``clip(0.35 v, 0.3, 1.2)``, on another model at equal Froude number (as
+    :func:`default_step_length`)."""
+    v_ref = scale.to_reference_speed(speed)
+    return scale.length(float(np.clip(0.35 * v_ref, 0.3, 1.2)))
 
 
 def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
@@ -178,7 +194,8 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
     t1 = f * total
     s_hip = v * t1
     height = 0.97 * float(np.sqrt(max(r_max**2 - (s_hip / 2.0) ** 2, 1e-4)))
-    xb, yb, bump = -0.6 * step, 0.1, 0.05
+    # Tip 2's start behind the hip and the arcs' heights (m on the reference biped's 1 m legs).
+    xb, yb, bump = -0.6 * step, model_scale(model).length(0.1), model_scale(model).length(0.05)
     phases = []
     for name, (ta, tb), held in (("stance", (0.0, t1), [stance.contact]),
                                  ("flight", (t1, total), [])):

@@ -16,10 +16,11 @@ is documented there.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar, cast
 
 from gaitopt.robot.biped import Biped
 from gaitopt.units import format_speed
@@ -62,15 +63,80 @@ class GaitOptionsError(ValueError):
     """A walking-problem option is out of range (names the field and what is allowed)."""
 
 
+class ModelFloat(float):
+    """A default number that follows the model: its value is the reference biped's (the
+    five-link biped's), and :func:`gaitopt.gait.model_defaults.options_for_model` replaces
+    it with the model's (:mod:`gaitopt.gait.model_scale`). A number given by the caller is
+    a plain ``float`` and stays."""
+
+    __slots__ = ()
+
+
+class ModelTuple(tuple):
+    """A default pair (bounds, knots) that follows the model, as :class:`ModelFloat`."""
+
+    __slots__ = ()
+
+
+class ModelStr(str):
+    """A default choice (gait, formulation) that follows the model, as :class:`ModelFloat`."""
+
+    __slots__ = ()
+
+
+_T = TypeVar("_T")
+
+
+def from_model(value: _T) -> _T:
+    """``value`` marked as a default that follows the model (:class:`ModelFloat`,
+    :class:`ModelTuple`, :class:`ModelStr`)."""
+    if isinstance(value, float):
+        return cast(_T, ModelFloat(value))
+    if isinstance(value, tuple):
+        return cast(_T, ModelTuple(value))
+    if isinstance(value, str):
+        return cast(_T, ModelStr(value))
+    raise TypeError(f"no model default of {type(value).__name__}")
+
+
+def follows_model(value: object) -> bool:
+    """Whether ``value`` is a default still to be chosen from the model (:func:`from_model`)."""
+    return isinstance(value, ModelFloat | ModelTuple | ModelStr)
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, ModelFloat):
+        return float(value)
+    if isinstance(value, ModelStr):
+        return str(value)
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return copy.deepcopy(value)
+    return value
+
+
 @dataclass(frozen=True, kw_only=True)
 class GaitOptions:
     """Every option of the walking problem (SI units).
 
+    Defaults that follow the model (:func:`from_model`: ``speed``, ``speed_bounds``,
+    ``step_length_bounds``, ``rate_bound``, ``max_impulse``, ``cost_smoothing``, ``knots``,
+    ``formulation``, ``gait``) hold the five-link biped's values here; a solve replaces each
+    one the caller did not give with the model's
+    (:func:`gaitopt.gait.model_defaults.options_for_model`: the gait its contact points
+    allow, Froude-scaled speeds and bounds), which for the five-link biped are the same
+    values exactly. A value given by the caller always stays.
+
     Attributes:
-        speed: average forward speed (m/s), or ``None`` for free (the optimal walk).
-        speed_bounds: bounds (m/s) when the speed is free.
+        speed: average forward speed (m/s), or ``None`` for free (the optimal walk). Default:
+            the gait's at equal Froude number (0.2 m/s for the five-link walk;
+            :data:`gaitopt.gait.model_defaults.DEFAULT_SPEEDS`).
+        speed_bounds: bounds (m/s) when the speed is free (default 0.02-1.5 m/s on 1 m legs,
+            times ``sqrt(g l / (9.81 * 1 m))``).
         step_length: step length (m), or ``None`` for free.
-        step_length_bounds: bounds (m) when the step length is free.
+        step_length_bounds: bounds (m) when the step length is free (default 0.02-0.8 m on
+            1 m legs, times ``l / 1 m``).
         step_time: step time ``L / v`` (s), or ``None`` for free. With a given speed it
             fixes the step length; with the speed free, the optimal walk of that step time.
             Give at most one of ``step_length`` and ``step_time``.
@@ -80,7 +146,8 @@ class GaitOptions:
             single-support gait (no double support, the trailing leg leaves at heel strike).
         knots: grid points per phase (single support, double support): 16 + 6 by default
             (the cost within 0.1 % of the fine-grid limit with ``control_model="jumps"``);
-            the paper's 8 + 5 with :meth:`paper`.
+            the paper's 8 + 5 with :meth:`paper`; 24 + 16 for steps of more than two phases
+            (:data:`gaitopt.gait.model_defaults.MULTI_PHASE_KNOTS`).
         transcription: ``"hermite-simpson-separated"`` (the default: the midpoint states
             as NLP variables, bounded like the knots; derivatives assembled from compiled
             functions of one grid point, several times faster per iteration),
@@ -99,16 +166,20 @@ class GaitOptions:
             and keeps the leg inverse kinematics away from its singularity at a straight knee
             (> 0 in the reduced formulation; >= 0 in the full one, where 0 lets the stance
             knee straighten up to its joint limit).
-        torso_bounds: torso angle bounds (rad).
-        rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates.
-        max_impulse: upper bound of the liftoff impulse (N s).
+        torso_bounds: torso angle bounds (rad; angles need no scaling between models).
+        rate_bound: bound on every joint rate (rad/s) and on the hip's polar rates (default
+            15 rad/s on 1 m legs, times ``sqrt(l_ref / l)``; the radial and base rates, in
+            m/s, are this times ``l / l_ref``).
+        max_impulse: upper bound of the liftoff impulse (N s; default 30 N s for 42 kg on
+            1 m legs, times ``m sqrt(g l) / (m_ref sqrt(g_ref l_ref))``).
         tol: IPOPT tolerance.
         max_iter: IPOPT iteration limit per stage.
         continuation: use the automatic continuation from a naive start (else one solve).
         formulation: ``"reduced"`` (the paper's: polar hip coordinates and leg inverse
             kinematics, the five-link biped only) or ``"full"`` (the whole tree's ``q, qd``
             with the held contact points as constraints: any model with two legs; a knee may
-            straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md.
+            straighten fully, ``min_stance_knee_flexion = 0``). See docs/walking.md. Default:
+            reduced for the walk of a five-link-shaped biped, else full.
         single_support_fraction_bounds: ``None`` (the fraction is ``single_support_fraction``)
             or ``(lower, upper)``: the fraction is free within them, a decision parameter
             (``single_support_fraction`` is its first guess); full formulation, with double
@@ -123,7 +194,9 @@ class GaitOptions:
             ``single_support_fraction`` of the step, then flight; full formulation only, no
             liftoff impulse) or ``"heel-toe"`` (feet with heel and toe points: foot flat,
             heel off, double support, heel rocker; full formulation; see
-            :func:`gaitopt.gait.builtin_sequences.heel_toe_sequence`).
+            :func:`gaitopt.gait.builtin_sequences.heel_toe_sequence`). Default: what the
+            model's contact points allow, the walk with one per leg, the heel-toe walk with
+            two (:func:`gaitopt.gait.model_defaults.default_gait`).
         contact_sequence: a contact sequence as plain data (the gait file's
             ``contact_sequence``; :func:`gaitopt.gait.contact_sequence.sequence_from_dict`),
             which replaces ``gait``; full formulation only. A phase fraction is a number
@@ -136,7 +209,8 @@ class GaitOptions:
         efficiency_negative: muscle efficiency of negative work (> 0; 1.2) of the metabolic
             cost.
         resting_power: resting metabolic power (W/kg, >= 0) of the metabolic cost.
-        cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs.
+        cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs
+            (default 0.01 W for 42 kg on 1 m legs, carried over as a power).
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, take every distinct coarse optimum through the
@@ -167,29 +241,29 @@ class GaitOptions:
             section 6).
     """
 
-    speed: float | None = 0.2
-    speed_bounds: tuple[float, float] = (0.02, 1.5)
+    speed: float | None = from_model(0.2)
+    speed_bounds: tuple[float, float] = from_model((0.02, 1.5))
     step_length: float | None = None
-    step_length_bounds: tuple[float, float] = (0.02, 0.8)
+    step_length_bounds: tuple[float, float] = from_model((0.02, 0.8))
     step_time: float | None = None
     ankle: bool = True
     impulse: bool = True
     single_support_fraction: float = 0.85
-    knots: tuple[int, int] = (16, 6)
+    knots: tuple[int, int] = from_model((16, 6))
     transcription: Transcription = "hermite-simpson-separated"
     periodic_controls: bool = True
     friction: float | None = None
     unilateral_impulses: bool = True
     min_stance_knee_flexion: float = 0.1
     torso_bounds: tuple[float, float] = (-0.8, 0.8)
-    rate_bound: float = 15.0
-    max_impulse: float = 30.0
+    rate_bound: float = from_model(15.0)
+    max_impulse: float = from_model(30.0)
     tol: float = 1e-7
     max_iter: int = 1000
     continuation: bool = True
     multistart: bool = False
-    formulation: Formulation = "reduced"
-    gait: GaitKind = "walk"
+    formulation: Formulation = from_model("reduced")
+    gait: GaitKind = from_model("walk")
     contact_sequence: dict[str, Any] | None = None
     single_support_fraction_bounds: tuple[float, float] | None = None
     free_phase_fractions: bool = False
@@ -197,7 +271,7 @@ class GaitOptions:
     efficiency_positive: float = 0.25
     efficiency_negative: float = 1.2
     resting_power: float = 1.2
-    cost_smoothing: float = 0.01
+    cost_smoothing: float = from_model(0.01)
     cost_regularization: float = 0.0
     mesh_tol: float | None = None
     control_model: ControlModel = "jumps"
@@ -237,11 +311,7 @@ class GaitOptions:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for the gait file (``None`` means free)."""
-        data = dataclasses.asdict(self)
-        for key, value in data.items():
-            if isinstance(value, tuple):
-                data[key] = list(value)
-        return data
+        return {f.name: _plain(getattr(self, f.name)) for f in dataclasses.fields(self)}
 
     @staticmethod
     def saved_defaults() -> dict[str, Any]:

@@ -30,6 +30,7 @@ import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.gait import cost, walking
+from gaitopt.gait.model_scale import ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.ocp.bounds import Bounds
@@ -157,6 +158,25 @@ def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
     return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
 
 
+#: Scale (m) of the constraints that are lengths (tip heights, landing positions) on the
+#: reference biped (1 m legs); ``l / l_ref`` times it on another model.
+LENGTH_SCALE = 0.1
+#: Scales of the parameters on the reference biped: step length (m), speed (m/s), liftoff
+#: impulse (N s); carried over as a length, a speed and an impulse
+#: (:mod:`gaitopt.gait.model_scale`).
+STEP_LENGTH_SCALE, SPEED_SCALE, IMPULSE_SCALE = 0.5, 1.0, 5.0
+
+
+def parameters_of(bounds: Mapping[str, tuple[float, float]], scale: ModelScale
+                  ) -> list[Parameter]:
+    """The step length, speed and impulse parameters within ``bounds``, scaled for the model
+    of ``scale`` (:data:`STEP_LENGTH_SCALE`, :data:`SPEED_SCALE`, :data:`IMPULSE_SCALE`)."""
+    return [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH],
+                      scale=scale.length(STEP_LENGTH_SCALE)),
+            Parameter(SPEED, *bounds[SPEED], scale=scale.speed(SPEED_SCALE)),
+            Parameter(IMPULSE, *bounds[IMPULSE], scale=scale.impulse(IMPULSE_SCALE))]
+
+
 def _limits(model: RobotModel, joint: str) -> tuple[float, float]:
     for j in model.joints:
         if j.name == joint:
@@ -178,6 +198,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     # knee bends further (an unbounded knee's limit is -inf)
     r_min = max(leg.reach(max(_limits(model, leg.knee)[0], -math.pi)) for leg in legs)
     rate = options.rate_bound
+    sc = model_scale(model)
     mu = options.friction
     # Lower bound of the normal impulses on held tips at the events (the paper's maps: none).
     impulse_floor = 0.0 if options.unilateral_impulses else -ca.inf
@@ -199,7 +220,9 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             bounds[leg.knee] = _limits(model, leg.knee)
         for n in names:
             if n.endswith("_rate"):
-                bounds[n] = (-rate, rate)
+                # The hip's radial rate (m/s): the rate bound times the leg length ratio.
+                v = sc.length(rate) if n == "r_rate" else rate
+                bounds[n] = (-v, v)
         return {n: bounds[n] for n in names}
 
     paper_cost = options.cost == "paper" and options.cost_regularization == 0.0
@@ -237,7 +260,8 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         PathConstraint(SS_FORCE, ss_contact, lower=0.0, upper=ca.inf,
                        scale=model.total_mass * 9.81),
         PathConstraint("swing clearance and stance hip limit", ss_geometry,
-                       lower=[0.0, hip_lo], upper=[ca.inf, hip_hi], scale=[0.1, 1.0]),
+                       lower=[0.0, hip_lo], upper=[ca.inf, hip_hi],
+                       scale=[sc.length(LENGTH_SCALE), 1.0]),
     ]
     if options.swing_clearance is not None:
         ss_path.append(_clearance_constraint(model, swing, options.swing_clearance,
@@ -264,7 +288,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         return vector([tip[0] - p[_L], tip[1]])
 
     events.append(BoundaryConstraint("swing tip lands at (L, 0)", landing, 0.0, 0.0,
-                                     scale=0.1))
+                                     scale=sc.length(LENGTH_SCALE)))
     if options.step_time is not None:
         events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
                                          lower=-ca.inf, upper=ca.inf, scale=1.0))
@@ -374,9 +398,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             linkages.append(_periodic_controls(model, SINGLE, ss_controls, ss_controls))
 
     bounds = parameter_bounds(options)
-    parameters = [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH], scale=0.5),
-                  Parameter(SPEED, *bounds[SPEED], scale=1.0),
-                  Parameter(IMPULSE, *bounds[IMPULSE], scale=5.0)]
+    parameters = parameters_of(bounds, sc)
     return Problem(
         phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
         parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
@@ -384,7 +406,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         mayer=None if options.cost == "paper" or not two_phases else
         (lambda ends, p: liftoff_cost(model, options, lift(ends, p), p[_P])),
         cost_denominator=lambda ends, p: cost.denominator(model, options, p),
-        objective_scale=cost.objective_scale(options))
+        objective_scale=cost.objective_scale(options, sc))
 
 
 def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition,
@@ -450,4 +472,5 @@ def _clearance_constraint(model: RobotModel, swing: Any, clearance: float, profi
         return walking.tip_height(model, configuration(x, u, p), swing) \
             - clearance_profile(clearance, s, profile)
 
-    return PathConstraint(CLEARANCE, fn, lower=0.0, upper=ca.inf, scale=0.1)
+    return PathConstraint(CLEARANCE, fn, lower=0.0, upper=ca.inf,
+                          scale=model_scale(model).length(LENGTH_SCALE))

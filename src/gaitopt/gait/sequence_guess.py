@@ -37,17 +37,21 @@ from gaitopt.dynamics.reduced import ReachError
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence
 from gaitopt.gait.guess import Array, PhaseGuess, WalkingGuess, _knots, _phase_guess, _smoothstep
+from gaitopt.gait.model_scale import model_scale
 from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 
 #: Samples per phase of the inverse kinematics (rates are differentiated from them).
 SAMPLES = 60
-#: Weights of the inverse-kinematics residuals: held points, swinging points, base path,
-#: torso, joints.
+#: Weights of the inverse-kinematics residuals: held points, swinging points, base path (per
+#: metre on the reference biped's 1 m legs: distances are divided by ``l / l_ref``), torso,
+#: joints (per radian).
 W_HELD, W_SWING, W_BASE, W_TORSO, W_JOINT = 10.0, 1.0, 0.1, 0.3, 0.02
 #: The pose the joints are pulled toward (rad): knees slightly flexed so that the inverse
 #: kinematics stays on the knee-forward branch; other joints 0.
 FLEXED_KNEE = -0.3
-#: Largest distance (m) of a held point from its ground point in the guess: farther, the
+#: Largest distance (m, on the reference biped's 1 m legs; times ``l / l_ref`` on another
+#: model, :mod:`gaitopt.gait.model_scale`) of a held point from its ground point in the
+#: guess: farther, the
 #: legs cannot reach the step (:class:`~gaitopt.dynamics.reduced.ReachError`). Measured over
 #: the three naive steps at 3-150 m/min: the weighted compromise leaves held points up to
 #: 1.1 cm off (the seven-link heel-toe walk at 60 m/min, 0.57 m), under 1 mm for the
@@ -111,7 +115,7 @@ def _check_placed(model: RobotModel, phase: str, t: float, q: Array,
             continue
         p = np.asarray(contact_position(model, q, c), dtype=float).ravel()
         miss = float(np.hypot(0.0 if tgt[0] is None else p[0] - tgt[0], p[1] - tgt[1]))
-        if miss > PLACEMENT_TOL:
+        if miss > model_scale(model).length(PLACEMENT_TOL):
             raise ReachError(
                 f"the legs of model {model.name!r} cannot hold {c!r} on its ground point in "
                 f"phase {phase!r} at t = {t:.3f} s of a {step:.3g} m step (the best pose "
@@ -127,8 +131,12 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
     v, step = speed, step_length
     total = step / v
-    lift = lift if lift is not None else min(0.05, 0.015 + 0.1 * step)
+    # The swing arcs' height: on the reference biped (1 m legs) min(0.05, 0.015 + 0.1 L) m.
+    scale = model_scale(model)
+    lift = (lift if lift is not None else
+            scale.length(min(0.05, 0.015 + 0.1 * step / scale.length_factor)))
     rows = _ground_points(seq, swap, step, total)
+    per_length = 1.0 / scale.length_factor  # distances in reference leg lengths
     names = [c.name for c in model.contacts]
     zero = np.zeros(model.nq)
     stand = -min(float(contact_position(model, zero, c)[1]) for c in names)
@@ -157,12 +165,12 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
                     if tgt is None:
                         continue
                     p = np.asarray(contact_position(model, qq, c), dtype=float).ravel()
-                    r.append(W_HELD * min(p[1], 0.0))   # never below the ground
+                    r.append(W_HELD * per_length * min(p[1], 0.0))   # never below the ground
                     if tgt[0] is not None:
-                        r.append(tgt[2] * (p[0] - tgt[0]))
-                    r.append(tgt[2] * (p[1] - tgt[1]))
-                r += [W_BASE * (qq[BASE_X] - base[0]), W_BASE * (qq[BASE_Y] - base[1]),
-                      W_TORSO * qq[BASE_ANGLE]]
+                        r.append(tgt[2] * per_length * (p[0] - tgt[0]))
+                    r.append(tgt[2] * per_length * (p[1] - tgt[1]))
+                r += [W_BASE * per_length * (qq[BASE_X] - base[0]),
+                      W_BASE * per_length * (qq[BASE_Y] - base[1]), W_TORSO * qq[BASE_ANGLE]]
                 r += list(W_JOINT * (qq[3:] - pose[3:]))
                 return np.array(r)
 

@@ -74,6 +74,8 @@ from gaitopt.gait.guess import (
     naive_guess,
     naive_running_guess,
 )
+from gaitopt.gait.model_defaults import default_gait, default_speed, options_for_model
+from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.phase_fractions import fraction_parameters
 from gaitopt.gait.problem import (
@@ -125,13 +127,19 @@ from gaitopt.ocp.regrid import regridded
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import leg_swap
 
-#: Reference speed (m/s) for the continuation fallback: the paper's optimal 12 m/min.
+#: Reference speed (m/s) of the reference biped (the five-link's 1 m legs) for the
+#: continuation fallback and the start of a speed-free solve: the paper's optimal 12 m/min.
+#: A model's is its default speed (:func:`reference_speed`), equal to this for the five-link
+#: walk.
 REFERENCE_SPEED = 0.2
-#: Largest speed change (m/s) between two continuation steps.
+#: Largest speed change (m/s) between two continuation steps on the reference biped; a model's
+#: is this at equal Froude number (:meth:`~gaitopt.gait.model_scale.ModelScale.speed`).
 SPEED_STEP = 0.1
 #: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
-#: cost's optimum, when the requested one is finer; each further stage divides it by
-#: :data:`COST_SMOOTHING_STEP` until the requested one (:func:`smoothing_ladder`).
+#: cost's optimum, when the requested one is finer (the reference biped's; a model's is
+#: carried over as a power, :meth:`~gaitopt.gait.model_scale.ModelScale.power`); each further
+#: stage divides it by :data:`COST_SMOOTHING_STEP` until the requested one
+#: (:func:`smoothing_ladder`).
 COST_SMOOTHING_START = 1.0
 COST_SMOOTHING_STEP = 10.0
 #: Most refinement rounds after the fixed-grid stages, and most knots per phase they may make
@@ -157,6 +165,20 @@ REGRID_MOVES: dict[str, frozenset[str]] = {"heel-toe": frozenset({"check"})}
 REGRID_OPTIONS: dict[str, Any] = {"ipopt.mu_init": 1e-4}
 
 
+def reference_speed(model: RobotModel, options: GaitOptions) -> float:
+    """The speed (m/s) a speed-free solve starts from and the continuation in speed starts
+    at: the model's default speed of the gait (:func:`~gaitopt.gait.model_defaults.
+    default_speed`; of the gait its feet allow for a given contact sequence), which is
+    :data:`REFERENCE_SPEED` for the five-link walk."""
+    gait = str(options.gait)
+    if options.contact_sequence is not None:
+        try:
+            gait = default_gait(model)
+        except GaitOptionsError:
+            gait = "walk"
+    return default_speed(model, gait)
+
+
 class _Run:
     """One call of :func:`solve_walking`: runs stages and records them."""
 
@@ -164,6 +186,9 @@ class _Run:
                  compiled: str | None) -> None:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
+        #: The model's size (:mod:`gaitopt.gait.model_scale`) and reference speed (m/s).
+        self.scale = model_scale(model)
+        self.reference_speed = reference_speed(model, options)
         self.stages: list[StageReport] = []
         #: Put before every stage name (the start being completed, with several).
         self.prefix = ""
@@ -216,6 +241,12 @@ class _Run:
             self.progress(report)
         return result
 
+    def scaled(self, relax: Relaxation) -> Relaxation:
+        """A relaxation of the reference biped (N, N s) carried over to the model as a force
+        and an impulse (zero stays zero)."""
+        return Relaxation(force=self.scale.force(relax.force),
+                          impulse=self.scale.impulse(relax.impulse))
+
     def cold(self, speed: float) -> Result | None:
         """Stages 1-2 on the coarse grid at ``speed`` without impulse, from naive guesses
         (the requested step length, or a speed-based guess and two others): the first that
@@ -240,7 +271,7 @@ class _Run:
             steps = [o.step_time * speed]
         else:
             default = default_running_step if o.gait == "run" else default_step_length
-            steps = [default(speed) * f for f in (1.0, 0.7, 1.4)]
+            steps = [default(speed, self.scale) * f for f in (1.0, 0.7, 1.4)]
         found: list[Result] = []
         for step0 in steps:
             try:
@@ -272,7 +303,7 @@ class _Run:
                               parameters={**start.parameters, **self.fractions})
             result: Guess | Result = start
             for spec in CONTACT_STAGES:
-                result = self.stage(spec.name, coarse, spec.relax, result, bounds,
+                result = self.stage(spec.name, coarse, self.scaled(spec.relax), result, bounds,
                                     hold_ankles=ANKLES in held,
                                     solver_options=spec.solver_options,
                                     warm_start_options=spec.warm_start_options(o),
@@ -440,12 +471,12 @@ class _Run:
     def speed_continuation(self, target: float) -> Result | None:
         """Solve at the reference speed, then step toward ``target``."""
         o = self.options
-        current = self.cold(REFERENCE_SPEED)
+        v_ref, v_step = self.reference_speed, self.scale.speed(SPEED_STEP)
+        current = self.cold(v_ref)
         if current is None:
             return None
-        speeds = np.linspace(REFERENCE_SPEED, target,
-                             int(np.ceil(abs(target - REFERENCE_SPEED) / SPEED_STEP)) + 1)[1:]
-        bounds = held_bounds(o, {IMPULSE, FRACTION}, REFERENCE_SPEED,
+        speeds = np.linspace(v_ref, target, int(np.ceil(abs(target - v_ref) / v_step)) + 1)[1:]
+        bounds = held_bounds(o, {IMPULSE, FRACTION}, v_ref,
                              fractions=self.fractions)
         for v in speeds:
             b = dict(bounds)
@@ -478,7 +509,7 @@ class _Run:
             return None
         guess: Guess | Result = result_guess(start.result)
         options = PRIMAL_WARM_OPTIONS
-        for eps in smoothing_ladder(o.cost_smoothing):
+        for eps in smoothing_ladder(o.cost_smoothing, self.scale):
             stage = self.stage(f"{o.cost} cost, eps {eps:g} W", target_grid(self.model, o),
                                Relaxation(), guess, parameter_bounds(o),
                                solver_options=options, problem=o.replace(cost_smoothing=eps))
@@ -501,11 +532,12 @@ class _Run:
         return self.results[-1]
 
 
-def smoothing_ladder(target: float) -> list[float]:
-    """The smoothings (W) solved before ``target``: :data:`COST_SMOOTHING_START` divided by
-    :data:`COST_SMOOTHING_STEP` while still coarser than ``target`` (``[1, 0.1]`` for 0.01;
-    ``[]`` when ``target`` is at least the start)."""
-    out, eps = [], COST_SMOOTHING_START
+def smoothing_ladder(target: float, scale: ModelScale = REFERENCE) -> list[float]:
+    """The smoothings (W) solved before ``target``: :data:`COST_SMOOTHING_START` (carried
+    over to the model of ``scale`` as a power) divided by :data:`COST_SMOOTHING_STEP` while
+    still coarser than ``target`` (``[1, 0.1]`` for 0.01 on the reference biped; ``[]`` when
+    ``target`` is at least the start)."""
+    out, eps = [], scale.power(COST_SMOOTHING_START)
     while eps > target * (1 + 1e-9):
         out.append(eps)
         eps /= COST_SMOOTHING_STEP
@@ -523,6 +555,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         GaitOptionsError: invalid options, or a step so long that no naive start can place
             the legs (nothing was solved; the message says what to change).
     """
+    options = options_for_model(model, options)
     validate_options(options, biped_for(model, options))
     checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
@@ -540,14 +573,14 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         outcome = run.other_cost()
         result = outcome if outcome is not None and outcome.success else None
     elif result is None:
-        speed = options.speed if options.speed is not None else REFERENCE_SPEED
-        far = options.continuation and abs(speed - REFERENCE_SPEED) > 1e-9
+        speed = options.speed if options.speed is not None else run.reference_speed
+        far = options.continuation and abs(speed - run.reference_speed) > 1e-9
         if options.multistart:
             starts = run.cold_starts(speed, every_start=True)
             if far:
                 continued = run.speed_continuation(speed)
                 starts += [continued] if continued is not None else []
-            outcome = run.best_completion(distinct(starts))
+            outcome = run.best_completion(distinct(starts, run.scale.length(SAME_STEP)))
         else:
             coarse = run.cold(speed)
             if far and coarse is None:
@@ -571,15 +604,16 @@ SAME_COST = 1e-5
 SAME_STEP = 1e-4
 
 
-def distinct(results: list[Result]) -> list[Result]:
-    """``results`` without those that repeat an earlier one (:data:`SAME_COST`,
-    :data:`SAME_STEP`): starts that found the same optimum are completed once."""
+def distinct(results: list[Result], same_step: float = SAME_STEP) -> list[Result]:
+    """``results`` without those that repeat an earlier one (:data:`SAME_COST`, and step
+    lengths within ``same_step``, m: :data:`SAME_STEP` on the reference biped): starts that
+    found the same optimum are completed once."""
     kept: list[Result] = []
     for r in results:
         if not any(abs(r.objective - k.objective) <= SAME_COST * abs(k.objective)
                    and abs(r.parameters.get(STEP_LENGTH, 0.0)
                            - k.parameters.get(STEP_LENGTH, 0.0))
-                   <= SAME_STEP for k in kept):
+                   <= same_step for k in kept):
             kept.append(r)
     return kept
 

@@ -20,7 +20,9 @@ from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, Relaxation, parameter
 from gaitopt.ocp import Bounds, Result, Transcription
 from gaitopt.robot.model import RobotModel
 
-#: Relaxation of the first stage (N, N s): large enough to switch the conditions off.
+#: Relaxation of the first stage (N, N s) on the reference biped (42 kg, 1 m legs; carried
+#: over as a force and an impulse to another model): large enough to switch the conditions
+#: off.
 RELAXED = Relaxation(force=1e4, impulse=1e3)
 #: IPOPT options of the first stage, solved from the naive guess. IPOPT's adaptive barrier
 #: update (Nocedal, Waechter and Waltz) needs fewer iterations from a poor start and finds
