@@ -17,6 +17,8 @@ The checks (stable ids, see :data:`CHECKS` and ``docs/outputs.md``, section "Ver
   periodicity with the legs relabelled;
 * the dense samples (:mod:`.checks.samples`): on the phases' interpolants, points at the
   kinematics, normal forces between knots, torque bounds, joint limits, swing clearance;
+* the solve's own grid-error estimates within the accuracy it was asked to reach
+  (``accuracy.estimate``; :mod:`gaitopt.gait.refinement`);
 * the cost recomputed from the file (:func:`gaitopt.gait.cost.recompute_cost`): for the
   paper's cost the exact integral of the squared piecewise-linear controls plus the impulse
   squared, over the step length; the costs of transport by the transcription's quadrature,
@@ -88,7 +90,7 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
                          f"{tolerance_scale!r}")
     lim = {k: v * tolerance_scale for k, v in LIMITS.items()}
     checks = [*knot_checks(gait, lim), *integration_checks(gait, lim), *event_checks(gait, lim),
-              *sample_checks(gait, lim), _cost_check(gait, lim)]
+              *sample_checks(gait, lim), _cost_check(gait, lim), _accuracy_check(gait, lim)]
     order = list(CHECKS)
     return VerifyReport(tuple(sorted(checks, key=lambda c: order.index(c.id))))
 
@@ -103,3 +105,21 @@ def _cost_check(gait: Gait, lim: dict[str, float]) -> Check:
     trapezoidal = gait.options.get("transcription", "hermite-simpson") == "trapezoidal"
     limit = 5e-2 if trapezoidal else lim["cost.recomputed"]
     return Check("cost.recomputed", rel, limit)
+
+
+def _accuracy_check(gait: Gait, lim: dict[str, float]) -> Check:
+    """``accuracy.estimate``: the largest relative grid-error estimate the solve recorded
+    (:func:`gaitopt.gait.refinement.worst_estimate`) against the accuracy it was asked to
+    reach (``solver.accuracy.target``, scaled like every limit). A gait solved on a grid the
+    caller chose has no target: the estimate is reported and the check passes."""
+    from gaitopt.gait.refinement import worst_estimate
+
+    record = gait.solver.get("accuracy") or {}
+    target = record.get("target")
+    worst, name = worst_estimate(record, gait.parameters)
+    if target is None:
+        value = worst if np.isfinite(worst) else 0.0
+        return Check("accuracy.estimate", value, np.inf,
+                     f"{name}; no accuracy target (a grid the caller chose): reported only")
+    scale = lim["accuracy.estimate"] / LIMITS["accuracy.estimate"]
+    return Check("accuracy.estimate", worst, float(target) * scale, name)

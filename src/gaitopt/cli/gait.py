@@ -37,6 +37,7 @@ from gaitopt.gait.options import (
     TRANSCRIPTIONS,
     GaitOptions,
     GaitOptionsError,
+    follows_model,
     validate_options,
 )
 from gaitopt.gait.preflight import refuse_unwalkable
@@ -167,6 +168,10 @@ def _step_time(text: str) -> float | None:
 @click.option("--mesh-tol", type=float, default=None,
               help="Refine the mesh until every interval's collocation error estimate is "
                    "<= TOL (e.g. 1e-4); default: the fixed grid --knots.")
+@click.option("--accuracy", type=float, default=0.01, show_default=True,
+              help="Refine the grid until the estimates of the cost, speed and step length are "
+                   "within this relative accuracy (up to 3 times; exit status 3 if not "
+                   "reached); with --knots the grid is kept and the estimate reported.")
 @click.option("--clearance", type=float, default=None,
               help="Swing-tip clearance c in m: height >= c 4 s (1 - s) over single support "
                    "(default: >= 0, the paper).")
@@ -196,7 +201,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   free_fractions: bool,
                   gait_kind: str | None, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
-                  control_model: str | None, mesh_tol: float | None,
+                  control_model: str | None, mesh_tol: float | None, accuracy: float,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool | None,
                   warm_start: Path | None, output: Path) -> None:
@@ -230,7 +235,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
         unilateral_impulses=unilateral_impulses,
         cost=cost,  # type: ignore[arg-type]
         cost_regularization=regularization,
-        mesh_tol=mesh_tol, swing_clearance=clearance,
+        mesh_tol=mesh_tol, accuracy=accuracy, swing_clearance=clearance,
         clearance_profile=clearance_profile,  # type: ignore[arg-type]
         free_phase_fractions=free_fractions)
     if resting_power is not None:
@@ -241,6 +246,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                                                  "--single-support-bounds"))
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
+    refine = follows_model(options.knots)  # knots left to the model: refine to --accuracy
     try:
         options = options_for_model(model, options)
         refuse_unwalkable(model, options)
@@ -284,7 +290,8 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
 
     try:
         solution = solve_gait_solution(model, options, progress=progress, warm_start=start,
-                                       compiled="codegen" if compiled else None)
+                                       compiled="codegen" if compiled else None,
+                                       refine=refine)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:
@@ -304,6 +311,18 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
     console.print(summary_table(gait, sequence_used))
     gait.save(output)
     console.print(f"wrote {output}")
+    record = gait.solver.get("accuracy", {})
+    if record.get("within_target") is False:
+        from gaitopt.gait.refinement import MAX_ROUNDS, describe
+
+        worst = (record.get("worst_estimate") or float("inf"),
+                 record.get("worst_estimate_of", "cost"))
+        console.print(f"NOT CONVERGED to {100 * record['target']:g} %: "
+                      f"{describe(worst, record['target'])} after "
+                      f"{record.get('refinements', 0)} of at most {MAX_ROUNDS} refinements; "
+                      f"the gait file says so (gaitopt verify: accuracy.estimate). Try "
+                      "--knots with more knots, --mesh-tol 1e-4, or --accuracy 0.02")
+        sys.exit(3)
 
 
 @cli.command("verify")

@@ -111,10 +111,19 @@ def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
     else:
         how = f"change from {grid} knots, J {accuracy['previous_cost']:.6g}"
         moved = f"change from {grid} knots"
+    target = accuracy.get("target") or 0.01
     share = "" if rel is None else (
-        f" = {100 * rel:.2f} % of J: " + ("within 1 %" if rel <= 0.01 else
-                                          "above 1 % (a finer --knots or --mesh-tol 1e-4)"))
+        f" = {100 * rel:.2f} % of J: " + (
+            f"within {100 * target:g} %" if rel <= target else
+            f"above {100 * target:g} % (a finer --knots or --mesh-tol 1e-4)"))
     rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} ({how})"))
+    if accuracy.get("target") is not None:
+        worst, name = accuracy.get("worst_estimate"), accuracy.get("worst_estimate_of", "cost")
+        shown = "none" if worst is None else f"{100 * worst:.2g} %"
+        verdict = ("converged" if accuracy.get("within_target") else
+                   f"NOT CONVERGED to {100 * target:g} %")
+        rows.append(("accuracy", f"{verdict}: largest estimate {shown} ({name}); "
+                     f"{accuracy.get('refinements', 0)} refinement(s) of the grid"))
     dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
     if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
         text = f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"

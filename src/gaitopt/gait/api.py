@@ -20,15 +20,18 @@ PosixPath('walk.gait.json')
 
 from __future__ import annotations
 
+import dataclasses
 import os
 
 import numpy as np
 
+from gaitopt.gait.accuracy import accuracy_record
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.model_defaults import options_for_model
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options import GaitOptions, follows_model
 from gaitopt.gait.preflight import refuse_unwalkable
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.refinement import refine_to_accuracy
 from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, PhaseGuess, WarmStart
 from gaitopt.robot import RobotModel, load_model
@@ -70,20 +73,39 @@ def warm_start_usable(gait: Gait, options: GaitOptions) -> bool:
 def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
                         options: GaitOptions | None = None, *,
                         warm_start: Gait | None = None, progress: ProgressFn | None = None,
-                        compiled: str | None = None) -> WalkingSolution:
+                        compiled: str | None = None,
+                        refine: bool | None = None) -> WalkingSolution:
     """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`.
+
+    ``refine``: whether the solve refines its grid to ``options.accuracy``
+    (:mod:`gaitopt.gait.refinement`); None: where the knots are left to the model's default.
 
     Raises:
         UnwalkableModelError: something in the model prevents walking
             (:func:`gaitopt.gait.preflight.preflight`); nothing was solved.
     """
     robot = as_model(model)
-    opts = options_for_model(robot, options or GaitOptions())
+    given = options or GaitOptions()
+    opts = options_for_model(robot, given)
     refuse_unwalkable(robot, opts)
     guess: Guess | WarmStart | None = None
     if warm_start is not None and warm_start_usable(warm_start, opts):
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
-    return solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+    first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+
+    def solve_on(finer: GaitOptions, before: WalkingSolution) -> WalkingSolution:
+        start = guess_from_gait(gait_from_solution(before))
+        again = solve_walking(robot, finer, warm_start=start, progress=progress,
+                              compiled=compiled, check_warm_start=True)
+        return dataclasses.replace(again, stages=before.stages + again.stages,
+                                   wall_time_s=before.wall_time_s + again.wall_time_s)
+
+    if refine is None:
+        refine = follows_model(given.knots)
+    refines = refine and opts.accuracy is not None and opts.mesh_tol is None
+    solution, _ = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
+                                     accuracy_of=accuracy_record)
+    return solution
 
 
 def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,

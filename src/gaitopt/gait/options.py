@@ -56,7 +56,7 @@ PAPER_GRID: dict[str, Any] = {"knots": (8, 5), "control_model": "paper",
 #: lacks the field means this value, not today's default. (Knots were uniform before the
 #: knot spacing became a field and its default until 2026-12-02.)
 LEGACY_DEFAULTS: dict[str, Any] = {"control_model": "paper", "transcription": "hermite-simpson",
-                                   "knot_spacing": "uniform"}
+                                   "knot_spacing": "uniform", "accuracy": None}
 
 
 class GaitOptionsError(ValueError):
@@ -220,6 +220,11 @@ class GaitOptions:
             it on by default at speeds 15 m/min or more from 12 m/min.
         mesh_tol: refine the mesh after the fixed-grid stages until every interval's
             collocation error estimate is <= mesh_tol (``None``: the fixed grid ``knots``).
+        accuracy: the relative accuracy a solve refines itself to (0.01: 1 %): while the
+            estimates of the cost, the speed or the step length (from the check grid) exceed
+            it, the gait is solved again on the check grid, up to
+            :data:`gaitopt.gait.refinement.MAX_ROUNDS` times; ``None``, or knots given by
+            the caller, keeps the one grid (its estimate reported).
         control_model: ``"jumps"`` (the default: no control linkages, the torques may jump
             at both events; the problem is then well posed and converges on coarse grids) or
             ``"paper"`` (controls continuous at the heel strike and, with
@@ -274,6 +279,7 @@ class GaitOptions:
     cost_smoothing: float = from_model(0.01)
     cost_regularization: float = 0.0
     mesh_tol: float | None = None
+    accuracy: float | None = 0.01
     control_model: ControlModel = "jumps"
     swing_clearance: float | None = None
     clearance_profile: ClearanceProfile = "quartic"
@@ -486,6 +492,9 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
         raise GaitOptionsError(f"tol = {o.tol!r}: must lie in (0, 1)")
     if not isinstance(o.max_iter, int) or o.max_iter < 1:
         raise GaitOptionsError(f"max_iter = {o.max_iter!r}: must be a positive integer")
+    if o.accuracy is not None and not 0.0 < _finite("accuracy", o.accuracy) < 1.0:
+        raise GaitOptionsError(f"accuracy = {o.accuracy!r}: must lie in (0, 1) (a relative "
+                               "accuracy, 0.01 for 1 %), or None for no refinement")
     if o.mesh_tol is not None and not 0.0 < _finite("mesh_tol", o.mesh_tol) < 1.0:
         raise GaitOptionsError(f"mesh_tol = {o.mesh_tol!r}: must lie in (0, 1) "
                                "(or None for the fixed grid)")

@@ -177,7 +177,7 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
                     "success": s.success, "iterations": s.iterations,
                     "objective": s.objective, "wall_time_s": s.wall_time_s}
                    for s in solution.stages],
-        "accuracy": accuracy_record(solution),
+        "accuracy": {**accuracy_record(solution), **(solution.accuracy_extra or {})},
     }
     return Gait(
         model_data=model.to_dict(), options=options.to_dict(),

@@ -9,8 +9,9 @@ constraint violation is at most :data:`ACCEPTABLE_VIOLATION`.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from gaitopt.gait.options import GaitOptions
 from gaitopt.ocp import Guess, PhaseGuess, Result
@@ -66,6 +67,9 @@ class WalkingSolution:
     #: The full-problem stages that converged, (knots per phase, cost), in order: the grids
     #: the cost was computed on (the cost error estimate compares the last two).
     grid_costs: tuple[tuple[tuple[int, ...], float], ...] = ()
+    #: What the refinement to an accuracy adds to the gait file's ``solver.accuracy``
+    #: (:func:`gaitopt.gait.refinement.refine_to_accuracy`); None before it ran.
+    accuracy_extra: Mapping[str, Any] | None = None
 
     @property
     def success(self) -> bool:

@@ -547,9 +547,14 @@ def smoothing_ladder(target: float, scale: ModelScale = REFERENCE) -> list[float
 def solve_walking(model: RobotModel, options: GaitOptions, *,
                   warm_start: Guess | Result | WarmStart | None = None,
                   progress: ProgressFn | None = None,
-                  compiled: str | None = None) -> WalkingSolution:
+                  compiled: str | None = None,
+                  check_warm_start: bool = False) -> WalkingSolution:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned solution says whether it succeeded and which stage failed.
+
+    ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
+    ``check grid``), so the answer carries its cost error estimate
+    (:mod:`gaitopt.gait.refinement` solves each finer grid so).
 
     Raises:
         GaitOptionsError: invalid options, or a step so long that no naive start can place
@@ -568,6 +573,8 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                            solver_options=PRIMAL_WARM_OPTIONS)
         if not result.success:
             result = None
+        elif check_warm_start and options.mesh_tol is None:
+            run.check(result)
     outcome: Result | None = result
     if result is None and (options.cost != "paper" or options.cost_regularization > 0.0):
         outcome = run.other_cost()

@@ -40,7 +40,7 @@ Grid = tuple[int, int] | tuple[np.ndarray, ...]
 #: Options that enter a solve only through bounds or the solve's own logic, never the NLP's
 #: structure: problems that differ only in these share one transcription.
 BOUNDS_ONLY_OPTIONS = frozenset({"speed", "step_length", "step_time", "knots", "multistart",
-                                 "continuation", "mesh_tol"})
+                                 "continuation", "mesh_tol", "accuracy"})
 
 
 def is_mesh(grid: Grid) -> bool:

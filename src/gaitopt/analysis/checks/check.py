@@ -68,6 +68,9 @@ _SPECS = (
     CheckSpec("swing.clearance", "swing tip above ground (penetration)", "m", 5e-3),
     # The objective.
     CheckSpec("cost.recomputed", "cost recomputed from the file (relative)", "", 1e-6),
+    # The solve's own accuracy.
+    CheckSpec("accuracy.estimate", "grid error estimates of cost, speed and step length "
+              "within the solve's accuracy target (largest, relative)", "", 1e-2),
 )
 
 #: Every check by id, in report order.

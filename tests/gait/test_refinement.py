@@ -1,0 +1,150 @@
+"""A solve refines its grid until its estimates are within ``accuracy`` (gait.refinement):
+the relative estimates, the loop's rules on fake solves, and real solves through the API and
+the command line (refined, within; not reachable, exit status 3 and verify failing
+``accuracy.estimate``; knots given, no refinement and no target)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import pytest
+from click.testing import CliRunner
+
+from gaitopt.analysis.verify import verify_gait
+from gaitopt.cli import cli
+from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.refinement import (
+    MAX_ROUNDS,
+    refine_to_accuracy,
+    relative_estimates,
+    worst_estimate,
+)
+from gaitopt.gait.solution import WalkingSolution
+from gaitopt.robot import load_model
+from gaitopt.robot.biped import reduced_biped
+
+
+def test_relative_estimates_and_the_worst() -> None:
+    acc = {"cost_error_relative": 0.002, "speed_error": 0.01, "step_length_error": 0.003}
+    rel = relative_estimates(acc, {"speed": 0.5, "step_length": 0.2})
+    assert rel == {"cost": 0.002, "speed": pytest.approx(0.02),
+                   "step_length": pytest.approx(0.015)}
+    assert worst_estimate(acc, {"speed": 0.5, "step_length": 0.2}) == (pytest.approx(0.02),
+                                                                       "speed")
+    # no estimate at all (a single grid): infinitely far from any target
+    assert worst_estimate({"cost_error_relative": None}, {"speed": 0.5}) == (math.inf, "cost")
+
+
+@dataclasses.dataclass(frozen=True)
+class FakeSolution:
+    """What refine_to_accuracy reads of a WalkingSolution."""
+
+    options: GaitOptions
+    success: bool = True
+    result: Any = dataclasses.field(
+        default_factory=lambda: SimpleNamespace(parameters={"speed": 0.2, "step_length": 0.1}))
+    accuracy_extra: Any = None
+
+
+def _loop(errors: list[float], *, refines: bool = True,
+          fail_at: int | None = None) -> tuple[Any, dict[str, Any], list[tuple[int, int]]]:
+    """Run the loop on fake solves whose cost estimates are ``errors`` in grid order."""
+    grids: list[tuple[int, int]] = []
+
+    def solve_on(finer: GaitOptions, before: Any) -> Any:
+        grids.append(tuple(finer.knots))  # type: ignore[arg-type]
+        return FakeSolution(finer, success=len(grids) != fail_at)
+
+    def accuracy_of(sol: Any) -> dict[str, Any]:
+        return {"cost_error_relative": errors[len(grids)]}
+
+    first = FakeSolution(GaitOptions(knots=(16, 6)))
+    sol, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,  # type: ignore[arg-type]
+                                    accuracy_of=accuracy_of)
+    return sol, extra, grids
+
+
+def test_the_loop_refines_on_the_check_grid_until_within() -> None:
+    sol, extra, grids = _loop([0.05, 0.02, 0.004])
+    assert grids == [(24, 8), (36, 12)]
+    assert tuple(sol.options.knots) == (36, 12)
+    assert extra["within_target"] is True and extra["refinements"] == 2
+    assert extra["worst_estimate"] == pytest.approx(0.004)
+
+
+def test_the_loop_stops_after_its_rounds_and_says_not_within() -> None:
+    sol, extra, grids = _loop([0.05] * (MAX_ROUNDS + 1))
+    assert len(grids) == MAX_ROUNDS
+    assert extra["within_target"] is False and extra["refinements"] == MAX_ROUNDS
+
+
+def test_a_failed_finer_solve_keeps_the_coarser_answer() -> None:
+    sol, extra, grids = _loop([0.05, 0.02], fail_at=1)
+    assert grids == [(24, 8)] and tuple(sol.options.knots) == (16, 6)
+    assert extra["within_target"] is False and extra["refinements"] == 0
+
+
+def test_without_refinement_there_is_no_target() -> None:
+    sol, extra, grids = _loop([0.05], refines=False)
+    assert grids == [] and extra["target"] is None and extra["within_target"] is None
+
+
+def test_the_accuracy_option_is_validated() -> None:
+    biped = reduced_biped(load_model("five-link"))
+    for bad in (0.0, 1.0, -0.1, float("nan")):
+        with pytest.raises(GaitOptionsError, match="accuracy"):
+            validate_options(GaitOptions(accuracy=bad), biped)
+
+
+# -- real solves ---------------------------------------------------------------------------
+
+FAST_NO_ANKLE = GaitOptions(speed=0.5, ankle=False, impulse=False)  # 30 m/min
+
+
+def test_a_solve_above_its_accuracy_is_refined_until_within() -> None:
+    """30 m/min without ankle torques: on the default 16 + 6 knots the step length's estimate
+    is above 1 % (measured 1.2 %); once refined to 24 + 8 it is within."""
+    solution: WalkingSolution = solve_gait_solution("five-link", FAST_NO_ANKLE)
+    extra = solution.accuracy_extra
+    assert solution.success and extra is not None
+    assert extra["refinements"] >= 1 and extra["within_target"] is True
+    assert tuple(solution.options.knots) != (16, 6)
+    assert extra["worst_estimate"] <= 0.01
+    names = [s.name for s in solution.stages]
+    assert names.count("check grid") == 1 + extra["refinements"]
+    gait_accuracy = verify_gait(_gait(solution)).check("accuracy.estimate")
+    assert gait_accuracy.passed and gait_accuracy.limit == pytest.approx(0.01)
+
+
+def _gait(solution: WalkingSolution) -> Gait:
+    from gaitopt.gait.record import gait_from_solution
+
+    return gait_from_solution(solution)
+
+
+def test_given_knots_keep_their_grid_and_report_the_estimate() -> None:
+    solution = solve_gait_solution("five-link", FAST_NO_ANKLE.replace(knots=(16, 6)))
+    assert tuple(solution.options.knots) == (16, 6)
+    assert solution.accuracy_extra is not None and solution.accuracy_extra["target"] is None
+    check = verify_gait(_gait(solution)).check("accuracy.estimate")
+    assert check.passed and check.value > 0.01  # above 1 %, reported, not failed
+
+
+def test_the_command_line_exits_3_when_the_accuracy_is_not_reached(tmp_path: Path) -> None:
+    out = tmp_path / "g.gait.json"
+    result = CliRunner().invoke(cli, ["solve", "--speed", "30m/min", "--no-ankle",
+                                      "--no-impulse", "--accuracy", "1e-5", "-o", str(out)])
+    assert result.exit_code == 3, result.output
+    assert "NOT CONVERGED to 0.001 %" in result.output
+    assert "Traceback" not in result.output
+    gait = Gait.load(out)
+    assert gait.solver["accuracy"]["within_target"] is False
+    assert gait.solver["accuracy"]["refinements"] == MAX_ROUNDS
+    verdict = CliRunner().invoke(cli, ["verify", str(out)])
+    assert verdict.exit_code == 1 and "accuracy.estimate" in verdict.output
