@@ -25,7 +25,8 @@ the links are massless and collide with nothing.
 Each contact point is a sphere of radius ``r`` (:class:`MjcfContact`) centred **at** the
 point, and the ground plane lies ``r`` below gaitopt's ground (at MuJoCo ``z = -r``): a
 sphere touches the plane exactly when its centre, the contact point, is at gaitopt height 0,
-whatever the link's angle. Only the spheres and the plane collide. Joint actuators are motors
+whatever the link's angle. Only the spheres and the plane collide (the spheres have
+``contype 0``, ``conaffinity 1``, the plane both 1: a swing tip passes the stance tip). Joint actuators are motors
 (gear 1, ``ctrlrange`` the actuator's torque bounds, N m). Contact actuators (the five-link
 model's ankles: a torque between the ground and the link while the point is on the ground) are
 not joints and have no MJCF element; a comment lists them (:mod:`gaitopt.analysis.simulate`
@@ -157,7 +158,7 @@ def mjcf_from_model(model: RobotModel, *, contact: MjcfContact | None = None) ->
         bodies[ct.link].append(ET.Comment(f" gaitopt contact point {ct.name!r} "))
         ET.SubElement(bodies[ct.link], "geom", name=ct.name, type="sphere",
                       size=_num(c.radius), pos=_xyz(model.link(ct.link).local_point(*ct.at)),
-                      contype="1", conaffinity="1", mass="0", rgba="0.8 0.2 0.2 1")
+                      contype="0", conaffinity="1", mass="0", rgba="0.8 0.2 0.2 1")
     actuators = ET.SubElement(root, "actuator")
     for a in model.actuators:
         if a.joint is not None:
