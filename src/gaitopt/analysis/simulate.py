@@ -4,15 +4,15 @@
 The robot starts at the gait's initial state (``q``, ``qd`` of the first knot). Each step
 replays the gait's phases in order, as the return map of :mod:`.stability` does: a phase that
 ends at a touchdown (the gait's ``heel_strike``, the heel-toe walk's ``foot_flat``) ends when
-that point's contact geom touches the ground while it is at least ``arm_distance`` (half a
-step length) ahead of where the step's stance point stood at the step's start; every other
-phase lasts its recorded duration. A swing point passes through the ground until the phase that ends with its touchdown has begun
-and it is armed (``ghost_swing``, the default: the return map's hybrid model, in which a point
-meets the ground only at its touchdown; optimal gaits graze the ground in mid-swing, where
-their clearance constraint is active, at the knots only: the seven-link walk at 60 m/min dips
-its swing toe 1.6 mm into the ground 0.46 m ahead of the origin, which a solid ground turns
-into a trip; ``ghost_swing=False`` makes every point solid all the time). The next step
-is the same motion with the legs swapped
+that point's contact geom touches the ground while it is at least ``arm_distance`` (half a step
+length) ahead of where the step's stance point stood at the step's start; every other phase
+lasts its recorded duration. A swing point passes through the ground until the phase that ends
+with its touchdown has begun and it is armed (``ghost_swing``, the default: the return map's
+hybrid model, in which a point meets the ground only at its touchdown; optimal gaits graze the
+ground in mid-swing, where their clearance constraint is active, at the knots only: the
+seven-link walk at 60 m/min dips its swing toe 1.6 mm into the ground 0.46 m ahead of the
+origin, which a solid ground turns into a trip; ``ghost_swing=False`` makes every point solid
+all the time). The next step is the same motion with the legs swapped
 (:func:`gaitopt.robot.symmetry.leg_swap`: ``q[perm_q]``, ``u[perm_u]``, contacts renamed) and
 its origin at the new stance point's measured position.
 
@@ -69,6 +69,8 @@ TABLE_STEP = 2.5e-4
 HIP_FRACTION = 0.5
 #: Fall: the base link's angle beyond +- this (rad).
 BASE_ANGLE_LIMIT = 1.0
+#: The trajectory is recorded every this many s (100 Hz).
+RECORD_STEP = 0.01
 #: A step that lasts this many nominal step times has stopped (a fall).
 STALL_FACTOR = 3.0
 
@@ -112,8 +114,8 @@ class SimulationResult:
     ``max_error``; per completed step its duration ``step_times`` (s) and length
     ``step_lengths`` (m, between successive stance points); ``peak_torque_ratio``: the largest
     |torque| / bound; ``t`` (N,) and ``q`` (N, nq) the simulated trajectory at 100 Hz
-    (physical leg labels); ``settings``: gains, tracking, contact parameters, the MJCF's
-    source."""
+    (physical leg labels), ``qpos`` (N, nq) MuJoCo's, ``robot`` the MuJoCo model;
+    ``settings``: gains, tracking, contact parameters, the MJCF's source."""
 
     steps: int
     steps_asked: int
@@ -130,6 +132,8 @@ class SimulationResult:
     peak_torque_ratio: float
     t: Array
     q: Array
+    qpos: Array
+    robot: MujocoRobot
     settings: dict[str, Any] = field(default_factory=dict)
 
 
@@ -232,8 +236,10 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     sq_err, n_err, max_err, peak = 0.0, 0, 0.0, 0.0
     rec_t: list[float] = []
     rec_q: list[Array] = []
+    rec_qpos: list[Array] = []
     fall: str | None = None
     dt = float(mj.opt.timestep)
+    record_every = max(1, round(RECORD_STEP / dt))
     nominal = gait.step_time
     while step < steps:
         t = float(data.time)
@@ -303,9 +309,10 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
                 tau_j = float(np.clip(tau_j, *bounds[j]))
             peak = max(peak, abs(tau_j) / max(abs(bounds[j]).max(), 1e-12))
             data.xfrc_applied[link_body[point], 4] = -tau_j  # +tau about gaitopt z = -y
-        if round(t / dt) % 20 == 0:
+        if round(t / dt) % record_every == 0:
             rec_t.append(t)
             rec_q.append(q)
+            rec_qpos.append(np.array(data.qpos))
         mujoco.mj_step(mj, data)
         for j, (act, g) in robot.joint_actuators.items():
             peak = max(peak, abs(float(data.actuator_force[act]) * g)
@@ -336,6 +343,7 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
         gait_speed=gait.speed, rms_error=float(np.sqrt(sq_err / max(n_err, 1))),
         max_error=max_err, step_times=tuple(step_times), step_lengths=tuple(step_lengths),
         peak_torque_ratio=peak, t=np.array(rec_t), q=np.array(rec_q).reshape(-1, model.nq),
+        qpos=np.array(rec_qpos).reshape(-1, mj.nq), robot=robot,
         settings={"pd": [kp, kd], "tracking": tracking, "torques_bounded": bounded,
                   "contact": contact.describe(), "mjcf": robot.source,
                   "ghost_swing": ghost_swing,

@@ -22,15 +22,15 @@ of the URDF export (the link's ellipsoid if it has a ``shape``, else ``iyy``). T
 does not compute inertias from geoms (``inertiafromgeom="false"``); the capsules drawn along
 the links are massless and collide with nothing.
 
-Each contact point is a sphere of radius ``r`` (:class:`MjcfContact`) centred **at** the
-point, and the ground plane lies ``r`` below gaitopt's ground (at MuJoCo ``z = -r``): a
-sphere touches the plane exactly when its centre, the contact point, is at gaitopt height 0,
-whatever the link's angle. Only the spheres and the plane collide (the spheres have
-``contype 0``, ``conaffinity 1``, the plane both 1: a swing tip passes the stance tip). Joint actuators are motors
-(gear 1, ``ctrlrange`` the actuator's torque bounds, N m). Contact actuators (the five-link
-model's ankles: a torque between the ground and the link while the point is on the ground) are
-not joints and have no MJCF element; a comment lists them (:mod:`gaitopt.analysis.simulate`
-applies them as external torques).
+Each contact point is a sphere of radius ``r`` (:class:`MjcfContact`) centred **at** the point,
+and the ground plane lies ``r`` below gaitopt's ground (at MuJoCo ``z = -r``): a sphere touches
+the plane exactly when its centre, the contact point, is at gaitopt height 0, whatever the
+link's angle. Only the spheres and the plane collide (the spheres have ``contype 0``,
+``conaffinity 1``, the plane both 1: a swing tip passes the stance tip). Joint actuators are
+motors (gear 1, ``ctrlrange`` the actuator's torque bounds, N m). Contact actuators (the
+five-link model's ankles: a torque between the ground and the link while the point is on the
+ground) are not joints and have no MJCF element; a comment lists them
+(:mod:`gaitopt.analysis.simulate` applies them as external torques).
 """
 
 from __future__ import annotations
