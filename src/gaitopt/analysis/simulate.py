@@ -22,10 +22,13 @@ piecewise linear), tabulated every :data:`TABLE_STEP` s and read linearly in bet
 
 * ``tracking="time"``: by the phase's own clock from its start (the last value held if the
   phase runs longer), the return map's controller, or
-* ``tracking="phase"``: by a monotonic phase variable, the hip's forward position relative
-  to the step's origin, ``theta = x_hip - x_origin``: the reference at ``tau(theta)``, the
-  inverse of the gait's ``theta(tau)`` (clipped to the phase), velocities scaled by the
-  measured ``theta_dot / theta_dot_ref(tau)``.
+* ``tracking="phase"``: in the phases that end at a touchdown (the swing), by a monotonic
+  phase variable, the hip's forward position relative to the step's origin,
+  ``theta = x_hip - x_origin``: the reference at ``tau(theta)``, the inverse of the gait's
+  ``theta(tau)`` (clipped to the phase), velocities scaled by the measured
+  ``theta_dot / theta_dot_ref(tau)``; the phases of fixed duration (double support, foot
+  flat) keep their clocks (indexed by the hip, a double support whose hip stalls never ends:
+  the five-link walk without ankle torques rolls back and stops).
 
 Torques: ``u = u_ff + kp B^T (q_ref - q) + kd B^T (qd_ref - qd)`` (N m; ``B`` the actuation
 matrix: a joint actuator tracks its joint, a contact actuator (the five-link model's ankles)
@@ -174,7 +177,10 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     swap = leg_swap(model)
     perm_q, perm_u = np.array(swap.perm_q), np.array(swap.perm_u)
     tables = [_table(model, ph, gait.step_length) for ph in gait.phases]
-    theta_ref = np.concatenate([tb.q[:, BASE_X] for tb in tables])
+    # theta(tau) of the whole step: the hip's x relative to the origin (the phases' shared
+    # boundary samples once)
+    theta_ref = np.concatenate([tb.q[int(i > 0):, BASE_X] for i, tb in enumerate(tables)])
+    tau_ref = np.concatenate([tb.tau[int(i > 0):] for i, tb in enumerate(tables)])
     if tracking == "phase" and np.any(np.diff(theta_ref) <= 0):
         raise SimulationError("tracking='phase': the gait's hip does not move forward "
                               "monotonically, so its forward position cannot index the step")
@@ -248,12 +254,13 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
         qd_g = qd[perm_q] if step % 2 else qd
         table = tables[phase]
         ph = gait.phases[phase]
-        if tracking == "time":
+        by_clock = tracking == "time" or spec.phases[phase].duration is not None
+        if by_clock:
             tau = ph.t[0] + min(t - t_phase0, ph.duration)
             q_r, qd_r, u_r = table.at(tau)
         else:
             theta = q_g[BASE_X] - origin
-            tau = float(np.interp(theta, theta_ref, np.concatenate([tb.tau for tb in tables])))
+            tau = float(np.interp(theta, theta_ref, tau_ref))
             tau = float(np.clip(tau, ph.t[0], ph.t[-1]))
             q_r, qd_r, u_r = table.at(tau)
             k = int(np.clip(np.searchsorted(table.tau, tau) - 1, 0, table.tau.size - 2))
@@ -273,10 +280,8 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
         if guard is not None:
             point = label[guard]
             done = touching(point) and point_x(point) - origin >= spec.arm_distance
-        elif tracking == "time":
-            done = t - t_phase0 >= ph.duration - 0.5 * dt
         else:
-            done = tau >= ph.t[-1]
+            done = t - t_phase0 >= ph.duration - 0.5 * dt
         if done:
             phase, t_phase0 = phase + 1, t
             if phase == len(gait.phases):
