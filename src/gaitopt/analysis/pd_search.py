@@ -9,7 +9,8 @@ five-link walk at 12 m/min it agrees with the default 1e-10 to 2e-7). The search
    :data:`KD_GRID` (10 to 500 N m s/rad);
 2. a local refinement from the best grid point: a compass search in ``(log kp, log kd)``,
    steps of a factor :data:`REFINE_FACTOR` (at most :data:`MOVES_PER_ROUND` moves), then
-   halved in the log, :data:`REFINE_ROUNDS` rounds.
+   halved in the log, :data:`REFINE_ROUNDS` rounds, within the grid's box (larger gains keep
+   lowering the radius of some gaits, but they are not a robot's).
 
 A pair whose simulated step fails (it never lands) counts as ``rho = inf``. Each evaluation
 prints a line through ``progress``.
@@ -84,7 +85,8 @@ def search_gains(gait: Gait, *, kp_grid: tuple[float, ...] = KP_GRID,
     for _ in range(rounds):
         for _ in range(MOVES_PER_ROUND):
             kp, kd = best
-            moves = [(kp * math.exp(a * factor), kd * math.exp(b * factor))
+            moves = [(float(np.clip(kp * math.exp(a * factor), min(kp_grid), max(kp_grid))),
+                      float(np.clip(kd * math.exp(b * factor), min(kd_grid), max(kd_grid))))
                      for a, b in ((1, 0), (-1, 0), (0, 1), (0, -1))]
             for m in moves:
                 rho(*m)
