@@ -95,7 +95,8 @@ class _PhaseTable:
     def at(self, tau: float) -> tuple[Array, Array, Array]:
         k = int(np.clip(np.searchsorted(self.tau, tau) - 1, 0, self.tau.size - 2))
         s = float(np.clip((tau - self.tau[k]) / (self.tau[k + 1] - self.tau[k]), 0.0, 1.0))
-        return tuple((1 - s) * a[k] + s * a[k + 1] for a in (self.q, self.qd, self.u))  # type: ignore[return-value]
+        q, qd, u = ((1 - s) * a[k] + s * a[k + 1] for a in (self.q, self.qd, self.u))
+        return q, qd, u
 
 
 def _table(model: RobotModel, phase: GaitPhase, step_length: float) -> _PhaseTable:
