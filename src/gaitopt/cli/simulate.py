@@ -78,10 +78,11 @@ def simulate_command(file: Path, steps: int, pd: str, tracking: str, video: Path
             what = ("no PD gains stabilise this gait: the best" if pd.strip().lower() == "auto"
                     else f"PD {gains[0]:g},{gains[1]:g} does not stabilise this gait: its")
             console.print(f"REFUSED: {what} spectral radius of the return map is {rho:.4g} "
-                          f"(at PD {gains[0]:.4g},{gains[1]:.4g}) > 1, so time-indexed tracking "
-                          "cannot keep the gait; not simulated. Try --tracking phase (the "
-                          "reference indexed by the hip's forward position; docs/simulate.md "
-                          "says which gaits it keeps) or --force.", soft_wrap=True)
+                          f"(at PD {gains[0]:.4g},{gains[1]:.4g}) > 1: the gait's orbit is "
+                          "unstable under time-indexed tracking, a replay leaves it; not "
+                          "simulated. --tracking phase indexes the swing by the hip's forward "
+                          "position (docs/simulate.md: it did not keep the five-link walk "
+                          "without ankle torques); --force simulates anyway.", soft_wrap=True)
             sys.exit(REFUSED)
     else:
         console.print("tracking by phase (the hip's forward position): the return map's "
