@@ -38,8 +38,8 @@ def resolve_gains(text: str, gait: Gait, console: Console) -> tuple[tuple[float,
 
     if text.strip().lower() == "auto":
         console.print("--pd auto: searching the PD gains that minimise the spectral radius of "
-                      "the return map (4 x 4 log grid, kp 100..10000, kd 10..500, then a local "
-                      "refinement)", soft_wrap=True)
+                      "the return map (4 x 4 log grid, kp 300..10000, kd 15..500, then a local "
+                      "refinement in kp 100..10000, kd 10..500)", soft_wrap=True)
         try:
             found = search_gains(gait, progress=lambda line: console.print(line))
         except StabilityError as exc:
