@@ -130,6 +130,7 @@ def test_seven_link_walks_ten_steps_with_auto_gains(tmp_path: Path) -> None:
     video = tmp_path / "walk.gif"
     out = CliRunner().invoke(cli, ["simulate", str(SEVEN), "--pd", "auto", "--steps", "10",
                                    "--video", str(video)])
+    print(out.output)  # the search and the steps, for the record (pytest -s)
     assert out.exit_code == 0, out.output
     assert "WALKED 10 steps" in out.output
     assert re.search(r"--pd auto: PD [0-9.e+]+,[0-9.e+]+, spectral radius 0\.[0-9]+ \(stable",
