@@ -162,6 +162,12 @@ def mjcf_from_model(model: RobotModel, *, contact: MjcfContact | None = None) ->
         ET.SubElement(bodies[ct.link], "geom", name=ct.name, type="sphere",
                       size=_num(c.radius), pos=_xyz(model.link(ct.link).local_point(*ct.at)),
                       contype="0", conaffinity="1", mass="0", rgba="0.8 0.2 0.2 1")
+    for link in model.links:  # a sole drawn between a link's contact points (feet)
+        points = [model.link(ct.link).local_point(*ct.at) for ct in model.contacts
+                  if ct.link == link.name]
+        for a, b in zip(points, points[1:], strict=False):
+            ET.SubElement(bodies[link.name], "geom", type="capsule", size="0.012", fromto=f"{_xyz(a)} {_xyz(b)}",
+                          mass="0")
     actuators = ET.SubElement(root, "actuator")
     for a in model.actuators:
         if a.joint is not None:
