@@ -166,8 +166,8 @@ def mjcf_from_model(model: RobotModel, *, contact: MjcfContact | None = None) ->
         points = [model.link(ct.link).local_point(*ct.at) for ct in model.contacts
                   if ct.link == link.name]
         for a, b in zip(points, points[1:], strict=False):
-            ET.SubElement(bodies[link.name], "geom", type="capsule", size="0.012", fromto=f"{_xyz(a)} {_xyz(b)}",
-                          mass="0")
+            ET.SubElement(bodies[link.name], "geom", type="capsule", size="0.012",
+                          fromto=f"{_xyz(a)} {_xyz(b)}", mass="0")
     actuators = ET.SubElement(root, "actuator")
     for a in model.actuators:
         if a.joint is not None:
