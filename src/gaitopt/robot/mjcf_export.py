@@ -165,9 +165,9 @@ def mjcf_from_model(model: RobotModel, *, contact: MjcfContact | None = None) ->
     for link in model.links:  # a sole drawn between a link's contact points (feet)
         points = [model.link(ct.link).local_point(*ct.at) for ct in model.contacts
                   if ct.link == link.name]
-        for a, b in zip(points, points[1:], strict=False):
+        for p_from, p_to in zip(points, points[1:], strict=False):
             ET.SubElement(bodies[link.name], "geom", type="capsule", size="0.012",
-                          fromto=f"{_xyz(a)} {_xyz(b)}", mass="0")
+                          fromto=f"{_xyz(p_from)} {_xyz(p_to)}", mass="0")
     actuators = ET.SubElement(root, "actuator")
     for a in model.actuators:
         if a.joint is not None:
