@@ -84,8 +84,9 @@ def test_a_fall_is_a_result_with_exit_status_1() -> None:
 
 
 def test_mjcf_file_matched_by_name(tmp_path: Path) -> None:
-    """``--mjcf FILE`` with gaitopt's own export gives the same walk; a file whose joint names
-    differ is refused with a line naming the joint."""
+    """``--mjcf FILE`` with gaitopt's own export gives the same walk; without a geom named
+    after a contact point it still walks (the touchdown read from the point's height); a file
+    whose joint names differ is refused with a line naming the joint."""
     from gaitopt.analysis.mujoco_model import MujocoModelError
     from gaitopt.analysis.simulate import simulate_gait
     from gaitopt.robot.mjcf_export import mjcf_from_model
@@ -97,6 +98,11 @@ def test_mjcf_file_matched_by_name(tmp_path: Path) -> None:
     from_file = simulate_gait(gait, steps=2, pd=(1000.0, 60.0), mjcf=str(path))
     assert from_file.settings["mjcf"] == str(path)
     np.testing.assert_allclose(from_file.q, own.q, atol=1e-9)
+    # a file without a geom named after a contact point: its touchdown read from its height
+    ball = tmp_path / "ball.xml"
+    ball.write_text(path.read_text().replace('name="tip_2"', 'name="ball_2"'))
+    by_height = simulate_gait(gait, steps=2, pd=(1000.0, 60.0), mjcf=str(ball))
+    assert not by_height.fell and by_height.steps == 2  # (its tip_2 is solid in mid-swing)
     bad = tmp_path / "renamed.xml"
     bad.write_text(path.read_text().replace('"knee_2"', '"right_knee"'))
     with pytest.raises(MujocoModelError, match="joint 'knee_2'.*right_knee"):

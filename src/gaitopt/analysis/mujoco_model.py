@@ -5,7 +5,10 @@ The MJCF is gaitopt's export (:func:`gaitopt.robot.mjcf_export.mjcf_from_model`)
 (``--mjcf FILE``, e.g. the file the model was imported from), matched to the model **by
 name**: the base body is named after the base link and carries three root joints, slides
 along +-x and +-z and a hinge about +-y (in any order); every gaitopt joint is a hinge of the
-same name about +-y; every contact point is a geom of the same name. With ``s`` the sign of
+same name about +-y; every link that carries a contact point is a body of the same name; a
+contact point is a geom of the same name if the file has one (gaitopt's export does), else
+the file's own geoms touch the ground and the point's touchdown is read from its height
+(:mod:`.simulate`). With ``s`` the sign of
 each coordinate (+1 for a slide along +x or +z and for a hinge about -y; -1 otherwise) and
 ``p0`` the base body's position (MuJoCo x, z), ``q[i] = s[i] qpos[index[i]] (+ p0 on x, y)``
 and ``qd[i] = s[i] qvel[dof[i]]`` (:class:`CoordinateMap`). MuJoCo orders its coordinates
@@ -68,15 +71,17 @@ class CoordinateMap:
 
 @dataclass(frozen=True, eq=False)
 class MujocoRobot:
-    """The compiled MuJoCo model of a gaitopt ``model``: ``mj`` (``MjModel``), the coordinate
-    map, the geom id of each contact point, the actuator id and sign of each joint actuator
-    (gaitopt actuator index -> (MuJoCo actuator, gear * sign)), the MJCF text and where it came
+    """The compiled MuJoCo model of a gaitopt ``model``: ``mj`` (``MjModel``), the
+    coordinate map, the geom id of each contact point that has a geom of its name (a file's
+    own feet may have none), the body of each contact point's link, the actuator id and sign
+    of each joint actuator (gaitopt actuator index -> (MuJoCo actuator, gear * sign)), the MJCF text and where it came
     from."""
 
     model: RobotModel
     mj: Any
     coordinates: CoordinateMap
     contact_geoms: dict[str, int]
+    contact_bodies: dict[str, int]
     ground_geoms: frozenset[int]
     joint_actuators: dict[int, tuple[int, float]]
     source: str
@@ -182,13 +187,17 @@ def mujoco_robot(model: RobotModel, *, contact: MjcfContact | None = None,
     if mj.nq != nq or mj.nv != nq:
         raise MujocoModelError(f"{source}: {mj.nq} coordinates, the model has {nq} "
                                f"({', '.join(model.coordinate_names)})")
-    geoms = {}
+    geoms, contact_bodies = {}, {}
     for c in model.contacts:
         g = _id(mujoco, mj, gm, c.name)
-        if g < 0:
-            raise MujocoModelError(f"{source}: no geom named {c.name!r} (a contact point of the "
-                                   f"model); its geoms: {_names(mujoco, mj, gm, mj.ngeom)}")
-        geoms[c.name] = g
+        if g >= 0:
+            geoms[c.name] = g
+        body = _id(mujoco, mj, bd, c.link)
+        if body < 0:
+            raise MujocoModelError(f"{source}: no body named {c.link!r} (the link of the "
+                                   f"model's contact point {c.name!r}); its bodies: "
+                                   f"{_names(mujoco, mj, bd, mj.nbody)}")
+        contact_bodies[c.name] = body
     ground = frozenset(g for g in range(mj.ngeom) if mj.geom_bodyid[g] == 0)
     actuators: dict[int, tuple[int, float]] = {}
     for k, a in enumerate(model.actuators):
@@ -203,6 +212,7 @@ def mujoco_robot(model: RobotModel, *, contact: MjcfContact | None = None,
         i = model.joint_coordinate(a.joint)
         actuators[k] = (acts[0], float(mj.actuator_gear[acts[0]][0]) * sign[i])
     return MujocoRobot(model=model, mj=mj, coordinates=CoordinateMap(index, dof, sign, offset),
-                       contact_geoms=geoms, ground_geoms=ground, joint_actuators=actuators,
+                       contact_geoms=geoms, contact_bodies=contact_bodies,
+                       ground_geoms=ground, joint_actuators=actuators,
                        source=source, mjcf=text)
 

@@ -72,6 +72,8 @@ TABLE_STEP = 2.5e-4
 HIP_FRACTION = 0.5
 #: Fall: the base link's angle beyond +- this (rad).
 BASE_ANGLE_LIMIT = 1.0
+#: Without a geom of its name (``--mjcf FILE``), a point touches the ground at this height (m).
+TOUCH_HEIGHT = 1e-3
 #: The trajectory is recorded every this many s (100 Hz).
 RECORD_STEP = 0.01
 #: A step that lasts this many nominal step times has stopped (a fall).
@@ -189,8 +191,7 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     ground_torques = [(j, a.contact or "", np.flatnonzero(np.array(
         actuation_rows(model, [a.contact or ""]))[:, j])) for j, a in enumerate(model.actuators)
         if a.contact is not None]
-    link_body = {c.name: int(mj.geom_bodyid[robot.contact_geoms[c.name]])
-                 for c in model.contacts}
+    link_body = robot.contact_bodies
     bounds = np.array([a.limits for a in model.actuators], dtype=float).reshape(-1, 2)
     hip_min = HIP_FRACTION * standing_height(model)
 
@@ -198,6 +199,8 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     mujoco.mj_forward(mj, data)
 
     def touching(point: str) -> bool:
+        if point not in robot.contact_geoms:  # a file without the point's geom: its height
+            return point_xy(point)[1] <= TOUCH_HEIGHT
         g = robot.contact_geoms[point]
         for k in range(data.ncon):
             con = data.contact[k]
@@ -206,8 +209,14 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
                 return True
         return False
 
+    def point_xy(point: str) -> Array:
+        if point in robot.contact_geoms:
+            return np.asarray(data.geom_xpos[robot.contact_geoms[point]])[[0, 2]]
+        q_now = cmap.q(data.qpos)
+        return np.asarray(contact_position(model, q_now, point), dtype=float).ravel()
+
     def point_x(point: str) -> float:
-        return float(data.geom_xpos[robot.contact_geoms[point]][0])
+        return float(point_xy(point)[0])
 
     step, phase, t_phase0 = 0, 0, 0.0
     names = dict(swap.contacts)
@@ -223,6 +232,8 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     affinity = {g: int(mj.geom_conaffinity[g]) for g in robot.contact_geoms.values()}
 
     def collide(point: str, on: bool) -> None:
+        if point not in robot.contact_geoms:
+            return  # a file's own feet stay solid
         g = robot.contact_geoms[point]
         mj.geom_conaffinity[g] = affinity[g] if on else 0
         mj.geom_contype[g] = int(mj.geom_contype[g]) if on else 0
