@@ -74,8 +74,8 @@ class MujocoRobot:
     """The compiled MuJoCo model of a gaitopt ``model``: ``mj`` (``MjModel``), the
     coordinate map, the geom id of each contact point that has a geom of its name (a file's
     own feet may have none), the body of each contact point's link, the actuator id and sign
-    of each joint actuator (gaitopt actuator index -> (MuJoCo actuator, gear * sign)), the MJCF text and where it came
-    from."""
+    of each joint actuator (gaitopt actuator index -> (MuJoCo actuator, gear * sign)), the
+    MJCF text and where it came from."""
 
     model: RobotModel
     mj: Any
