@@ -8,6 +8,7 @@ generous tolerances (contact is soft, torques saturate; the CPU changes the last
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from click.testing import CliRunner
 from gaitopt.cli import cli
 from gaitopt.gait.gait_file import Gait
 
+os.environ.setdefault("MUJOCO_GL", "egl")  # before MuJoCo loads: headless rendering
 mujoco = pytest.importorskip("mujoco")
 
 DATA = Path(__file__).parent / "data"
@@ -141,3 +143,5 @@ def test_seven_link_walks_ten_steps_with_auto_gains(tmp_path: Path) -> None:
     assert "WALKED 10 steps" in out.output
     assert re.search(r"--pd auto: PD [0-9.e+]+,[0-9.e+]+, spectral radius 0\.[0-9]+ \(stable",
                      out.output)
+    if "video:" in out.output:  # MuJoCo's offscreen renderer worked (EGL)
+        assert video.stat().st_size > 10_000

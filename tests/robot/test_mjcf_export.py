@@ -10,6 +10,7 @@ export's frames, signs, inertials and gravity: MuJoCo computes both with its own
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -21,6 +22,7 @@ from gaitopt.dynamics import bias_forces, contact_position, crba
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.mjcf_export import MjcfContact, mjcf_from_model
 
+os.environ.setdefault("MUJOCO_GL", "egl")  # before MuJoCo loads (the simulate tests render)
 mujoco = pytest.importorskip("mujoco")
 sys.path.insert(0, str(Path(__file__).parents[1] / "dynamics"))
 from dynamics_helpers import random_tree  # noqa: E402
