@@ -66,6 +66,9 @@ def simulate_command(file: Path, steps: int, pd: str, tracking: str, video: Path
         import_mujoco()
     except (GaitFileError, MujocoModelError) as exc:
         raise UserError(str(exc)) from None
+    if not gait.success:
+        raise UserError(f"{file}: the gait's solve did not converge (status {gait.status!r}): "
+                        "its trajectories are not a gait; solve it again")
     if video is not None and video.suffix.lower() != ".gif":
         raise UserError(f"--video {video}: allowed: a .gif file")
     console.print(f"{file}: {gait.model.name}, {gait.speed * 60:.2f} m/min, step "
