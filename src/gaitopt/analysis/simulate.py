@@ -229,14 +229,14 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     guard_points: dict[str, int] = {}  # swing point -> the phase its touchdown ends
     for i in spec.guard_phases:
         guard_points.setdefault(spec.guard_point(i), i)
-    affinity = {g: int(mj.geom_conaffinity[g]) for g in robot.contact_geoms.values()}
+    filters = {g: (int(mj.geom_contype[g]), int(mj.geom_conaffinity[g]))
+               for g in robot.contact_geoms.values()}
 
     def collide(point: str, on: bool) -> None:
         if point not in robot.contact_geoms:
             return  # a file's own feet stay solid
         g = robot.contact_geoms[point]
-        mj.geom_conaffinity[g] = affinity[g] if on else 0
-        mj.geom_contype[g] = int(mj.geom_contype[g]) if on else 0
+        mj.geom_contype[g], mj.geom_conaffinity[g] = filters[g] if on else (0, 0)
 
     def disarm() -> None:  # the step's swing points pass through the ground until armed
         for c in robot.contact_geoms:
