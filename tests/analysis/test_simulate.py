@@ -76,9 +76,9 @@ def test_unstabilisable_gait_is_refused_with_its_spectral_radius() -> None:
 
 
 def test_a_fall_is_a_result_with_exit_status_1() -> None:
-    """Tiny gains cannot hold the seven-link walk at 60 m/min: it falls in its first steps
-    (``--force``: simulated although the return map is unstable)."""
-    out = CliRunner().invoke(cli, ["simulate", str(SEVEN), "--pd", "30,3", "--steps", "4",
+    """Tiny gains cannot hold the five-link walk: it stops within its first steps (a fall;
+    ``--force``: simulated although the return map is unstable)."""
+    out = CliRunner().invoke(cli, ["simulate", str(FIVE), "--pd", "30,3", "--steps", "4",
                                    "--force"])
     assert out.exit_code == 1, out.output
     assert "FELL after" in out.output and "fall criteria:" in out.output
