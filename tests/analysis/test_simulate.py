@@ -145,3 +145,18 @@ def test_seven_link_walks_ten_steps_with_auto_gains(tmp_path: Path) -> None:
                      out.output)
     if "video:" in out.output:  # MuJoCo's offscreen renderer worked (EGL)
         assert video.stat().st_size > 10_000
+
+
+def test_stick_figure_video_fallback(tmp_path: Path) -> None:
+    """Without an OpenGL context the video is gaitopt's stick figure of the trajectory: one
+    frame per state."""
+    from PIL import Image
+
+    from gaitopt.viz.mujoco_video import write_stick_gif
+
+    gait = Gait.load(SEVEN)
+    q = gait.samples.q[::10]
+    path = tmp_path / "stick.gif"
+    assert write_stick_gif(gait.model, q, path, fps=25) == len(q)
+    with Image.open(path) as im:
+        assert im.n_frames == len(q)

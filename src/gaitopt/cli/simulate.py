@@ -140,8 +140,16 @@ def _video(console: object, result: object, path: Path) -> None:
     try:
         frames = write_gif(mujoco, robot.mj, result.qpos[::every], path,  # type: ignore[attr-defined]
                            base_body=base, fps=VIDEO_FPS)
+        how = "MuJoCo's offscreen renderer"
     except Exception as exc:  # no offscreen OpenGL: MuJoCo raises several types
-        console.print(f"video not written: MuJoCo's offscreen renderer failed "  # type: ignore[attr-defined]
-                      f"(MUJOCO_GL={os.environ.get('MUJOCO_GL')}): {exc}")
-        return
-    console.print(f"video: {path} ({frames} frames at {VIDEO_FPS} fps, real time)")  # type: ignore[attr-defined]
+        from gaitopt.viz.mujoco_video import write_stick_gif
+
+        console.print(f"MuJoCo's offscreen renderer failed (MUJOCO_GL="  # type: ignore[attr-defined]
+                      f"{os.environ.get('MUJOCO_GL')}: {' '.join(str(exc).split())}); drawing "
+                      "the simulated trajectory as gaitopt's stick figure instead",
+                      soft_wrap=True)
+        frames = write_stick_gif(robot.model, result.q[::every], path,  # type: ignore[attr-defined]
+                                 fps=VIDEO_FPS)
+        how = "gaitopt's stick figure"
+    console.print(f"video: {path} ({frames} frames at {VIDEO_FPS} fps, real time; "  # type: ignore[attr-defined]
+                  f"{how})")
