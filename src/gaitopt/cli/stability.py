@@ -34,12 +34,21 @@ def resolve_gains(text: str, gait: Gait, console: Console) -> tuple[tuple[float,
     """``--pd KP,KD`` or ``--pd auto`` for ``gait``: the gains and the spectral radius of the
     return map with them (``auto``: the search of :mod:`gaitopt.analysis.pd_search`, a line
     per evaluation). Shared by ``gaitopt stability`` and ``gaitopt simulate``."""
-    from gaitopt.analysis.pd_search import search_gains, spectral_radius
+    from gaitopt.analysis.pd_search import (
+        KD_BOX,
+        KD_GRID,
+        KP_BOX,
+        KP_GRID,
+        search_gains,
+        spectral_radius,
+    )
 
     if text.strip().lower() == "auto":
-        console.print("--pd auto: searching the PD gains that minimise the spectral radius of "
-                      "the return map (4 x 4 log grid, kp 300..10000, kd 15..500, then a local "
-                      "refinement in kp 100..10000, kd 10..500)", soft_wrap=True)
+        console.print(f"--pd auto: searching the PD gains that minimise the spectral radius of "
+                      f"the return map ({len(KP_GRID)} x {len(KD_GRID)} log grid, kp "
+                      f"{min(KP_GRID):g}..{max(KP_GRID):g}, kd {min(KD_GRID):g}..{max(KD_GRID):g}"
+                      f", then a local refinement in kp {KP_BOX[0]:g}..{KP_BOX[1]:g}, kd "
+                      f"{KD_BOX[0]:g}..{KD_BOX[1]:g}; a line per evaluation)", soft_wrap=True)
         try:
             found = search_gains(gait, progress=lambda line: console.print(line))
         except StabilityError as exc:
