@@ -224,28 +224,36 @@ def _compiled(spec: StepSpec, function: ca.Function) -> ca.Function:
 
 
 def _rhs(spec: StepSpec, contacts: tuple[str, ...], jacobian: bool = True) -> ca.Function:
-    """``rhs(y, u_ff, q_ref, qd_ref) -> ydot (2nq)`` and, with ``jacobian``, also
-    ``A = d ydot / d y (2nq, 2nq)``; compiled."""
+    """``rhs(y, u_ff, q_ref, qd_ref, gains) -> ydot (2nq)`` and, with ``jacobian``, also
+    ``A = d ydot / d y (2nq, 2nq)``; compiled. ``gains`` (2,) = ``(kp, kd)`` is an input (one
+    compiled function serves every pair of gains, as a search over gains needs); it is
+    ignored without PD (``spec.pd`` None)."""
     model, nq = spec.model, spec.nq
-    gains = "open" if spec.pd is None else f"pd_{spec.pd[0]:.17g}_{spec.pd[1]:.17g}"
-    tag = "_".join([*contacts, gains, "A" if jacobian else "f"])
+    tag = "_".join([*contacts, "open" if spec.pd is None else "pd", "A" if jacobian else "f"])
 
     def build() -> ca.Function:
         y, uff = ca.SX.sym("y", 2 * nq), ca.SX.sym("u", model.nu)
         q_ref, qd_ref = ca.SX.sym("q_ref", nq), ca.SX.sym("qd_ref", nq)
+        gains = ca.SX.sym("gains", 2)
         q, qd = y[:nq], y[nq:]
         u = uff
         if spec.pd is not None and model.nu:
-            kp, kd = spec.pd
+            kp, kd = gains[0], gains[1]
             bt = ca.DM(np.array(actuation_rows(model, contacts), dtype=float).T)
             u = uff + kp * ca.mtimes(bt, q_ref - q) + kd * ca.mtimes(bt, qd_ref - qd)
         qdd = contact_dynamics_function(model, contacts, inputs="u")(q, qd, u)[0]
         ydot = ca.vertcat(qd, qdd)
         outputs = [ydot, ca.jacobian(ydot, y)] if jacobian else [ydot]
         name = re.sub(r"_+", "_", re.sub(r"\W", "_", f"rhs_{tag}"))
-        return _compiled(spec, ca.Function(name, [y, uff, q_ref, qd_ref], outputs))
+        return _compiled(spec, ca.Function(name, [y, uff, q_ref, qd_ref, gains], outputs))
 
     return spec.function("rhs:" + tag, build)
+
+
+def _gains(spec: StepSpec) -> Array:
+    """The PD gains ``(kp, kd)`` (2,) as the compiled right-hand side takes them (0 without
+    PD)."""
+    return np.zeros(2) if spec.pd is None else np.array(spec.pd, dtype=float)
 
 
 def _tip(spec: StepSpec, contact: str) -> ca.Function:
@@ -307,7 +315,7 @@ def phase_rhs(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> tupl
     u, q_ref, qd_ref = phase.inputs(tau)
     zero = np.zeros(spec.nq)
     ydot, a = _eval(_rhs(spec, phase.contacts), y, u, zero if q_ref is None else q_ref,
-                    zero if qd_ref is None else qd_ref)
+                    zero if qd_ref is None else qd_ref, _gains(spec))
     return ydot.ravel(), a
 
 
@@ -317,7 +325,8 @@ def phase_field(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> Ar
     zero = np.zeros(spec.nq)
     f = _rhs(spec, phase.contacts, jacobian=False)
     return np.asarray(f(y, u, zero if q_ref is None else q_ref,
-                        zero if qd_ref is None else qd_ref), dtype=float).ravel()
+                        zero if qd_ref is None else qd_ref, _gains(spec)),
+                      dtype=float).ravel()
 
 
 def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational: bool,

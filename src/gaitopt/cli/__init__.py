@@ -6,6 +6,7 @@ one command family and registers its subcommands on the group when imported, whi
 when one of its commands is looked up (:data:`COMMANDS`):
 :mod:`~gaitopt.cli.model` (``model show|export|import``), :mod:`~gaitopt.cli.gait`
 (``solve``, ``verify``), :mod:`~gaitopt.cli.stability` (``stability``),
+:mod:`~gaitopt.cli.simulate` (``simulate``),
 :mod:`~gaitopt.cli.study` (``sweep``, ``study``) and :mod:`~gaitopt.cli.report`
 (``report``, ``animate``).
 """
@@ -24,6 +25,7 @@ COMMANDS: dict[str, str] = {
     "solve": "gaitopt.cli.gait",
     "verify": "gaitopt.cli.gait",
     "stability": "gaitopt.cli.stability",
+    "simulate": "gaitopt.cli.simulate",
     "sweep": "gaitopt.cli.study",
     "study": "gaitopt.cli.study",
     "report": "gaitopt.cli.report",

@@ -8,8 +8,10 @@ from pathlib import Path
 
 import click
 import numpy as np
+from rich.console import Console
 from rich.table import Table
 
+from gaitopt.analysis.stability import StabilityError
 from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
@@ -28,11 +30,50 @@ def _gains(text: str | None) -> tuple[float, float] | None:
     return kp, kd
 
 
+def resolve_gains(text: str, gait: Gait, console: Console) -> tuple[tuple[float, float], float]:
+    """``--pd KP,KD`` or ``--pd auto`` for ``gait``: the gains and the spectral radius of the
+    return map with them (``auto``: the search of :mod:`gaitopt.analysis.pd_search`, a line
+    per evaluation). Shared by ``gaitopt stability`` and ``gaitopt simulate``."""
+    from gaitopt.analysis.pd_search import (
+        KD_BOX,
+        KD_GRID,
+        KP_BOX,
+        KP_GRID,
+        search_gains,
+        spectral_radius,
+    )
+
+    if text.strip().lower() == "auto":
+        console.print(f"--pd auto: searching the PD gains that minimise the spectral radius of "
+                      f"the return map ({len(KP_GRID)} x {len(KD_GRID)} log grid, kp "
+                      f"{min(KP_GRID):g}..{max(KP_GRID):g}, kd {min(KD_GRID):g}..{max(KD_GRID):g}"
+                      f", then a local refinement in kp {KP_BOX[0]:g}..{KP_BOX[1]:g}, kd "
+                      f"{KD_BOX[0]:g}..{KD_BOX[1]:g}; a line per evaluation)", soft_wrap=True)
+        try:
+            found = search_gains(gait, progress=lambda line: console.print(line))
+        except StabilityError as exc:
+            raise UserError(str(exc)) from None
+        console.print(f"--pd auto: PD {found.pd[0]:.4g},{found.pd[1]:.4g}, spectral radius "
+                      f"{found.spectral_radius:.4g} ({'stable' if found.stable else 'UNSTABLE'}; "
+                      f"{len(found.evaluations)} evaluations)", soft_wrap=True)
+        return found.pd, found.spectral_radius
+    gains = _gains(text)
+    assert gains is not None
+    try:
+        rho = spectral_radius(gait, gains)
+    except StabilityError as exc:
+        raise UserError(str(exc)) from None
+    console.print(f"return map with PD {gains[0]:.4g},{gains[1]:.4g}: spectral radius {rho:.4g}",
+                  soft_wrap=True)
+    return gains, rho
+
+
 @cli.command("stability")
 @click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("--pd", "pd", default=None,
               help="Joint-space PD tracking of the gait's knots, 'KP,KD' (N m/rad, N m s/rad; "
-                   "torques unbounded). Default: the gait's torques open loop.")
+                   "torques unbounded), or 'auto': the gains that minimise the spectral radius "
+                   "(a search). Default: the gait's torques open loop.")
 @click.option("--newton", is_flag=True,
               help="Analyse at the fixed point of the simulated map found by Newton's method "
                    "(default: at the gait's own start state).")
@@ -49,16 +90,23 @@ def stability_command(file: Path, pd: str | None, newton: bool, about: str, no_c
                       json_out: Path | None) -> None:
     """Floquet multipliers of a gait's step-to-step return map, and the verdict."""
     from gaitopt.analysis.return_map import StepSimulationError
-    from gaitopt.analysis.stability import StabilityError, analyse_step, gait_start, step_from_gait
+    from gaitopt.analysis.stability import analyse_step, gait_start, step_from_gait
 
-    gains = _gains(pd)
+    console = make_console()
     try:
         gait = Gait.load(file)
+        if pd is not None and pd.strip().lower() == "auto":
+            if not gait.success:
+                raise StabilityError(f"the gait's solve did not converge (status "
+                                     f"{gait.status!r}): its trajectories are not a gait")
+            gains: tuple[float, float] | None = resolve_gains(pd, gait, console)[0]
+            pd = f"{gains[0]:.4g},{gains[1]:.4g}"  # type: ignore[index]
+        else:
+            gains = _gains(pd)
         spec = step_from_gait(gait, pd=gains)
     except (GaitFileError, StabilityError) as exc:
         raise UserError(f"{file}: {exc}" if isinstance(exc, StabilityError) else str(exc)) \
             from None
-    console = make_console()
     try:
         report = analyse_step(spec, gait_start(gait), fixed_point="newton" if newton else "start",
                               check=not no_check, about=about)  # type: ignore[arg-type]
