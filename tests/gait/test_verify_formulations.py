@@ -50,6 +50,7 @@ def full_coordinate_copy(gait: Gait) -> dict[str, Any]:
         raw["x"] = np.hstack([ph.q, ph.qd]).tolist()
         raw["xdot"] = np.hstack([ph.qd, ph.qdd]).tolist()
         del raw["error_estimate"]  # the reduced grid's estimate; not one of these states
+        raw.pop("costates", None)  # the reduced states' costates, likewise
         full = GaitPhase(**{k: v for k, v in raw.items() if k != "error_estimate"})
         mask = (s.t <= ph.t[-1]) & ~taken
         taken |= mask

@@ -291,7 +291,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
     try:
         solution = solve_gait_solution(model, options, progress=progress, warm_start=start,
                                        compiled="codegen" if compiled else None,
-                                       refine=refine)
+                                       refine=refine, speed_given=speed is not None)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:
@@ -308,6 +308,11 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
         console.print(f"FAILED after the last stage, which converged: {exc}. No gait file "
                       "written.")
         sys.exit(1)
+    if solution.options.speed != options.speed and options.speed is not None:
+        console.print(f"note: the solve at the model's default speed "
+                      f"{format_speed(options.speed)} failed (its stages above); the gait "
+                      f"walks at the slower default of the walk, "
+                      f"{format_speed(solution.options.speed or 0.0)}; --speed chooses one")
     console.print(summary_table(gait, sequence_used))
     gait.save(output)
     console.print(f"wrote {output}")

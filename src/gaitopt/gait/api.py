@@ -27,7 +27,7 @@ import numpy as np
 
 from gaitopt.gait.accuracy import accuracy_record
 from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.model_defaults import options_for_model
+from gaitopt.gait.model_defaults import default_speed, options_for_model
 from gaitopt.gait.options import GaitOptions, follows_model
 from gaitopt.gait.preflight import refuse_unwalkable
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
@@ -74,11 +74,16 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
                         options: GaitOptions | None = None, *,
                         warm_start: Gait | None = None, progress: ProgressFn | None = None,
                         compiled: str | None = None,
-                        refine: bool | None = None) -> WalkingSolution:
+                        refine: bool | None = None,
+                        speed_given: bool | None = None) -> WalkingSolution:
     """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`.
 
     ``refine``: whether the solve refines its grid to ``options.accuracy``
     (:mod:`gaitopt.gait.refinement`); None: where the knots are left to the model's default.
+    ``speed_given``: whether the caller chose the speed; None: unless it is left to the
+    model. A cold solve at the model's default speed that fails is tried once more at the
+    slower default speed of the walk (:func:`slower_default`), the stages of both attempts
+    in the solution.
 
     Raises:
         UnwalkableModelError: something in the model prevents walking
@@ -92,6 +97,15 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     if warm_start is not None and warm_start_usable(warm_start, opts):
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
     first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+    if speed_given is None:
+        speed_given = not follows_model(given.speed)
+    slower = slower_default(robot, opts)
+    if not first.success and guess is None and not speed_given and slower is not None:
+        retry = solve_walking(robot, opts.replace(speed=slower), progress=progress,
+                              compiled=compiled)
+        if retry.success:
+            first = dataclasses.replace(retry, stages=first.stages + retry.stages,
+                                        wall_time_s=first.wall_time_s + retry.wall_time_s)
 
     def solve_on(finer: GaitOptions, before: WalkingSolution) -> WalkingSolution:
         start = guess_from_gait(gait_from_solution(before))
@@ -106,6 +120,18 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     solution, _ = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
                                      accuracy_of=accuracy_record)
     return solution
+
+
+def slower_default(model: RobotModel, options: GaitOptions) -> float | None:
+    """The speed (m/s) a failed solve at the model's default speed tries next: the walk's
+    default at equal Froude number (:func:`gaitopt.gait.model_defaults.default_speed`: 12
+    m/min on 1 m legs), if it is under 90 % of ``options.speed``; else None. A model whose
+    hips only swing backward, like MuJoCo's Walker2d, walks slowly with its torso leaning
+    back and fails at the heel-toe walk's faster default."""
+    if options.speed is None:
+        return None
+    slower = default_speed(model, "walk")
+    return slower if slower < 0.9 * options.speed else None
 
 
 def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
