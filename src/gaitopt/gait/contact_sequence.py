@@ -10,7 +10,7 @@ contact points held on the ground; event ``i`` ends phase ``i``:
 
 An event may do both at once (the single-support gait: the front tip strikes and the rear tip
 leaves at that instant). After the last event the legs swap roles (the mapping of the model's
-:func:`~gaitopt.robot.symmetry.swap_permutations`) and the gait moves on by one step length,
+:func:`~gaitopt.robot.symmetry.swap_matrices`) and the gait moves on by one step length,
 and the next step starts again with phase 0.
 
 A held point stands still at its *anchor* on the ground: ``x = anchor * L + offset`` (``L``

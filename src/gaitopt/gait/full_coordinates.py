@@ -476,22 +476,23 @@ def _step_share(share: Callable[[Any], Any]) -> Callable[[Any], Any]:
 
 def _periodic_controls(model: RobotModel, symmetry: LegSwap, seq: ContactSequence,
                        actuators_of: Mapping[str, Sequence[str]]) -> ControlLinkage:
-    """``u_first(0)[a] = u_last(T)[swap(a)]`` for every actuator ``a`` of the first phase
-    whose swapped counterpart acts at the end of the last phase."""
+    """``u_first(0)[a] = (S_u u_last(T))[a] = sign_a u_last(T)[swap(a)]`` for every
+    actuator ``a`` of the first phase whose swapped counterpart acts at the end of the last
+    phase (``S_u`` a signed permutation: :meth:`LegSwap.actuator_source`)."""
     first, last = seq.phases[0].name, seq.phases[-1].name
     last_acts = list(actuators_of[last])
     names = [a.name for a in model.actuators]
     targets, sources = [], []
     for a in actuators_of[first]:
-        other = names[symmetry.perm_u[model.actuator_index(a)]]
-        if other in last_acts:
+        j, sign = symmetry.actuator_source(model.actuator_index(a))
+        if names[j] in last_acts:
             targets.append(a)
-            sources.append(last_acts.index(other))
+            sources.append((last_acts.index(names[j]), sign))
     n_last = len(last_acts) + 2 * len(hold_axes(seq.phases[-1].held))
 
     def fn(u_from: Any, p: Any) -> Any:
         us = as_scalars(u_from, n_last, "u")
-        return vector([us[k] for k in sources])
+        return vector([us[k] if sign > 0 else -us[k] for k, sign in sources])
 
     return ControlLinkage(last, first, fn=fn, controls=targets,
                           name="controls periodic (legs swapped)")

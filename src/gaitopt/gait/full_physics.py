@@ -20,7 +20,7 @@ from gaitopt.dynamics.impact import impact, liftoff_impulse
 from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.tree import HOLD_AXES, hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec
-from gaitopt.robot.model import RobotModel
+from gaitopt.robot.model import BASE_X, RobotModel
 from gaitopt.robot.symmetry import LegSwap, leg_swap
 
 
@@ -155,8 +155,10 @@ def event_impulses(model: RobotModel, seq: ContactSequence, i: int, x: Any, impu
 
 def swap_state(model: RobotModel, symmetry: LegSwap, q: Any, qd: Any, step: Any
                ) -> tuple[list[Any], list[Any]]:
-    """The next step's ``(q, qd)``: legs swapped, moved back by one step length."""
+    """The next step's ``(q, qd)``: ``S_q q`` and ``S_q qd`` (the legs swapped,
+    :func:`~gaitopt.robot.symmetry.swap_matrices`), ``x`` moved back by one step length
+    ``step`` (m)."""
     qs, qds = as_scalars(q, model.nq, "q"), as_scalars(qd, model.nq, "qd")
-    q_next = [qs[j] for j in symmetry.perm_q]
-    q_next[0] = q_next[0] - step
-    return q_next, [qds[j] for j in symmetry.perm_q]
+    q_next = symmetry.swap_q(qs)
+    q_next[BASE_X] = q_next[BASE_X] - step
+    return q_next, symmetry.swap_q(qds)

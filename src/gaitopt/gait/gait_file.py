@@ -182,9 +182,9 @@ class Gait:
         if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
             raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
         s = self.samples
-        from gaitopt.robot.symmetry import swap_names, swap_permutations
+        from gaitopt.robot.symmetry import swap_matrices, swap_names
 
-        q_swap, u_swap = swap_permutations(self.model)
+        s_q, s_u = swap_matrices(self.model)  # q' = S_q q, u' = S_u u
         names = swap_names(self.model)
         period, shift = self.step_time, self.step_length
         x_index = self.model.coordinate_names.index("x")
@@ -194,12 +194,12 @@ class Gait:
         for k in range(n_steps):
             sl = slice(1 if (k > 0 and duplicate) else 0, None)
             swap = k % 2 == 1
-            q = (s.q[:, q_swap] if swap else s.q.copy())[sl]
+            q = (s.q @ s_q.T if swap else s.q.copy())[sl]
             q[:, x_index] += k * shift
             parts["t"].append(s.t[sl] + k * period)
             parts["q"].append(q)
-            parts["qd"].append((s.qd[:, q_swap] if swap else s.qd)[sl])
-            parts["u"].append((s.u[:, u_swap] if swap else s.u)[sl])
+            parts["qd"].append((s.qd @ s_q.T if swap else s.qd)[sl])
+            parts["u"].append((s.u @ s_u.T if swap else s.u)[sl])
             for name in s.points:
                 source = names.get(name, name) if swap else name
                 if source not in s.points:

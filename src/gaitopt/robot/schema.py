@@ -108,10 +108,10 @@ class _Validator(FieldReader):
         model = RobotModel(name=name, links=links, contacts=contacts, actuators=actuators,
                            gravity=gravity, description=description, symmetry=symmetry)
         if symmetry is not None:
-            from gaitopt.robot.symmetry import SymmetryError, swap_permutations
+            from gaitopt.robot.symmetry import SymmetryError, swap_matrices
 
             try:
-                swap_permutations(model)
+                swap_matrices(model)
             except SymmetryError as exc:
                 raise self.fail("symmetry", top["symmetry"],
                                 "pairs that map the model onto itself", problem=str(exc)
