@@ -155,6 +155,10 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
                              "its trajectories are not a gait; solve it again")
     if pd is not None and (len(pd) != 2 or not all(np.isfinite(pd)) or min(pd) < 0):
         raise StabilityError(f"pd: got {pd!r}; allowed: two finite gains kp, kd >= 0")
+    if gait.period_steps != 1:
+        raise StabilityError(f"contact_sequence.steps = {gait.period_steps}: the return map of "
+                             "a stride (two steps, no leg swap) is not implemented; only of "
+                             "one step periodic through the leg swap")
     if gait.contact_sequence is not None:
         return _step_from_sequence(gait, pd, rtol)
     phases = gait.phases

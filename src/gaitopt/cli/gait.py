@@ -115,6 +115,10 @@ def _step_time(text: str) -> float | None:
 @click.option("--free-fractions", is_flag=True,
               help="Every phase's share of the step free, within half to twice its given "
                    "share (at most 0.95), starting from it (needs --formulation full).")
+@click.option("--stride", is_flag=True,
+              help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "
+                   "lengths, no leg swap assumed (for unequal legs); cost per metre of the "
+                   "stride; full formulation (the default with it).")
 @knots_option
 @knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events; "
                      "docs/walking.md section 6) or uniform.")
@@ -186,7 +190,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
-                  free_fractions: bool,
+                  free_fractions: bool, stride: bool,
                   gait_kind: str, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
                   control_model: str | None, mesh_tol: float | None,
@@ -208,7 +212,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
             raise UserError(f"--warm-start: {exc}") from None
     sequence = None if sequence_file is None else read_sequence(sequence_file)
     if formulation is None:
-        formulation = default_formulation(model, gait_kind, sequence is not None)
+        formulation = default_formulation(model, gait_kind, sequence is not None, stride)
     options = GaitOptions(
         contact_sequence=sequence,
         speed=_speed(speed), step_length=_step(step_length), step_time=_step_time(step_time),
@@ -225,7 +229,7 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
         cost_regularization=regularization,
         mesh_tol=mesh_tol, swing_clearance=clearance,
         clearance_profile=clearance_profile,  # type: ignore[arg-type]
-        free_phase_fractions=free_fractions)
+        free_phase_fractions=free_fractions, stride=stride)
     if resting_power is not None:
         options = options.replace(resting_power=resting_power)
     if single_support_bounds is not None:

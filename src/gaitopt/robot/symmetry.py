@@ -327,3 +327,28 @@ def leg_swap(model: RobotModel) -> LegSwap:
     _, contacts = swap_maps(model)
     return LegSwap(tuple(tuple(float(c) for c in row) for row in s_q),
                    tuple(tuple(float(c) for c in row) for row in s_u), contacts)
+
+
+def contact_pairing(model: RobotModel) -> dict[str, str]:
+    """Every contact -> its counterpart on the other leg (itself unless paired): the
+    contact pairs of the symmetry (declared, or inferred from the chains), or, for legs no
+    symmetry pairs (unequal chains), the first two contact points (one per leg, as the
+    built-in sequences take them). Needs no swap of the coordinates: a stride
+    (:func:`gaitopt.gait.contact_sequence.stride_sequence`) only renames its points."""
+    names = {c.name: c.name for c in model.contacts}
+    try:
+        return names | _mapping(model_symmetry(model).contacts)
+    except SymmetryError:
+        if len(model.contacts) < 2:
+            raise
+        c1, c2 = model.contacts[0].name, model.contacts[1].name
+        return names | {c1: c2, c2: c1}
+
+
+def identity_swap(model: RobotModel) -> LegSwap:
+    """The map of a period that exchanges nothing (a stride's): identities of ``q``, ``u``
+    and the contact names."""
+    eye_q, eye_u = np.eye(model.nq), np.eye(model.nu)
+    return LegSwap(tuple(tuple(float(c) for c in row) for row in eye_q),
+                   tuple(tuple(float(c) for c in row) for row in eye_u),
+                   {c.name: c.name for c in model.contacts})
