@@ -245,9 +245,9 @@ def periodicity_errors(gait: Gait, *, controls: tuple[str, ...]) -> tuple[float,
 
 
 def recomputed_cost(gait: Gait) -> float:
-    """(integral of u'u over the step + P^2) / L from the saved knots, independent of the
-    solver: Simpson's rule per interval on the piecewise-linear controls (exact for their
-    square, a quadratic)."""
+    """(integral of u'u over the step + P^2) / L (a stride: over both steps, + 2 P^2, / 2 L)
+    from the saved knots, independent of the solver: Simpson's rule per interval on the
+    piecewise-linear controls (exact for their square, a quadratic)."""
     total = 0.0
     for ph in gait.phases:
         for k in range(ph.t.size - 1):
@@ -256,7 +256,8 @@ def recomputed_cost(gait: Gait) -> float:
             mid = 0.5 * (a + b)
             total += h / 6.0 * float(a @ a + 4.0 * mid @ mid + b @ b)
     p = gait.parameters["liftoff_impulse"]
-    return (total + p * p) / gait.step_length
+    steps = gait.period_steps  # a stride: two steps, two liftoffs, 2 L
+    return (total + steps * p * p) / (steps * gait.step_length)
 
 
 def contact_forces(ref: Reference, q: Array, qd: Array, u: Array,
