@@ -22,6 +22,7 @@ from gaitopt.dynamics import (
 from gaitopt.robot import RobotModel, load_model, model_from_dict
 from gaitopt.robot.symmetry import (
     SymmetryError,
+    contact_pairing,
     leg_swap,
     model_symmetry,
     swap_matrices,
@@ -132,6 +133,22 @@ def test_what_has_no_swap_is_refused_by_name() -> None:
     with pytest.raises(SymmetryError, match=r"pairs 'thigh_1' with 'thigh_2'.*joint at its "
                                             "origin"):
         swap_matrices(model_from_dict(data))
+    # Leg 2 one link longer (a pylon below shank 2) on a torso: the chains look like a leg
+    # welded into the base, but the torso points up and thigh 2 down: no swap (a stride
+    # needs none: the contacts still pair).
+    data = copy.deepcopy(load_model("five-link").to_dict())
+    data["links"].append({"name": "pylon_2", "parent": "shank_2", "direction": "down",
+                          "length": 0.05, "mass": 0.3, "inertia": 1e-4,
+                          "joint": {"name": "pylon_joint_2", "at": [0.5, 0.0],
+                                    "limits": [-0.3, 0.3]}})
+    data["contacts"][1] = {"name": "tip_2", "link": "pylon_2", "at": [0.05, 0.0]}
+    data["actuators"].append({"name": "pylon_2", "joint": "pylon_joint_2",
+                              "limits": [-25.0, 25.0]})
+    long_leg = model_from_dict(data)
+    with pytest.raises(SymmetryError, match=r"pairs 'torso' with 'thigh_2', but they differ "
+                                            "in shape"):
+        swap_matrices(long_leg)
+    assert contact_pairing(long_leg)["tip_1"] == "tip_2"
     # An actuator without a counterpart: only knee 1 is actuated.
     data = _kcg()
     data["actuators"] = [a for a in data["actuators"] if a["name"] != "knee_2"]

@@ -180,7 +180,9 @@ def _check_pairs(model: RobotModel) -> None:
     """Raise :class:`SymmetryError` unless the pairs map the tree onto itself: paired links
     have paired parents (or the same one), or one is the other's parent with the joint at
     its origin (a welded leg, whose partner's hip is where the welded link's frame is);
-    paired contacts sit on paired links."""
+    paired links point the same way and sit at the same point of their paired parents;
+    paired contacts sit at the same point of paired links. (The kinematics, not the masses:
+    a heavier leg keeps its swap, which only a symmetric gait needs to be exact.)"""
     links, contacts = swap_maps(model)
     name = model.name
     for a, b in links.items():
@@ -194,10 +196,22 @@ def _check_pairs(model: RobotModel) -> None:
                 f"model {name!r}: symmetry pairs {a!r} with {b!r}, but their parents "
                 f"{la.parent!r} and {lb.parent!r} are not a pair (nor is one the other's "
                 "parent with the joint at its origin: a leg welded into it)")
+        if la.direction != lb.direction or (
+                same_parents and la.joint is not None and lb.joint is not None
+                and la.joint.at != lb.joint.at):
+            raise SymmetryError(
+                f"model {name!r}: symmetry pairs {a!r} with {b!r}, but they differ in shape: "
+                f"direction {la.direction!r} and {lb.direction!r}, joints at "
+                f"{None if la.joint is None else la.joint.at} and "
+                f"{None if lb.joint is None else lb.joint.at} on their parents")
     for a, b in contacts.items():
         if links[model.contact(a).link] != model.contact(b).link:
             raise SymmetryError(f"model {name!r}: symmetry pairs contacts {a!r} and {b!r}, "
                                 "but their links are not a pair")
+        if model.contact(a).at != model.contact(b).at:
+            raise SymmetryError(f"model {name!r}: symmetry pairs contacts {a!r} and {b!r}, "
+                                f"but they sit at {model.contact(a).at} and "
+                                f"{model.contact(b).at} on their links")
 
 
 def swap_matrices(model: RobotModel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
