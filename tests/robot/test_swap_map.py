@@ -19,7 +19,7 @@ from gaitopt.dynamics import (
     generalized_forces,
     potential_energy,
 )
-from gaitopt.robot import RobotModel, load_model, model_from_dict
+from gaitopt.robot import ModelError, RobotModel, load_model, model_from_dict
 from gaitopt.robot.symmetry import (
     SymmetryError,
     contact_pairing,
@@ -154,3 +154,17 @@ def test_what_has_no_swap_is_refused_by_name() -> None:
     data["actuators"] = [a for a in data["actuators"] if a["name"] != "knee_2"]
     with pytest.raises(SymmetryError, match="actuator 'knee_1' has no unique counterpart"):
         swap_matrices(model_from_dict(data))
+
+
+def test_a_declared_welded_symmetry_names_the_base_and_gives_the_same_maps() -> None:
+    data = _kcg()
+    data["symmetry"] = {"links": [["thigh_1", "thigh_2"], ["shank_1", "shank_2"]],
+                        "contacts": [["tip_1", "tip_2"]]}
+    model = model_from_dict(data)
+    assert model_symmetry(model).source == "declared"
+    for mine, inferred in zip(swap_matrices(model), swap_matrices(load_model(str(KCG))),
+                              strict=True):
+        np.testing.assert_array_equal(mine, inferred)
+    data["symmetry"]["links"] = [["thigh_1", "shank_2"], ["shank_1", "thigh_2"]]
+    with pytest.raises(ModelError, match="symmetry"):
+        model_from_dict(data)

@@ -125,7 +125,7 @@ class _Validator(FieldReader):
                            "the left/right symmetry (pairs of links and of contacts)")
         seen: set[str] = set()
         out: dict[str, tuple[tuple[str, str], ...]] = {}
-        for key, known in (("links", [link.name for link in links[1:]]),
+        for key, known in (("links", [link.name for link in links]),
                            ("contacts", [c.name for c in contacts])):
             pairs = []
             for i, item in enumerate(self.optional_list(f"symmetry.{key}", top.get(key), key)):
