@@ -18,6 +18,7 @@ from gaitopt.cli import cli
 from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
 from gaitopt.gait.contact_sequence import (
     check_sequence,
+    phase_knots,
     sequence_from_dict,
     stride_sequence,
 )
@@ -76,6 +77,18 @@ def test_the_stride_sequence_is_the_step_twice_with_the_legs_renamed() -> None:
     assert "steps" not in walking_sequence(model, 0.85, impulse=True).to_dict()
 
 
+def test_each_step_of_a_stride_gets_the_knots_of_one_step() -> None:
+    model = load_model("five-link")
+    for f in (0.85, 1.0):
+        step = walking_sequence(model, f, impulse=f < 1.0)
+        assert phase_knots(stride_sequence(step, TIPS), (16, 6)) == 2 * phase_knots(
+            step, (16, 6))
+    heel_toe = heel_toe_sequence(load_model("seven-link"), contact_pairing(
+        load_model("seven-link")), 0.8, impulse=True)
+    stride = stride_sequence(heel_toe, contact_pairing(load_model("seven-link")))
+    assert phase_knots(stride, (24, 16)) == 2 * phase_knots(heel_toe, (24, 16))
+
+
 def test_a_heel_toe_stride_renames_the_feet_and_keeps_their_offsets() -> None:
     model = load_model("seven-link")
     pairing = contact_pairing(model)
@@ -127,6 +140,18 @@ def test_the_stride_of_the_five_link_is_two_mirrored_optimal_steps(solved: Solve
     assert samples.t[-1] == pytest.approx(4 * stride.step_time)
     with pytest.raises(StabilityError, match="stride"):
         step_from_gait(stride)
+
+
+def test_the_single_support_stride_is_the_one_step_optimum(solved: SolveFn) -> None:
+    """The single-support walk (one phase per step, 16 knots each): the same cost within
+    10 x the solver's tolerance, the steps mirrored."""
+    options = FULL.replace(single_support_fraction=1.0)
+    step = solved(options).gait
+    stride = solved(options.replace(stride=True)).gait
+    assert step.success and stride.success
+    assert stride.cost_value == pytest.approx(step.cost_value, rel=10 * FULL.tol)
+    state, control = _mirror_errors(stride)
+    assert state < 1e-5 and control < 1e-4
 
 
 def test_a_heavier_shank_walks_with_two_different_steps(solved: SolveFn) -> None:
