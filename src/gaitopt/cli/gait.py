@@ -250,16 +250,19 @@ def solve_command(model_name: str, speed: str, step_length: str, step_time: str,
                   + f", {options.knots[0]}+{options.knots[1]} knots, control model "
                   f"{options.control_model}"
                   + (" (the paper's grid)" if options.paper_grid else "")
-                  + f", {options.formulation} coordinates")
+                  + f", {options.formulation} coordinates"
+                  + (", a stride (two steps, no leg swap)" if options.stride else ""))
 
     if (start is None and not options.multistart
             and multistart_default(options.speed, options.formulation)):
         console.print("note: far from 12 m/min a cold solve can end in a worse local optimum; "
                       "--multistart (the default here) also tries the continuation in speed "
                       "and keeps the best")
-    if (sequence_used is not None and len(sequence_used.phases) > 2
+    per_step = (0 if sequence_used is None
+                else len(sequence_used.phases) // sequence_used.steps)
+    if (per_step > 2
             and tuple(options.knots) < FOUR_PHASE_KNOTS):
-        console.print(f"note: a {len(sequence_used.phases)}-phase step on {options.knots[0]}+"
+        console.print(f"note: a {per_step}-phase step on {options.knots[0]}+"
                       f"{options.knots[1]} knots is coarse; the heel-toe walk passes verify on "
                       f"{FOUR_PHASE_KNOTS[0]},{FOUR_PHASE_KNOTS[1]} or finer (--knots; "
                       "docs/feet.md)")
