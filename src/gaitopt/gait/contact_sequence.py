@@ -197,16 +197,20 @@ def phase_knots(seq: ContactSequence, knots: Sequence[int]) -> tuple[int, ...]:
     0 ``first`` knots and every other phase at least ``others``, more when the density of
     phase 0 (intervals per share of the step) asks for more, so that long phases are not
     coarser than phase 0. A stride's steps get the knots of one step each (its second step
-    those of the first: like with like against the one-step problem)."""
+    those of the first: like with like against the one-step problem), when its phases split
+    into two steps of as many phases (a stride written by hand may not: then the rule above
+    on all its phases)."""
     first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
-    step = seq.phases[:len(seq.phases) // seq.steps]
+    n = len(seq.phases)
+    repeats = seq.steps if n % seq.steps == 0 else 1
+    step = seq.phases[:n // repeats]
     if len(step) <= 2:
         counts = tuple(first if i == 0 else others for i in range(len(step)))
     else:
         density = (first - 1) / step[0].fraction
         counts = (first,) + tuple(max(others, 1 + math.ceil(density * ph.fraction - 1e-9))
                                   for ph in step[1:])
-    return counts * seq.steps
+    return counts * repeats
 
 
 def swap_spec(spec: str, contact_swap: Mapping[str, str]) -> str:
