@@ -9,7 +9,7 @@ variant that differs from an earlier solve only in its speed or step length reus
 The checks here never use the solver's equations: the equations of motion, contact
 Jacobians, tip kinematics and actuation come from Pinocchio
 (``tests/dynamics/pinocchio_model.py`` builds the same tree from the model data), and
-periodicity uses the gait file's own leg-swap permutations.
+periodicity uses the model's leg-swap maps.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import gait_from_solution
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.robot import RobotModel, load_model
-from gaitopt.robot.symmetry import swap_permutations
+from gaitopt.robot.symmetry import swap_matrices
 from tests.dynamics.pinocchio_model import PinModel, build
 
 Array = NDArray[np.float64]
@@ -232,24 +232,24 @@ def periodicity_errors(gait: Gait, *, controls: tuple[str, ...]) -> tuple[float,
 
     ``controls``: the actuator names compared (those acting at the start of the step)."""
     model = gait.model
-    perm_q, perm_u = swap_permutations(model)
+    s_q, s_u = swap_matrices(model)
     first, last = gait.phases[0], gait.phases[-1]
     liftoff = next(e for e in gait.events if e.name == "liftoff")
-    q_next = last.q[-1][perm_q].copy()
+    q_next = s_q @ last.q[-1]
     q_next[0] -= gait.step_length
-    qd_next = liftoff.qd_after[perm_q]
+    qd_next = s_q @ liftoff.qd_after
     state = max(float(np.max(np.abs(q_next - first.q[0]))),
                 float(np.max(np.abs(qd_next - first.qd[0]))))
     cols = [model.actuator_index(a) for a in controls]
-    u_next = last.u[-1][perm_u]
+    u_next = s_u @ last.u[-1]
     control = float(np.max(np.abs(u_next[cols] - first.u[0][cols]), initial=0.0))
     return state, control
 
 
 def recomputed_cost(gait: Gait) -> float:
-    """(integral of u'u over the step + P^2) / L from the saved knots, independent of the
-    solver: Simpson's rule per interval on the piecewise-linear controls (exact for their
-    square, a quadratic)."""
+    """(integral of u'u over the step + P^2) / L (a stride: over both steps, + 2 P^2, / 2 L)
+    from the saved knots, independent of the solver: Simpson's rule per interval on the
+    piecewise-linear controls (exact for their square, a quadratic)."""
     total = 0.0
     for ph in gait.phases:
         for k in range(ph.t.size - 1):
@@ -258,7 +258,8 @@ def recomputed_cost(gait: Gait) -> float:
             mid = 0.5 * (a + b)
             total += h / 6.0 * float(a @ a + 4.0 * mid @ mid + b @ b)
     p = gait.parameters["liftoff_impulse"]
-    return (total + p * p) / gait.step_length
+    steps = gait.period_steps  # a stride: two steps, two liftoffs, 2 L
+    return (total + steps * p * p) / (steps * gait.step_length)
 
 
 def contact_forces(ref: Reference, q: Array, qd: Array, u: Array,

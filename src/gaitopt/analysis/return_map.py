@@ -21,9 +21,9 @@ is at the origin with zero velocity. From a state ``y = [q; qd]`` (2 nq,) on it,
    contacts held in double support (or the striking tip alone when the gait has none);
 3. **double support** for a fixed duration (time-triggered);
 4. the **liftoff impulse** of the gait's magnitude (:func:`gaitopt.dynamics.liftoff_impulse`);
-5. the **leg swap** (:func:`gaitopt.robot.symmetry.swap_permutations`) and the shift of the
-   base position by the new stance tip's position, so that it is at the origin:
-   ``q+ = P q - E c(P q)``, ``qd+ = P qd`` (``E`` puts the 2-vector on ``x, y``).
+5. the **leg swap** (the linear map ``S`` of :func:`gaitopt.robot.symmetry.swap_matrices`)
+   and the shift of the base position by the new stance tip's position, so that it is at
+   the origin: ``q+ = S q - E c(S q)``, ``qd+ = S qd`` (``E`` puts the 2-vector on ``x, y``).
 
 That is the paper's walk; in general (:class:`StepSpec`) the phases run in order, those
 that end when a point strikes the ground are state-triggered (each with its own guard: the
@@ -75,7 +75,7 @@ from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.dynamics.tree import holds
 from gaitopt.ocp.hermite_simpson import HermiteSimpson
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import swap_permutations
+from gaitopt.robot.symmetry import swap_matrices
 
 Array = NDArray[np.float64]
 
@@ -291,14 +291,14 @@ def _swap_jump(spec: StepSpec) -> ca.Function:
     """``swap(y) -> (y+, d y+ / d y)``: legs exchanged, base shifted so that the new stance
     tip (the stance contact after relabelling) is at the origin."""
     nq = spec.nq
-    perm_q, _ = swap_permutations(spec.model)
+    s_q = ca.DM(swap_matrices(spec.model)[0])
 
     def build() -> ca.Function:
         y = ca.SX.sym("y", 2 * nq)
-        q = y[:nq][perm_q.tolist()]
+        q = ca.mtimes(s_q, y[:nq])
         tip = contact_position(spec.model, q, spec.stance)
         shift = ca.vertcat(tip, ca.SX.zeros(nq - 2))
-        out = ca.vertcat(q - shift, y[nq:][perm_q.tolist()])
+        out = ca.vertcat(q - shift, ca.mtimes(s_q, y[nq:]))
         return ca.Function("swap", [y], [out, ca.jacobian(out, y)])
 
     return spec.function("swap", build)

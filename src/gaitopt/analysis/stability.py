@@ -57,7 +57,7 @@ from gaitopt.dynamics.tree import holds
 from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
 from gaitopt.gait.gait_file import Gait
 from gaitopt.robot.model import BASE_POSITION
-from gaitopt.robot.symmetry import leg_swap, swap_permutations
+from gaitopt.robot.symmetry import leg_swap, swap_matrices
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -155,6 +155,10 @@ def step_from_gait(gait: Gait, *, pd: tuple[float, float] | None = None,
                              "its trajectories are not a gait; solve it again")
     if pd is not None and (len(pd) != 2 or not all(np.isfinite(pd)) or min(pd) < 0):
         raise StabilityError(f"pd: got {pd!r}; allowed: two finite gains kp, kd >= 0")
+    if gait.period_steps != 1:
+        raise StabilityError(f"contact_sequence.steps = {gait.period_steps}: the return map of "
+                             "a stride (two steps, no leg swap) is not implemented; only of "
+                             "one step periodic through the leg swap")
     if gait.contact_sequence is not None:
         return _step_from_sequence(gait, pd, rtol)
     phases = gait.phases
@@ -305,13 +309,13 @@ def free_rotations(spec: StepSpec, states: list[Array]) -> list[tuple[str, Array
         for c in range(len(model.links)):
             if model.parent_index(c) == k:
                 t[model.coordinate_of_link(c), 2 + k] = -1.0
-    perm_q, _ = swap_permutations(model)
+    s_q, _ = swap_matrices(model)
     b = np.array(actuation_rows(model, [c.name for c in model.contacts]), dtype=float)
     names = [c.name for c in model.contacts]
     out = []
     for k, link in enumerate(model.links):
         v = t[:, 2 + k]
-        if not np.allclose(v[perm_q], v):
+        if not np.allclose(s_q @ v, v):
             continue
         free = not np.any(np.abs(t.T @ b)[2 + k] > 0.0)
         for y in states:

@@ -122,6 +122,10 @@ def _step_time(text: str) -> float | None:
 @click.option("--free-fractions", is_flag=True,
               help="Every phase's share of the step free, within half to twice its given "
                    "share (at most 0.95), starting from it (needs --formulation full).")
+@click.option("--stride", is_flag=True,
+              help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "
+                   "lengths, no leg swap assumed (for unequal legs); cost per metre of the "
+                   "stride; full formulation (the default with it).")
 @knots_option
 @knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events; "
                      "docs/walking.md section 6) or uniform.")
@@ -198,7 +202,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
-                  free_fractions: bool,
+                  free_fractions: bool, stride: bool,
                   gait_kind: str | None, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
                   control_model: str | None, mesh_tol: float | None, accuracy: float,
@@ -237,7 +241,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
         cost_regularization=regularization,
         mesh_tol=mesh_tol, accuracy=accuracy, swing_clearance=clearance,
         clearance_profile=clearance_profile,  # type: ignore[arg-type]
-        free_phase_fractions=free_fractions)
+        free_phase_fractions=free_fractions, stride=stride)
     if resting_power is not None:
         options = options.replace(resting_power=resting_power)
     if single_support_bounds is not None:
@@ -266,7 +270,8 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   + f", {options.knots[0]}+{options.knots[1]} knots, control model "
                   f"{options.control_model}"
                   + (" (the paper's grid)" if options.paper_grid else "")
-                  + f", {options.formulation} coordinates")
+                  + f", {options.formulation} coordinates"
+                  + (", a stride (two steps, no leg swap)" if options.stride else ""))
 
     if (start is None and not options.multistart
             and multistart_default(options.speed, options.formulation, reference,
@@ -275,9 +280,11 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                       "worse local optimum; "
                       "--multistart (the default here) also tries the continuation in speed "
                       "and keeps the best")
-    if (sequence_used is not None and len(sequence_used.phases) > 2
+    per_step = (0 if sequence_used is None
+                else len(sequence_used.phases) // sequence_used.steps)
+    if (per_step > 2
             and tuple(options.knots) < MULTI_PHASE_KNOTS):
-        console.print(f"note: a {len(sequence_used.phases)}-phase step on {options.knots[0]}+"
+        console.print(f"note: a {per_step}-phase step on {options.knots[0]}+"
                       f"{options.knots[1]} knots is coarse; the heel-toe walk passes verify on "
                       f"{MULTI_PHASE_KNOTS[0]},{MULTI_PHASE_KNOTS[1]} or finer (--knots; "
                       "docs/feet.md)")

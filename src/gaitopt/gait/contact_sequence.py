@@ -10,7 +10,7 @@ contact points held on the ground; event ``i`` ends phase ``i``:
 
 An event may do both at once (the single-support gait: the front tip strikes and the rear tip
 leaves at that instant). After the last event the legs swap roles (the mapping of the model's
-:func:`~gaitopt.robot.symmetry.swap_permutations`) and the gait moves on by one step length,
+:func:`~gaitopt.robot.symmetry.swap_matrices`) and the gait moves on by one step length,
 and the next step starts again with phase 0.
 
 A held point stands still at its *anchor* on the ground: ``x = anchor * L + offset`` (``L``
@@ -43,6 +43,7 @@ section of a YAML file; docs/formulations.md).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -68,6 +69,10 @@ class PhaseSpec:
     held: tuple[str, ...]
     fraction: float
     bounds: tuple[float, float] | None = None
+    #: Where this phase's points stand, when not at the sequence's anchors and offsets (the
+    #: second step of a stride, :func:`stride_sequence`): contact -> step lengths, and m.
+    anchors: tuple[tuple[str, float], ...] | None = None
+    offsets: tuple[tuple[str, float], ...] | None = None
 
     @property
     def free(self) -> bool:
@@ -96,7 +101,11 @@ class EventSpec:
 @dataclass(frozen=True)
 class ContactSequence:
     """Phases and the events that end them (``events[i]`` ends ``phases[i]``), with the
-    ground anchor of each contact point (``x = anchor * L``, see the module docstring)."""
+    ground anchor of each contact point (``x = anchor * L``, see the module docstring).
+
+    ``steps``: 1, one step of a symmetric gait (after the last event the legs swap and ``x``
+    moves on by ``L``), or 2, a stride (:func:`stride_sequence`: two steps, leg 1's then
+    leg 2's, and after the last event no swap: ``x`` moves on by ``2 L``)."""
 
     name: str
     phases: tuple[PhaseSpec, ...]
@@ -104,18 +113,38 @@ class ContactSequence:
     anchors: tuple[tuple[str, float], ...]
     #: Ground x offsets (m) added to ``anchor * L``; points not listed have none.
     offsets: tuple[tuple[str, float], ...] = ()
+    steps: int = 1
 
-    def anchor(self, contact: str) -> float:
-        """The anchor of ``contact`` (its ground x in step lengths)."""
-        return dict(self.anchors)[hold_name(contact)]
+    def _anchors(self, phase: int | None) -> dict[str, float]:
+        own = None if phase is None else self.phases[phase].anchors
+        return dict(self.anchors if own is None else own)
 
-    def offset(self, contact: str) -> float:
-        """The ground x offset (m) of ``contact``'s anchor."""
-        return dict(self.offsets).get(hold_name(contact), 0.0)
+    def anchored(self, phase: int | None = None) -> set[str]:
+        """The contacts with an anchor (in phase ``phase``, else the sequence's)."""
+        return set(self._anchors(phase))
 
-    def ground_x(self, contact: str, step_length: Any) -> Any:
-        """Where ``contact`` is held on the ground: ``anchor * L + offset`` (m)."""
-        return self.anchor(contact) * step_length + self.offset(contact)
+    def anchor(self, contact: str, phase: int | None = None) -> float:
+        """The anchor of ``contact`` (its ground x in step lengths) in phase ``phase`` (its
+        own anchors if it has some, else the sequence's)."""
+        return self._anchors(phase)[hold_name(contact)]
+
+    def offset(self, contact: str, phase: int | None = None) -> float:
+        """The ground x offset (m) of ``contact``'s anchor (in phase ``phase``)."""
+        own = None if phase is None else self.phases[phase].offsets
+        return dict(self.offsets if own is None else own).get(hold_name(contact), 0.0)
+
+    def ground_x(self, contact: str, step_length: Any, phase: int | None = None) -> Any:
+        """Where ``contact`` is held on the ground in phase ``phase``: ``anchor * L +
+        offset`` (m). A point that touches down at the end of phase ``i`` lands at phase
+        ``i``'s anchor for it."""
+        return self.anchor(contact, phase) * step_length + self.offset(contact, phase)
+
+    def period_contacts(self, contact_swap: Mapping[str, str]) -> Mapping[str, str]:
+        """The renaming of the contacts from the end of the sequence to its start: the leg
+        swap for one step, none (every name itself) for a stride."""
+        if self.steps == 1:
+            return contact_swap
+        return {c: c for c in contact_swap}
 
     def held_after(self, i: int) -> tuple[str, ...]:
         """The names of the points held just after event ``i`` (before any leg swap)."""
@@ -129,19 +158,24 @@ class ContactSequence:
         nxt = self.phases[(i + 1) % len(self.phases)].held
         if i < len(self.events) - 1:
             return nxt
-        return tuple(swap_spec(c, contact_swap) for c in nxt)
+        return tuple(swap_spec(c, self.period_contacts(contact_swap)) for c in nxt)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for the gait file."""
+        def phase(p: PhaseSpec) -> dict[str, Any]:
+            own = {k: dict(v) for k, v in (("anchors", p.anchors), ("offsets", p.offsets))
+                   if v is not None}
+            return {"name": p.name, "held": list(p.held), "fraction": p.fraction_data()} | own
+
         return {
             "name": self.name,
-            "phases": [{"name": p.name, "held": list(p.held), "fraction": p.fraction_data()}
-                       for p in self.phases],
+            "phases": [phase(p) for p in self.phases],
             "events": [{"name": e.name, "touchdown": list(e.touchdown),
                         "release": list(e.release), "impulse": e.impulse}
                        for e in self.events],
             "anchors": {c: a for c, a in self.anchors},
-        } | ({"offsets": {c: b for c, b in self.offsets}} if self.offsets else {})
+        } | ({"offsets": {c: b for c, b in self.offsets}} if self.offsets else {}) | (
+            {"steps": self.steps} if self.steps != 1 else {})
 
 
 def phase_holds(sequence: Mapping[str, Any] | None, i: int, contacts: Sequence[str]
@@ -162,13 +196,21 @@ def phase_knots(seq: ContactSequence, knots: Sequence[int]) -> tuple[int, ...]:
     take them as they are (the paper's single and double support); longer ones give phase
     0 ``first`` knots and every other phase at least ``others``, more when the density of
     phase 0 (intervals per share of the step) asks for more, so that long phases are not
-    coarser than phase 0."""
+    coarser than phase 0. A stride's steps get the knots of one step each (its second step
+    those of the first: like with like against the one-step problem), when its phases split
+    into two steps of as many phases (a stride written by hand may not: then the rule above
+    on all its phases)."""
     first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
-    if len(seq.phases) <= 2:
-        return tuple(first if i == 0 else others for i in range(len(seq.phases)))
-    density = (first - 1) / seq.phases[0].fraction
-    return (first,) + tuple(max(others, 1 + math.ceil(density * ph.fraction - 1e-9))
-                            for ph in seq.phases[1:])
+    n = len(seq.phases)
+    repeats = seq.steps if n % seq.steps == 0 else 1
+    step = seq.phases[:n // repeats]
+    if len(step) <= 2:
+        counts = tuple(first if i == 0 else others for i in range(len(step)))
+    else:
+        density = (first - 1) / step[0].fraction
+        counts = (first,) + tuple(max(others, 1 + math.ceil(density * ph.fraction - 1e-9))
+                                  for ph in step[1:])
+    return counts * repeats
 
 
 def swap_spec(spec: str, contact_swap: Mapping[str, str]) -> str:
@@ -180,10 +222,10 @@ def swap_spec(spec: str, contact_swap: Mapping[str, str]) -> str:
 def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSequence:
     """A sequence from plain data (the form :meth:`ContactSequence.to_dict` writes, as in a
     YAML file): ``name``, ``phases`` (``name``, ``held``, ``fraction``: a number, or
-    ``{guess, min, max}`` for a free one), ``events`` (``name``,
-    optional ``touchdown``, ``release``, ``impulse``), ``anchors`` (contact -> step
-    lengths), optional ``offsets`` (contact -> m). Check it against a model with
-    :func:`check_sequence`."""
+    ``{guess, min, max}`` for a free one; optional ``anchors`` and ``offsets`` of its own),
+    ``events`` (``name``, optional ``touchdown``, ``release``, ``impulse``), ``anchors``
+    (contact -> step lengths), optional ``offsets`` (contact -> m), optional ``steps`` (1,
+    or 2 for a stride). Check it against a model with :func:`check_sequence`."""
     def fail(field: str, value: Any, expected: str) -> ContactSequenceError:
         return ContactSequenceError(f"{where}.{field} = {value!r}: {expected}")
 
@@ -218,19 +260,30 @@ def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSeq
             raise fail(field, value, "needs 0 < min <= guess <= max <= 1")
         return guess, (lo, hi)
 
-    top = mapping("", data, ("name", "phases", "events", "anchors", "offsets"),
+    def points(field: str, value: Any) -> tuple[tuple[str, float], ...]:
+        if not isinstance(value, dict):
+            raise fail(field, value, "must be a mapping of contact names to numbers")
+        return tuple((str(c), number(f"{field}.{c}", a)) for c, a in value.items())
+
+    top = mapping("", data, ("name", "phases", "events", "anchors", "offsets", "steps"),
                   ("phases", "events", "anchors"))
+    steps = top.get("steps", 1)
+    if steps not in (1, 2) or isinstance(steps, bool):
+        raise fail("steps", steps, "must be 1 (one step, legs swapped after it) or 2 (a "
+                                   "stride: two steps, no swap)")
     if not isinstance(top["phases"], list) or not top["phases"]:
         raise fail("phases", top["phases"], "must be a non-empty list")
     if not isinstance(top["events"], list):
         raise fail("events", top["events"], "must be a list (one event per phase)")
     phases = []
     for k, ph in enumerate(top["phases"]):
-        e = mapping(f"phases[{k}]", ph, ("name", "held", "fraction"),
+        e = mapping(f"phases[{k}]", ph, ("name", "held", "fraction", "anchors", "offsets"),
                     ("name", "held", "fraction"))
         fraction, bounds = share(f"phases[{k}].fraction", e["fraction"])
+        own = {key: points(f"phases[{k}].{key}", e[key]) if key in e else None
+               for key in ("anchors", "offsets")}
         phases.append(PhaseSpec(str(e["name"]), names(f"phases[{k}].held", e["held"]),
-                                fraction, bounds))
+                                fraction, bounds, **own))
     events = []
     for k, ev in enumerate(top["events"]):
         e = mapping(f"events[{k}]", ev, ("name", "touchdown", "release", "impulse"),
@@ -241,14 +294,10 @@ def sequence_from_dict(data: Any, where: str = "contact_sequence") -> ContactSeq
                                 names(f"events[{k}].touchdown", e.get("touchdown", [])),
                                 names(f"events[{k}].release", e.get("release", [])),
                                 bool(e.get("impulse", False))))
-    anchors, offsets = top["anchors"], top.get("offsets", {}) or {}
-    for field, value in (("anchors", anchors), ("offsets", offsets)):
-        if not isinstance(value, dict):
-            raise fail(field, value, "must be a mapping of contact names to numbers")
     return ContactSequence(
         str(top.get("name", "custom")), tuple(phases), tuple(events),
-        tuple((str(c), number(f"anchors.{c}", a)) for c, a in anchors.items()),
-        tuple((str(c), number(f"offsets.{c}", b)) for c, b in offsets.items()))
+        points("anchors", top["anchors"]), points("offsets", top.get("offsets", {}) or {}),
+        int(steps))
 
 
 def check_sequence(model: RobotModel, seq: ContactSequence,
@@ -262,12 +311,15 @@ def check_sequence(model: RobotModel, seq: ContactSequence,
         raise ContactSequenceError(f"sequence {seq.name!r}: needs one event per phase")
     if len({ph.name for ph in seq.phases}) != len(seq.phases):
         raise ContactSequenceError(f"sequence {seq.name!r}: phase names must be distinct")
-    anchors = dict(seq.anchors)
-    for c in list(anchors) + [c for c, _ in seq.offsets]:
+    placed = [c for c, _ in seq.anchors + seq.offsets]
+    for ph in seq.phases:
+        placed += [c for c, _ in (ph.anchors or ()) + (ph.offsets or ())]
+    for c in placed:
         if c not in names:
             raise ContactSequenceError(f"sequence {seq.name!r}: anchor of {c!r}, not a "
                                        f"contact of model {model.name!r}")
-    for ph in seq.phases:
+    for i_ph, ph in enumerate(seq.phases):
+        anchors = seq.anchored(i_ph)
         for spec in ph.held:
             c = hold_name(spec)
             if c not in names:
@@ -321,8 +373,47 @@ def check_sequence(model: RobotModel, seq: ContactSequence,
         after = set(seq.held_after(i))
         nxt = [hold_name(c) for c in seq.phases[(i + 1) % len(seq.phases)].held]
         if i == len(seq.events) - 1:
-            after = {contact_swap.get(c, c) for c in after}
+            period = seq.period_contacts(contact_swap)
+            after = {period.get(c, c) for c in after}
         if after != set(nxt):
             raise ContactSequenceError(
                 f"sequence {seq.name!r}: after event {ev.name!r} the points "
                 f"{sorted(after)} are held, but the next phase holds {sorted(nxt)}")
+
+
+#: Suffix of the names of the second step's phases and events in a stride.
+SECOND_STEP = "_2"
+
+
+def stride_sequence(seq: ContactSequence, pairing: Mapping[str, str]) -> ContactSequence:
+    """Two steps of ``seq`` as one period without symmetry (``steps = 2``): leg 1's step as
+    ``seq`` states it, then the same step with the legs' roles exchanged.
+
+    The second step's phases and events are ``seq``'s with every contact renamed by
+    ``pairing`` (contact -> the other leg's counterpart, e.g. ``tip_1 <-> tip_2``), their
+    names suffixed :data:`SECOND_STEP`, and their points one step length further: a point
+    ``pairing[c]`` stands at ``c``'s anchor + 1 (step lengths) with ``c``'s offset. Every
+    share of the step time is halved (a share of the stride time ``2 L / v``), with its
+    bounds. After the last event the stride repeats with ``x`` moved on by ``2 L``, the legs
+    not swapped, so the two steps may differ (legs of unequal mass or shape); the step
+    length ``L`` and the liftoff impulse ``P`` are shared by both steps."""
+    if seq.steps != 1:
+        raise ContactSequenceError(f"sequence {seq.name!r} is already a stride")
+
+    def renamed(names: Sequence[str]) -> tuple[str, ...]:
+        return tuple(swap_spec(c, pairing) for c in names)
+
+    def half(ph: PhaseSpec, **changes: Any) -> PhaseSpec:
+        bounds = None if ph.bounds is None else (ph.bounds[0] / 2.0, ph.bounds[1] / 2.0)
+        return dataclasses.replace(ph, fraction=ph.fraction / 2.0, bounds=bounds, **changes)
+
+    anchors = tuple((pairing.get(c, c), a + 1.0) for c, a in seq.anchors)
+    offsets = tuple((pairing.get(c, c), b) for c, b in seq.offsets)
+    second = tuple(half(ph, name=ph.name + SECOND_STEP, held=renamed(ph.held),
+                        anchors=anchors, offsets=offsets) for ph in seq.phases)
+    events = tuple(dataclasses.replace(ev, name=ev.name + SECOND_STEP,
+                                       touchdown=renamed(ev.touchdown),
+                                       release=renamed(ev.release)) for ev in seq.events)
+    return dataclasses.replace(
+        seq, name=f"{seq.name} stride", phases=tuple(half(ph) for ph in seq.phases) + second,
+        events=seq.events + events, steps=2)

@@ -182,7 +182,8 @@ def recompute_cost(gait: Any) -> float:
     options = GaitOptions.from_dict(dict(gait.options))
     nq = model.nq
     step, speed = gait.parameters["step_length"], gait.parameters["speed"]
-    p = [step, speed, gait.parameters["liftoff_impulse"]]
+    steps = gait.period_steps  # a stride: two steps, two liftoff impulses, per 2 L
+    p = [steps * step, speed, gait.parameters["liftoff_impulse"]]
     total = 0.0
     for ph in gait.phases:
         t_mid = 0.5 * (ph.t[:-1] + ph.t[1:])
@@ -208,7 +209,7 @@ def recompute_cost(gait: Any) -> float:
             total += h / 6.0 * (values[0] + 4.0 * values[1] + values[2])
     impulse = p[2]
     if options.cost == "paper":
-        total += impulse * impulse
+        total += steps * impulse * impulse
     else:
         for ev in impulse_events(gait):
             lift = ev.impulses.get(ev.leg)

@@ -16,7 +16,9 @@ from gaitopt.gait.contact_sequence import (
     ContactSequenceError,
     check_sequence,
     sequence_from_dict,
+    stride_sequence,
 )
+from gaitopt.gait.full_physics import period_map
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.phase_fractions import with_first_fraction_bounds, with_free_fractions
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
@@ -29,7 +31,7 @@ from gaitopt.robot.biped import (
     reduced_biped,
 )
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import leg_swap
+from gaitopt.robot.symmetry import contact_pairing
 
 
 def biped_for(model: RobotModel, options: GaitOptions) -> Biped | None:
@@ -44,21 +46,25 @@ def biped_for(model: RobotModel, options: GaitOptions) -> Biped | None:
         return None
 
 
-def default_formulation(model: RobotModel, gait: str, custom_sequence: bool) -> str:
+def default_formulation(model: RobotModel, gait: str, custom_sequence: bool,
+                        stride: bool = False) -> str:
     """The formulation a user gets without asking: the paper's reduced coordinates for the
     walk of a five-link-shaped biped, else full coordinates (the only one for other models,
-    runs, heel-toe walks and given sequences)."""
-    if gait != "walk" or custom_sequence or not has_reduced_shape(model):
+    runs, heel-toe walks, given sequences and strides)."""
+    if gait != "walk" or custom_sequence or stride or not has_reduced_shape(model):
         return "full"
     return "reduced"
 
 
 def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
     """The contact sequence of ``options``: the one given as data, or the paper's walk, the
-    single-support walk, a run or a heel-toe walk; with its fractions freed by
+    single-support walk, a run or a heel-toe walk; doubled into a stride with ``stride``
+    (:func:`stride_sequence`); with its fractions freed by
     ``single_support_fraction_bounds`` (phase 0 of two) or ``free_phase_fractions`` (every
     phase, default bounds)."""
     seq = _sequence(model, options)
+    if options.stride:
+        seq = stride_sequence(seq, contact_pairing(model))
     if options.single_support_fraction_bounds is not None:
         seq = with_first_fraction_bounds(seq, options.single_support_fraction_bounds)
     if options.free_phase_fractions:
@@ -70,7 +76,7 @@ def _sequence(model: RobotModel, options: GaitOptions) -> ContactSequence:
     if options.contact_sequence is not None:
         return sequence_from_dict(options.contact_sequence)
     if options.gait == "heel-toe":
-        return heel_toe_sequence(model, leg_swap(model).contacts,
+        return heel_toe_sequence(model, contact_pairing(model),
                                  options.single_support_fraction, impulse=options.impulse)
     if options.gait == "run":
         return running_sequence(model, options.single_support_fraction)
@@ -85,7 +91,7 @@ def checked_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence
         return None
     try:
         seq = contact_sequence(model, options)
-        check_sequence(model, seq, dict(leg_swap(model).contacts))
+        check_sequence(model, seq, dict(period_map(model, seq).contacts))
     except (ContactSequenceError, ValueError) as exc:
         raise GaitOptionsError(f"contact sequence: {exc}") from None
     if options.free_phase_fractions and len(seq.phases) < 2:

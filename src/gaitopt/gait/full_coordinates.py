@@ -73,6 +73,7 @@ from gaitopt.gait.full_physics import (
     event_map,
     full_controls,
     hold_axes,
+    period_map,
     phase_point,
     projection_names,
     state_names,
@@ -96,7 +97,7 @@ from gaitopt.ocp.problem import (
 )
 from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import LegSwap, leg_swap
+from gaitopt.robot.symmetry import LegSwap
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 _L, _V, _P, _F = range(4)
@@ -175,10 +176,11 @@ def base_point(model: RobotModel, held: Sequence[str]) -> str | None:
     return pinned[0] if translates else None
 
 
-def _placed_base(model: RobotModel, seq: ContactSequence, point: str
+def _placed_base(model: RobotModel, seq: ContactSequence, point: str, phase: int
                  ) -> Callable[[Any, Any], Any]:
     """``(x, p) -> (x, y, x_rate, y_rate)`` of the base that puts ``point`` at its ground
-    point ``(a L + b, 0)`` at rest: minus its position and velocity with the base at 0."""
+    point ``(a L + b, 0)`` of phase ``phase`` at rest: minus its position and velocity with
+    the base at 0."""
     nq = model.nq
 
     def fn(x: Any, p: Any) -> Any:
@@ -187,7 +189,8 @@ def _placed_base(model: RobotModel, seq: ContactSequence, point: str
         qd = vector([0.0, 0.0] + list(xs[nq + 2:]))
         pos = as_scalars(contact_position(model, q, point), 2, "p")
         vel = as_scalars(contact_velocity(model, q, qd, point), 2, "v")
-        return vector([seq.ground_x(point, p[_L]) - pos[0], -pos[1], -vel[0], -vel[1]])
+        return vector([seq.ground_x(point, p[_L], phase) - pos[0], -pos[1], -vel[0],
+                       -vel[1]])
 
     return fn
 
@@ -199,7 +202,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
     ``place_base`` (default): the first pinned point of each phase places the base at the
     knots after the first (:func:`base_point`) instead of its held-point rows; False states
     those rows (the same optimum, a larger NLP)."""
-    symmetry = leg_swap(model)
+    symmetry = period_map(model, seq)
     check_sequence(model, seq, dict(symmetry.contacts))
     nq = model.nq
     mu = options.friction
@@ -233,7 +236,7 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
     phases: list[Phase] = []
     counts = phase_knots(seq, options.knots)
     actuators_of: dict[str, tuple[str, ...]] = {}
-    for ph in seq.phases:
+    for i_ph, ph in enumerate(seq.phases):
         held = ph.held
         acts = actuator_names(model, held, ankle=options.ankle)
         actuators_of[ph.name] = acts
@@ -255,14 +258,14 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
         n_rows = len(stated)
         if stated:
             def held_rows(x: Any, u: Any, p: Any, t: Any,
-                          stated: list[tuple[str, int]] = stated) -> Any:
+                          stated: list[tuple[str, int]] = stated, i_ph: int = i_ph) -> Any:
                 xs = as_scalars(x, 2 * nq, "x")
                 q, qd = vector(xs[:nq]), vector(xs[nq:])
                 rows, speeds = [], []
                 for c, a in stated:
                     pos = as_scalars(contact_position(model, q, c), 2, "p")
                     vel = as_scalars(contact_velocity(model, q, qd, c), 2, "v")
-                    rows.append(pos[a] - seq.ground_x(c, p[_L]) if a == 0 else pos[a])
+                    rows.append(pos[a] - seq.ground_x(c, p[_L], i_ph) if a == 0 else pos[a])
                     speeds.append(vel[a])
                 return vector(rows + speeds)
 
@@ -298,7 +301,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
             path.append(PathConstraint(label, clearance, lower=0.0, upper=ca.inf,
                                        scale=sc.length(LENGTH_SCALE)))
         if options.swing_clearance is not None and not phases and landing:
-            path.append(_clearance_profile(model, options, landing, _share(seq, 0)))
+            path.append(_clearance_profile(model, options, landing,
+                                           _step_share(seq, _share(seq, 0))))
 
         def dynamics(x: Any, u: Any, p: Any, t: Any, point: Any = point) -> Any:
             return point(x, u).xdot
@@ -310,7 +314,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                 return ca.sumsqr(u[:n_act]) if n_act else ca.SX(0.0)
             qd = vector(as_scalars(x, 2 * nq, "x")[nq:])
             u_act = as_scalars(u, n_u, "u")[:n_act] if n_act else []
-            return cost.running_cost(model, options, qd, full_controls(model, acts, u_act), p)
+            return cost.running_cost(model, options, qd, full_controls(model, acts, u_act),
+                                     _period(seq, p))
 
         control_bounds = {a: model.actuators[model.actuator_index(a)].limits for a in acts}
         control_bounds |= {n: (-PROJECTION_BOUND, PROJECTION_BOUND) for n in proj}
@@ -318,14 +323,14 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
                                             for n in model.coordinate_names}
         phases.append(Phase(
             name=ph.name, states=names, controls=controls, dynamics=dynamics,
-            duration=Duration.of_parameters(_step_share(_share(seq, len(phases)))),
+            duration=Duration.of_parameters(_step_share(seq, _share(seq, len(phases)))),
             state_bounds=state_bounds(held), control_bounds=control_bounds,
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
             control_scales={n: PROJECTION_SCALE for n in proj},
             intervals=counts[len(phases)] - 1,
             knot_states=None if placed is None else KnotStates(
-                BASE_STATES, _placed_base(model, seq, placed))))
+                BASE_STATES, _placed_base(model, seq, placed, i_ph))))
 
     linkages: list[Linkage | ControlLinkage] = []
     events: list[BoundaryConstraint] = []
@@ -343,23 +348,24 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
             q, qd = split(xf)
             after = event_map(model, seq, i, q, qd, p[_P]).qd_after
             if last:
-                q_next, qd_next = swap_state(model, symmetry, q, after, p[_L])
+                q_next, qd_next = swap_state(model, symmetry, q, after, seq.steps * p[_L])
                 return vector(q_next + qd_next)
             return vector(as_scalars(q, nq, "q") + as_scalars(after, nq, "qd"))
 
+        period = " (legs swapped)" if seq.steps == 1 else " (a stride: x + 2 L, no swap)"
         linkages.append(Linkage(src, dst, jump=jump, name=f"{ev.name}: event map" +
-                                (" and periodicity (legs swapped)" if last else "")))
+                                (f" and periodicity{period}" if last else "")))
         if ev.touchdown:
             landing_rows = [(c, a) for c, a in hold_axes(seq.holds_after(i, symmetry.contacts))
                             if c in ev.touchdown]
 
-            def touchdown(ends: Mapping[str, Any], p: Any, src: str = src,
+            def touchdown(ends: Mapping[str, Any], p: Any, src: str = src, i: int = i,
                           landing_rows: list[tuple[str, int]] = landing_rows) -> Any:
                 q, _ = split(ends[src].xf)
                 rows: list[Any] = []
                 for c, a in landing_rows:
                     pos = as_scalars(contact_position(model, q, c), 2, "p")
-                    rows.append(pos[a] - seq.ground_x(c, p[_L]) if a == 0 else pos[a])
+                    rows.append(pos[a] - seq.ground_x(c, p[_L], i) if a == 0 else pos[a])
                 return vector(rows)
 
             events.append(BoundaryConstraint(f"{ev.name}: {TOUCHDOWN}", touchdown, 0.0, 0.0,
@@ -421,13 +427,23 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
         events.append(BoundaryConstraint(f"{seq.phases[rest].name}: {REMAINDER}",
                                          lambda ends, p: _share(seq, rest)(p), lower=lo,
                                          upper=hi, scale=1.0))
+    steps = seq.steps
     return Problem(
         phases=phases, parameters=parameters, linkages=linkages, boundary_constraints=events,
-        parameter_cost=(lambda p: p[_P] ** 2) if options.cost == "paper" else
-        (lambda p: cost.parameter_cost(model, options, p)),
+        parameter_cost=(lambda p: steps * p[_P] ** 2) if options.cost == "paper" else
+        (lambda p: cost.parameter_cost(model, options, _period(seq, p))),
         mayer=None if options.cost == "paper" else _impulse_cost(model, options, seq, split),
-        cost_denominator=lambda ends, p: cost.denominator(model, options, p),
+        cost_denominator=lambda ends, p: cost.denominator(model, options, _period(seq, p)),
         objective_scale=cost.objective_scale(options, sc))
+
+
+def _period(seq: ContactSequence, p: Any) -> Any:
+    """The parameters ``p`` with the step length ``L`` replaced by the length of the
+    period, ``steps L`` (``p`` itself for one step): the costs' denominator and resting
+    time are the period's (a stride's cost is per metre of the stride)."""
+    if seq.steps == 1:
+        return p
+    return ca.vertcat(seq.steps * p[_L], p[_V], p[_P])
 
 
 def _impulse_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
@@ -459,9 +475,10 @@ def _share(seq: ContactSequence, i: int) -> Callable[[Any], Any]:
 
 
 def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence[str],
-                       share: Callable[[Any], Any]) -> PathConstraint:
+                       duration: Callable[[Any], Any]) -> PathConstraint:
     """The swing clearance of the first phase (:func:`gaitopt.gait.problem.clearance_profile`):
-    each point landing at its end stays above ``profile(s)``, ``s = t v / (f L)``."""
+    each point landing at its end stays above ``profile(s)``, ``s = t / T_0`` (``T_0 =
+    duration(p)``, the phase's duration ``f steps L / v``)."""
     from gaitopt.gait.problem import clearance_profile
 
     assert options.swing_clearance is not None
@@ -470,7 +487,7 @@ def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence
 
     def fn(x: Any, u: Any, p: Any, t: Any) -> Any:
         q = vector(as_scalars(x, 2 * nq, "x")[:nq])
-        s = t * p[_V] / (share(p) * p[_L])
+        s = t / duration(p)
         low = clearance_profile(height, s, options.clearance_profile)
         return vector([as_scalars(contact_position(model, q, c), 2, "p")[1] - low
                        for c in points])
@@ -479,29 +496,33 @@ def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence
                           scale=model_scale(model).length(LENGTH_SCALE))
 
 
-def _step_share(share: Callable[[Any], Any]) -> Callable[[Any], Any]:
-    """``p -> share(p) L / v``: a phase's duration."""
-    return lambda p: share(p) * p[_L] / p[_V]
+def _step_share(seq: ContactSequence, share: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    """``p -> share(p) steps L / v``: a phase's duration (its share of the period: the
+    step, or the stride of ``seq.steps = 2`` steps)."""
+    steps = seq.steps
+    return lambda p: share(p) * steps * p[_L] / p[_V]
 
 
 def _periodic_controls(model: RobotModel, symmetry: LegSwap, seq: ContactSequence,
                        actuators_of: Mapping[str, Sequence[str]]) -> ControlLinkage:
-    """``u_first(0)[a] = u_last(T)[swap(a)]`` for every actuator ``a`` of the first phase
-    whose swapped counterpart acts at the end of the last phase."""
+    """``u_first(0)[a] = (S_u u_last(T))[a] = sign_a u_last(T)[swap(a)]`` for every
+    actuator ``a`` of the first phase whose swapped counterpart acts at the end of the last
+    phase (``S_u`` a signed permutation: :meth:`LegSwap.actuator_source`; the identity for a
+    stride)."""
     first, last = seq.phases[0].name, seq.phases[-1].name
     last_acts = list(actuators_of[last])
     names = [a.name for a in model.actuators]
     targets, sources = [], []
     for a in actuators_of[first]:
-        other = names[symmetry.perm_u[model.actuator_index(a)]]
-        if other in last_acts:
+        j, sign = symmetry.actuator_source(model.actuator_index(a))
+        if names[j] in last_acts:
             targets.append(a)
-            sources.append(last_acts.index(other))
+            sources.append((last_acts.index(names[j]), sign))
     n_last = len(last_acts) + 2 * len(hold_axes(seq.phases[-1].held))
 
     def fn(u_from: Any, p: Any) -> Any:
         us = as_scalars(u_from, n_last, "u")
-        return vector([us[k] for k in sources])
+        return vector([us[k] if sign > 0 else -us[k] for k, sign in sources])
 
     return ControlLinkage(last, first, fn=fn, controls=targets,
                           name="controls periodic (legs swapped)")

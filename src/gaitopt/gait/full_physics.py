@@ -20,8 +20,15 @@ from gaitopt.dynamics.impact import impact, liftoff_impulse
 from gaitopt.dynamics.kinematics import contact_jacobian
 from gaitopt.dynamics.tree import HOLD_AXES, hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec
-from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import LegSwap, leg_swap
+from gaitopt.robot.model import BASE_X, RobotModel
+from gaitopt.robot.symmetry import LegSwap, identity_swap, leg_swap
+
+
+def period_map(model: RobotModel, seq: ContactSequence) -> LegSwap:
+    """The map from the end of ``seq`` to its start: the leg swap for one step
+    (:func:`~gaitopt.robot.symmetry.leg_swap`), the identity for a stride (``seq.steps =
+    2``: no symmetry assumed)."""
+    return leg_swap(model) if seq.steps == 1 else identity_swap(model)
 
 
 def state_names(model: RobotModel) -> tuple[str, ...]:
@@ -124,7 +131,7 @@ def event_map(model: RobotModel, seq: ContactSequence, i: int, q: Any, qd: Any,
     any touch down; else the liftoff impulse of magnitude ``impulse`` (N s) on the released
     point; else nothing. Impulses ``(2,)`` per point as in :func:`per_point`."""
     ev: EventSpec = seq.events[i]
-    after = seq.holds_after(i, leg_swap(model).contacts)
+    after = seq.holds_after(i, period_map(model, seq).contacts)
     if ev.touchdown:
         sol = impact(model, q, qd, after)
         return EventValues(sol.qd_plus, per_point(after, sol.impulses))
@@ -155,8 +162,11 @@ def event_impulses(model: RobotModel, seq: ContactSequence, i: int, x: Any, impu
 
 def swap_state(model: RobotModel, symmetry: LegSwap, q: Any, qd: Any, step: Any
                ) -> tuple[list[Any], list[Any]]:
-    """The next step's ``(q, qd)``: legs swapped, moved back by one step length."""
+    """The next period's ``(q, qd)``: ``S_q q`` and ``S_q qd`` (the legs swapped,
+    :func:`~gaitopt.robot.symmetry.swap_matrices`; the identity for a stride:
+    :func:`period_map`), ``x`` moved back by ``step`` (m: the step length, or the stride's
+    for a stride)."""
     qs, qds = as_scalars(q, model.nq, "q"), as_scalars(qd, model.nq, "qd")
-    q_next = [qs[j] for j in symmetry.perm_q]
-    q_next[0] = q_next[0] - step
-    return q_next, [qds[j] for j in symmetry.perm_q]
+    q_next = symmetry.swap_q(qs)
+    q_next[BASE_X] = q_next[BASE_X] - step
+    return q_next, symmetry.swap_q(qds)

@@ -60,11 +60,11 @@ def check_solver(value: Any) -> dict[str, Any]:
 
 
 def check_consistency(model: RobotModel, p: Mapping[str, float], phases: Sequence[Any],
-                      events: Sequence[Any], s: Any) -> None:
+                      events: Sequence[Any], s: Any, steps: int = 1) -> None:
     """The parts of a gait agree with its ``model`` (``nq``, ``nu``, contact names) and with
-    each other: parameters ``p`` (checked numbers) against the phases' span, phases joined in
-    time, events and samples inside the step. Raises
-    :class:`~gaitopt.gait.gait_fields.GaitFileError` naming the field.
+    each other: parameters ``p`` (checked numbers) against the phases' span (``steps`` step
+    times: 2 for a stride), phases joined in time, events and samples inside the period.
+    Raises :class:`~gaitopt.gait.gait_fields.GaitFileError` naming the field.
     """
     nq, nu = model.nq, model.nu
     contacts = [c.name for c in model.contacts]
@@ -91,9 +91,10 @@ def check_consistency(model: RobotModel, p: Mapping[str, float], phases: Sequenc
             raise bad_field(f"{where}.t", f"starts at {phase.t[0]:g} s but the previous phase ends "
                             f"at {phases[i - 1].t[-1]:g} s")
     span = phases[-1].t[-1] - phases[0].t[0]
-    if not math.isclose(span, p["step_time"], rel_tol=1e-6, abs_tol=1e-9):
-        raise bad_field("parameters.step_time", f"{p['step_time']:g} s differs from the phases' "
-                        f"span {span:g} s")
+    if not math.isclose(span, steps * p["step_time"], rel_tol=1e-6, abs_tol=1e-9):
+        times = "" if steps == 1 else f" x {steps} steps (a stride)"
+        raise bad_field("parameters.step_time", f"{p['step_time']:g} s{times} differs from the "
+                        f"phases' span {span:g} s")
     t0, t1 = phases[0].t[0] - 1e-9, phases[-1].t[-1] + 1e-9
     for i, event in enumerate(events):
         where = f"events[{i}]"

@@ -114,6 +114,9 @@ class Gait:
         if self.contact_sequence is not None:
             seq = mapping_of("contact_sequence", self.contact_sequence,
                              required=("name", "phases", "events"))
+            if seq.get("steps", 1) not in (1, 2) or isinstance(seq.get("steps"), bool):
+                raise bad_field("contact_sequence.steps", f"expected 1 (one step) or 2 (a "
+                                f"stride), got {seq['steps']!r}")
             set_(self, "contact_sequence", frozen_copy(plain_json("contact_sequence", seq)))
         set_(self, "model_data", frozen_copy(self.model_data))
         options = mapping_of("options", self.options)
@@ -129,7 +132,8 @@ class Gait:
         set_(self, "solver", frozen_copy(plain_json("solver", check_solver(self.solver))))
         set_(self, "phases", tuple(self.phases))
         set_(self, "events", tuple(self.events))
-        check_consistency(model, self.parameters, self.phases, self.events, self.samples)
+        check_consistency(model, self.parameters, self.phases, self.events, self.samples,
+                          self.period_steps)
 
     def __repr__(self) -> str:
         phases = "+".join(f"{p.name}({p.t.size})" for p in self.phases)
@@ -155,7 +159,16 @@ class Gait:
 
     @property
     def step_time(self) -> float:
+        """One step's time ``L / v``, s (a stride's period is two)."""
         return float(self.parameters["step_time"])
+
+    @property
+    def period_steps(self) -> int:
+        """Steps in the solved period: 1 (one step, periodic through the leg swap) or 2 (a
+        stride: two steps, periodic without swap; ``contact_sequence.steps``)."""
+        if self.contact_sequence is None:
+            return 1
+        return int(self.contact_sequence.get("steps", 1))
 
     @property
     def cost_value(self) -> float:
@@ -177,16 +190,23 @@ class Gait:
         (the ``x`` coordinate and every point) shifted by k * step_length, and, for odd k, the
         legs swapped (coordinates, controls and points of leg 1 <-> leg 2), so that
         ``points["tip_1"]`` follows the same physical leg throughout. A sample repeated at a
-        step boundary is kept once.
+        step boundary is kept once. A stride file (:attr:`period_steps` 2) repeats its
+        stride, shifted by two step times and lengths and never swapped, until it covers
+        ``n_steps`` steps (``ceil(n_steps / 2)`` strides).
         """
         if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
             raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
         s = self.samples
-        from gaitopt.robot.symmetry import swap_names, swap_permutations
+        from gaitopt.robot.symmetry import swap_matrices, swap_names
 
-        q_swap, u_swap = swap_permutations(self.model)
-        names = swap_names(self.model)
-        period, shift = self.step_time, self.step_length
+        steps = self.period_steps
+        if steps == 1:
+            s_q, s_u = swap_matrices(self.model)  # q' = S_q q, u' = S_u u
+            names = swap_names(self.model)
+        else:  # a stride: no swap
+            s_q, s_u, names = np.eye(self.model.nq), np.eye(self.model.nu), {}
+        period, shift = steps * self.step_time, steps * self.step_length
+        n_steps = -(-n_steps // steps)  # periods
         x_index = self.model.coordinate_names.index("x")
         duplicate = abs((s.t[-1] - s.t[0]) - period) <= 1e-9 * max(1.0, period)
         parts: dict[str, list[Array]] = {"t": [], "q": [], "qd": [], "u": []}
@@ -194,12 +214,12 @@ class Gait:
         for k in range(n_steps):
             sl = slice(1 if (k > 0 and duplicate) else 0, None)
             swap = k % 2 == 1
-            q = (s.q[:, q_swap] if swap else s.q.copy())[sl]
+            q = (s.q @ s_q.T if swap else s.q.copy())[sl]
             q[:, x_index] += k * shift
             parts["t"].append(s.t[sl] + k * period)
             parts["q"].append(q)
-            parts["qd"].append((s.qd[:, q_swap] if swap else s.qd)[sl])
-            parts["u"].append((s.u[:, u_swap] if swap else s.u)[sl])
+            parts["qd"].append((s.qd @ s_q.T if swap else s.qd)[sl])
+            parts["u"].append((s.u @ s_u.T if swap else s.u)[sl])
             for name in s.points:
                 source = names.get(name, name) if swap else name
                 if source not in s.points:

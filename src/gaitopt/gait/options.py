@@ -244,6 +244,14 @@ class GaitOptions:
             clustered at the events, where fast walks have a boundary layer before the heel
             strike that a uniform grid resolves at first order only (docs/walking.md,
             section 6).
+        stride: solve a stride, two steps (leg 1's, then leg 2's) periodic with ``x``
+            moved on by two step lengths and no leg swap, instead of one step periodic
+            through the swap: for legs that are no mirror of each other (one heavier leg, a
+            prosthesis). The contact sequence is doubled with the contact points renamed by
+            the leg pairing (:func:`gaitopt.gait.contact_sequence.stride_sequence`; both
+            steps share ``L`` and ``P``, each phase keeps its share of its step unless the
+            fractions are free); the cost is per metre of the stride. Full formulation, not
+            with ``single_support_fraction_bounds``.
     """
 
     speed: float | None = from_model(0.2)
@@ -284,6 +292,7 @@ class GaitOptions:
     swing_clearance: float | None = None
     clearance_profile: ClearanceProfile = "quartic"
     knot_spacing: KnotSpacing = "cosine"
+    stride: bool = False
 
     # -- derived -------------------------------------------------------------------------------
     @property
@@ -403,6 +412,15 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
         if o.single_support_fraction_bounds is not None:
             raise GaitOptionsError("free_phase_fractions and single_support_fraction_bounds: "
                                    "give one of them (free_phase_fractions frees every phase)")
+    if o.stride:
+        if o.formulation != "full":
+            raise GaitOptionsError("stride: a two-step stride needs formulation 'full' (the "
+                                   "reduced coordinates describe one step of the five-link "
+                                   "biped, periodic through the leg swap)")
+        if o.single_support_fraction_bounds is not None:
+            raise GaitOptionsError("stride and single_support_fraction_bounds: give "
+                                   "free_phase_fractions instead (it frees every phase of "
+                                   "both steps)")
     if o.gait not in GAITS:
         raise GaitOptionsError(f"gait = {o.gait!r}: must be one of {', '.join(GAITS)}")
     if (o.gait == "heel-toe" or o.contact_sequence is not None) and o.formulation != "full":

@@ -59,32 +59,37 @@ FLEXED_KNEE = -0.3
 PLACEMENT_TOL = 0.03
 
 
-def _held_intervals(seq: ContactSequence, ends: Array) -> dict[str, list[tuple[float, float]]]:
-    """Contact name -> the time intervals of this step in which it is held."""
-    out: dict[str, list[tuple[float, float]]] = {}
+def _held_intervals(seq: ContactSequence, ends: Array, step: float
+                    ) -> dict[str, list[tuple[float, float, float | None]]]:
+    """Contact name -> ``(t0, t1, x)``: the time intervals of this period in which it is
+    held and where (its ground x in that phase, None without an anchor)."""
+    out: dict[str, list[tuple[float, float, float | None]]] = {}
     for i, ph in enumerate(seq.phases):
+        anchored = seq.anchored(i)
         for spec in ph.held:
-            out.setdefault(hold_name(spec), []).append((float(ends[i]), float(ends[i + 1])))
+            c = hold_name(spec)
+            x = seq.ground_x(c, step, i) if c in anchored else None
+            out.setdefault(c, []).append((float(ends[i]), float(ends[i + 1]), x))
     return out
 
 
 def _ground_points(seq: ContactSequence, swap: Mapping[str, str], step: float, total: float
                    ) -> dict[str, list[tuple[float, float, float | None]]]:
-    """Contact -> held intervals ``(t0, t1, x)`` over five steps (two before this one, two
-    after: the point ``c`` is ``swap(c)`` one step later and ``c`` again two steps later,
-    ``L`` further each step), ``x`` its ground point or None without an anchor."""
+    """Contact -> held intervals ``(t0, t1, x)`` over five periods of ``total`` seconds
+    (two before this one, two after: the point ``c`` is ``swap(c)`` one period later and
+    ``c`` again two periods later, ``seq.steps L`` further each period; a stride's ``swap``
+    is the identity), ``x`` its ground point or None without an anchor."""
     ends = np.concatenate([[0.0], np.cumsum([ph.fraction for ph in seq.phases])]) * total
-    here = _held_intervals(seq, ends)
-    anchored = dict(seq.anchors)
+    here = _held_intervals(seq, ends, step)
+    length = seq.steps * step
     out: dict[str, list[tuple[float, float, float | None]]] = {}
     for c in {*here, *swap, *swap.values()}:
         rows: list[tuple[float, float, float | None]] = []
         for shift in (-2, -1, 0, 1, 2):
             name = c if shift % 2 == 0 else swap.get(c, c)
-            x = seq.ground_x(name, step) if name in anchored else None
-            for t0, t1 in here.get(name, []):
+            for t0, t1, x in here.get(name, []):
                 rows.append((t0 + shift * total, t1 + shift * total,
-                             None if x is None else x + shift * step))
+                             None if x is None else x + shift * length))
         out[c] = sorted(rows, key=lambda r: r[0])
     return out
 
@@ -127,10 +132,13 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
                    ankle_torques: bool | None = None, lift: float | None = None
                    ) -> WalkingGuess:
     """The guess of the module docstring, one :class:`PhaseGuess` per phase of ``seq`` (the
-    knots of phase ``i`` are ``knots[min(i, 1)]``, as in the full-coordinate problem)."""
+    knots of phase ``i`` are ``knots[min(i, 1)]``, as in the full-coordinate problem) over
+    its period ``seq.steps L / v``; ``swap``: the contact renaming from the end of the period
+    to its start (:meth:`ContactSequence.period_contacts` applies: none for a stride)."""
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
     v, step = speed, step_length
-    total = step / v
+    swap = seq.period_contacts(swap)
+    total = seq.steps * step / v
     # The swing arcs' height: on the reference biped (1 m legs) min(0.05, 0.015 + 0.1 L) m.
     scale = model_scale(model)
     lift = (lift if lift is not None else

@@ -68,6 +68,7 @@ import numpy as np
 from gaitopt.dynamics.reduced import ReachError
 from gaitopt.gait.check_grid import check_knots
 from gaitopt.gait.formulation import biped_for, checked_sequence, contact_sequence, stage_bounds
+from gaitopt.gait.full_physics import period_map
 from gaitopt.gait.guess import (
     default_running_step,
     default_step_length,
@@ -125,7 +126,6 @@ from gaitopt.ocp import Guess, ProblemError, Result, WarmStart, refined_mesh
 from gaitopt.ocp.mesh import split_intervals
 from gaitopt.ocp.regrid import regridded
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import leg_swap
 
 #: Reference speed (m/s) of the reference biped (the five-link's 1 m legs) for the
 #: continuation fallback and the start of a speed-free solve: the paper's optimal 12 m/min.
@@ -259,7 +259,8 @@ class _Run:
         ``every_start`` all of them."""
         o, coarse = self.options, coarse_knots(self.options)
         biped = biped_for(self.model, o)
-        generic = biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
+        generic = (biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
+                   or o.stride)
         r_max = (0.0 if biped is None else
                  min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
         held = {spec.frees for spec in RELEASES if spec.frees and spec.runs(o)}
@@ -280,8 +281,9 @@ class _Run:
                     # paper's walk never uses.
                     from gaitopt.gait.sequence_guess import sequence_guess
 
-                    guess = sequence_guess(self.model, contact_sequence(self.model, o),
-                                           leg_swap(self.model).contacts, speed=speed,
+                    seq = contact_sequence(self.model, o)
+                    guess = sequence_guess(self.model, seq,
+                                           period_map(self.model, seq).contacts, speed=speed,
                                            step_length=step0, knots=coarse, ankle=o.ankle,
                                            ankle_torques=False)
                 elif o.gait == "run":

@@ -67,7 +67,8 @@ class Biped:
     Attributes:
         legs: ``legs[0]`` is leg 1 (the first contact point), the stance leg at the start of
             a step; ``legs[1]`` leg 2, the swing leg.
-        swap: the leg swap after a step (permutations of ``q``, ``u`` and the contact names).
+        swap: the leg swap after a step (the linear maps of ``q`` and ``u``, here
+            permutations, and the contact names: :class:`~gaitopt.robot.symmetry.LegSwap`).
         reduced: the model is exactly a torso and these two legs (5 links, 7 coordinates),
             the shape the paper's reduced coordinates describe.
         base_position, base_angle: where the floating base's ``(x, y)`` (m, world frame) and

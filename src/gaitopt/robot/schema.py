@@ -114,10 +114,10 @@ class _Validator(FieldReader):
                            gravity=gravity, description=description, symmetry=symmetry)
         check_positive_definite(model, source=self.source)
         if symmetry is not None:
-            from gaitopt.robot.symmetry import SymmetryError, swap_permutations
+            from gaitopt.robot.symmetry import SymmetryError, swap_matrices
 
             try:
-                swap_permutations(model)
+                swap_matrices(model)
             except SymmetryError as exc:
                 raise self.fail("symmetry", top["symmetry"],
                                 "pairs that map the model onto itself", problem=str(exc)
@@ -131,7 +131,7 @@ class _Validator(FieldReader):
                            "the left/right symmetry (pairs of links and of contacts)")
         seen: set[str] = set()
         out: dict[str, tuple[tuple[str, str], ...]] = {}
-        for key, known in (("links", [link.name for link in links[1:]]),
+        for key, known in (("links", [link.name for link in links]),
                            ("contacts", [c.name for c in contacts])):
             pairs = []
             for i, item in enumerate(self.optional_list(f"symmetry.{key}", top.get(key), key)):

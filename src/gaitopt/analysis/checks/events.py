@@ -10,8 +10,9 @@ For each event at the end of phase i (its time equals that phase's last knot):
   the first phase's contacts with the legs relabelled: ``tip_1`` -> ``tip_2``); a liftoff
   applies the liftoff impulse (``parameters.liftoff_impulse``) on the lifting tip while the
   other contacts held before it stay;
-* ``events.periodicity``: the state after the last event, legs relabelled
-  (:func:`~gaitopt.robot.symmetry.swap_permutations`) and shifted back one step length,
+* ``events.periodicity``: the state after the last event, legs swapped (``S_q q``, ``S_q qd``:
+  :func:`~gaitopt.robot.symmetry.swap_matrices`) and shifted back one step length (a
+  stride's: not swapped, shifted back two step lengths; :func:`period_maps`),
   equals the first knot; ``events.periodic_controls`` the same for the controls of the
   actuators acting at both ends, if the gait was solved with periodic controls (and the
   paper's control model: with ``control_model = "jumps"`` the torques may jump at the events).
@@ -28,7 +29,7 @@ from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, sequence_from_dict
 from gaitopt.gait.full_physics import per_point
 from gaitopt.gait.gait_file import Gait, GaitEvent
-from gaitopt.robot.symmetry import leg_swap, swap_names, swap_permutations
+from gaitopt.robot.symmetry import swap_matrices, swap_names
 
 Array = NDArray[np.float64]
 
@@ -44,10 +45,23 @@ def _phase_ending_at(gait: Gait, t: float) -> int | None:
     return ends[-1] if ends else None
 
 
+def period_maps(gait: Gait) -> tuple[Array, Array, dict[str, str]]:
+    """``(S_q, S_u, names)``: the map from the end of the gait's period to its start, of the
+    coordinates (nq, nq), the actuators (nu, nu) and the names of points, joints and links:
+    the leg swap (:func:`~gaitopt.robot.symmetry.swap_matrices`,
+    :func:`~gaitopt.robot.symmetry.swap_names`) for one step, the identity for a stride
+    (:attr:`Gait.period_steps` 2)."""
+    model = gait.model
+    if gait.period_steps == 1:
+        s_q, s_u = swap_matrices(model)
+        return s_q, s_u, swap_names(model)
+    return np.eye(model.nq), np.eye(model.nu), {}
+
+
 def _held_after_strike(gait: Gait, i: int, leg: str) -> tuple[str, ...]:
     if i + 1 < len(gait.phases):
         return tuple(gait.phases[i + 1].contacts)
-    names = swap_names(gait.model)
+    names = period_maps(gait)[2]
     relabelled = tuple(names.get(c, c) for c in gait.phases[0].contacts)
     return relabelled if leg in relabelled else (leg,)
 
@@ -62,7 +76,7 @@ def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...], i: int
     spec = _sequence_event(gait, i, event)
     if spec is not None:
         seq, ev = spec
-        after = seq.holds_after(i, leg_swap(model).contacts)
+        after = seq.holds_after(i, period_maps(gait)[2])
         touchdown, impulse = bool(ev.touchdown), ev.impulse
     else:
         touchdown, impulse = event.name in TOUCHDOWNS, event.name in IMPULSE_RELEASES
@@ -142,11 +156,11 @@ def event_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
 def _periodicity_checks(gait: Gait, q_end: Array, qd_end: Array, lim: dict[str, float]
                         ) -> list[Check]:
     model = gait.model
-    perm_q, perm_u = swap_permutations(model)
+    s_q, s_u, _ = period_maps(gait)
     first, last = gait.phases[0], gait.phases[-1]
-    q_next = q_end[perm_q].copy()
-    q_next[model.coordinate_names.index("x")] -= gait.parameters["step_length"]
-    err = np.concatenate([np.abs(q_next - first.q[0]), np.abs(qd_end[perm_q] - first.qd[0])])
+    q_next = s_q @ q_end
+    q_next[model.coordinate_names.index("x")] -= gait.period_steps * gait.step_length
+    err = np.concatenate([np.abs(q_next - first.q[0]), np.abs(s_q @ qd_end - first.qd[0])])
     k = int(np.argmax(err))
     names = model.coordinate_names
     label = names[k] if k < len(names) else f"{names[k - len(names)]}_rate"
@@ -154,7 +168,7 @@ def _periodicity_checks(gait: Gait, q_end: Array, qd_end: Array, lim: dict[str, 
                     f"{label}")]
     if (gait.options.get("periodic_controls", True)
             and gait.options.get("control_model", "paper") == "paper"):
-        u_next = last.u[-1][perm_u]
+        u_next = s_u @ last.u[-1]
         active = np.abs(first.u[0]) > 0  # actuators that act at the start of the step
         both = active & (np.abs(u_next) > 0)
         diff = np.where(both, np.abs(u_next - first.u[0]), 0.0)

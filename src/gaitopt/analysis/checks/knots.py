@@ -147,16 +147,18 @@ def knot_function(model: RobotModel, contacts: tuple[str, ...]) -> ca.Function:
                        [eom, ca.vertcat(*pos), ca.vertcat(*vel), ca.vertcat(*acc)])
 
 
-def ground_points(gait: Gait) -> dict[str, Array]:
-    """Where each held point stands (world, m): from the gait's contact sequence (``anchor L
-    + offset``, ``y = 0``; ``x`` NaN for a point without an anchor, held along y only), or for
+def ground_points(gait: Gait, phase: int | None = None) -> dict[str, Array]:
+    """Where each held point stands in phase ``phase`` (world, m): from the gait's contact
+    sequence (``anchor L + offset``, ``y = 0``, the phase's own anchors if it has some, as a
+    stride's second step; ``x`` NaN for a point without an anchor, held along y only), or for
     a gait file without one, leg 1 at ``x = 0`` and leg 2 at ``x = L``."""
     step = gait.parameters["step_length"]
     if gait.contact_sequence is not None:
         seq = sequence_from_dict(dict(gait.contact_sequence))
-        anchored = dict(seq.anchors)
-        return {c.name: np.array([seq.ground_x(c.name, step) if c.name in anchored else np.nan,
-                                  0.0]) for c in gait.model.contacts}
+        i = phase if phase is not None and phase < len(seq.phases) else None
+        anchored = seq.anchored(i)
+        return {c.name: np.array([seq.ground_x(c.name, step, i) if c.name in anchored
+                                  else np.nan, 0.0]) for c in gait.model.contacts}
     stance, swing = biped_of(gait.model).contacts
     return {stance: np.array([0.0, 0.0]), swing: np.array([step, 0.0])}
 
@@ -183,7 +185,6 @@ def knot_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
     model = gait.model
     weight = model.total_mass * float(np.hypot(*model.gravity))
     scale = weight * body_size(model)
-    at_ground = ground_points(gait)
     worst = {k: Worst() for k in ("eom.residual", "contacts.position", "contacts.velocity",
                                   "contacts.acceleration", "contacts.normal_force",
                                   "states.values", "states.rates")}
@@ -193,6 +194,7 @@ def knot_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
                   else np.zeros((ph.t.size, 0)))
         eom, pos, vel, acc = _columns(knot_function(model, contacts), ph.q, ph.qd, ph.qdd,
                                       ph.u, forces)
+        at_ground = ground_points(gait, i)
         ground = np.hstack([at_ground[c] for c in contacts]) if contacts else np.zeros(0)
         x, xdot = _columns(state_map(model, tuple(ph.state_names)), ph.q, ph.qd, ph.qdd)
         per_knot = {
