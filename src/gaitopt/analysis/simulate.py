@@ -13,7 +13,7 @@ ground in mid-swing, where their clearance constraint is active, at the knots on
 seven-link walk at 60 m/min dips its swing toe 1.6 mm into the ground 0.46 m ahead of the
 origin, which a solid ground turns into a trip; ``ghost_swing=False`` makes every point solid
 all the time). The next step is the same motion with the legs swapped
-(:func:`gaitopt.robot.symmetry.leg_swap`: ``q[perm_q]``, ``u[perm_u]``, contacts renamed) and
+(:func:`gaitopt.robot.symmetry.leg_swap`: ``S_q q``, ``S_u u``, contacts renamed) and
 its origin at the new stance point's measured position.
 
 Within a phase the reference is the gait file's own interpolation
@@ -178,7 +178,7 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     mj, cmap = robot.mj, robot.coordinates
     data = mujoco.MjData(mj)
     swap = leg_swap(model)
-    perm_q, perm_u = np.array(swap.perm_q), np.array(swap.perm_u)
+    s_q, s_u = swap.s_q, swap.s_u  # the swap's linear maps of q (and qd) and of u
     tables = [_table(model, ph, gait.step_length) for ph in gait.phases]
     # theta(tau) of the whole step: the hip's x relative to the origin (the phases' shared
     # boundary samples once)
@@ -262,8 +262,8 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
     while step < steps:
         t = float(data.time)
         q, qd = cmap.q(data.qpos), cmap.qd(data.qvel)
-        q_g = q[perm_q] if step % 2 else q  # gait labels
-        qd_g = qd[perm_q] if step % 2 else qd
+        q_g = s_q @ q if step % 2 else q  # gait labels (S_q is an involution)
+        qd_g = s_q @ qd if step % 2 else qd
         table = tables[phase]
         ph = gait.phases[phase]
         by_clock = tracking == "time" or spec.phases[phase].duration is not None
@@ -312,9 +312,9 @@ def simulate_gait(gait: Gait, *, steps: int = 10, pd: tuple[float, float] = (100
                     break
             continue
         # torques in physical labels
-        u_ff = u_r[perm_u] if step % 2 else u_r
-        q_ref = q_r[perm_q] if step % 2 else q_r
-        qd_ref = qd_r[perm_q] if step % 2 else qd_r
+        u_ff = s_u @ u_r if step % 2 else u_r
+        q_ref = s_q @ q_r if step % 2 else q_r
+        qd_ref = s_q @ qd_r if step % 2 else qd_r
         data.ctrl[:] = robot.servo_ctrl(u_ff, q_ref, qd_ref, kp, kd)
         data.xfrc_applied[:] = 0.0
         for j, point, chain in ground_torques:

@@ -22,7 +22,7 @@ from typing import Any
 from gaitopt.robot.errors import ModelError
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.schema import model_from_dict
-from gaitopt.robot.symmetry import SymmetryError, model_symmetry, swap_permutations
+from gaitopt.robot.symmetry import SymmetryError, model_symmetry, swap_matrices
 from gaitopt.robot.urdf_xml import Reader, UJoint
 
 
@@ -132,7 +132,7 @@ def symmetry_note(model: RobotModel, *, by_import: bool = False) -> str:
     periodic gait needs one)."""
     try:
         symmetry = model_symmetry(model)
-        swap_permutations(model)
+        swap_matrices(model)
     except SymmetryError as exc:
         if len(model.contacts) < 2:
             return f"symmetry: none ({exc})"
