@@ -18,9 +18,9 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_gait, solve_gait_solution
 from gaitopt.gait.diagnose import diagnose
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.solve import WalkingSolution, transcription_for
 from gaitopt.robot import load_model, model_from_dict, model_to_yaml
 from tests.gait.conftest import Solved
@@ -146,7 +146,9 @@ def _short_legs(tmp_path: Path, length: float = 0.2) -> Path:
 
 @pytest.mark.parametrize(("step", "words"), [
     ("0.78", "longer than the legs can reach"),  # refused by the options' own check
-    ("0.7", "every naive start puts a leg beyond its reach"),  # no start can be placed
+    # The step bounds follow the model (0.8 leg lengths: 0.32 m on 0.4 m legs): a step
+    # beyond them is refused by name before the reach is looked at.
+    ("0.7", "must lie in step_length_bounds [0.008, 0.32] m"),
 ])
 def test_an_unreachable_step_is_one_line_naming_the_reach(tmp_path: Path, step: str,
                                                           words: str) -> None:
@@ -156,5 +158,18 @@ def test_an_unreachable_step_is_one_line_naming_the_reach(tmp_path: Path, step: 
     assert result.exit_code == 2, result.output
     last = result.output.strip().splitlines()[-1]  # after the "solving ..." line, if any
     assert last.startswith("Error: step_length = ") and words in last
-    assert "shorter step" in last or "needs step_length <" in last
+    assert ("shorter step" in last or "needs step_length <" in last
+            or "step_length_bounds" in last)
     assert "Traceback" not in result.output and not out.exists()
+
+
+def test_a_step_no_naive_start_can_place_is_one_line_naming_the_reach(tmp_path: Path) -> None:
+    """With the step bounds widened past the legs (0.7 m on 0.4 m legs), no naive start
+    places the legs: the refusal says so and what to change."""
+    options = GaitOptions(step_length=0.7, step_length_bounds=(0.02, 0.8))
+    with pytest.raises(GaitOptionsError) as info:
+        solve_gait(str(_short_legs(tmp_path)), options)
+    message = str(info.value)
+    assert message.startswith("step_length = ")
+    assert "every naive start puts a leg beyond its reach" in message
+    assert "shorter step" in message or "needs step_length <" in message
