@@ -396,3 +396,17 @@ def test_a_check_passes_only_within_its_limit() -> None:
     with pytest.raises(KeyError, match="unknown check id 'eom'"):
         Check("eom", 0.0, 1.0)
     assert Check("eom.residual", float("inf"), 1.0).to_dict()["value"] is None  # valid JSON
+
+
+def test_an_unbounded_joint_has_no_excess_over_its_limits(default_gait: Gait) -> None:
+    """A joint without limits (null in the model file: a URDF continuous joint or Inf limits)
+    is never beyond them: the bound checks report 0 for it, not an infinite excess."""
+    data = copy.deepcopy(default_gait.to_dict())
+    for link in data["model"]["links"]:
+        if link.get("joint") and link["joint"]["name"] == "hip_1":
+            link["joint"]["limits"] = [None, None]
+    gait = Gait.from_dict(data)
+    assert next(j for j in gait.model.joints if j.name == "hip_1").limits == (-np.inf, np.inf)
+    report = verify_gait(gait)
+    for key in ("bounds.joints_knots", "bounds.joints_samples"):
+        assert report.check(key).passed and np.isfinite(report.check(key).value), key

@@ -95,12 +95,15 @@ def _bounds(model: RobotModel, torso: tuple[float, float]) -> tuple[Array, Array
 
 def _starts(model: RobotModel, lo: Array, hi: Array) -> list[Array]:
     """Starting poses inside the box: every joint at 0, at the middle of its range, and at a
-    quarter and three quarters of it (clipped, finite)."""
+    quarter and three quarters of it (clipped, finite; an unbounded side of a joint's range
+    counts as -pi or pi, where a revolute joint has turned once)."""
     out = []
+    low = np.where(np.isfinite(lo), lo, np.minimum(-np.pi, hi))
+    high = np.where(np.isfinite(hi), hi, np.maximum(np.pi, lo))
     for frac in (None, 0.5, 0.25, 0.75):
         q = np.zeros(model.nq)
         if frac is not None:
-            q[3:] = lo[3:] + frac * (hi[3:] - lo[3:])
+            q[3:] = low[3:] + frac * (high[3:] - low[3:])
         q[2] = 0.0
         out.append(np.clip(q, np.where(np.isfinite(lo), lo, -1e9),
                            np.where(np.isfinite(hi), hi, 1e9)))

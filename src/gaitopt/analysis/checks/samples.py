@@ -124,17 +124,17 @@ def _bound_checks(gait: Gait, lim: dict[str, float]) -> list[Check]:
     torque, knots, between = Worst(), Worst(), Worst()
     for j, a in enumerate(model.actuators):
         lo, hi = a.limits
-        excess = np.maximum(s.u[:, j] - hi, lo - s.u[:, j])
+        excess = np.maximum(np.maximum(s.u[:, j] - hi, lo - s.u[:, j]), 0.0)  # unbounded: 0
         k = int(np.argmax(excess))
         torque = torque.update(excess[k], f"{a.name} sample {k}")
     for joint in model.joints:
         c = model.joint_coordinate(joint.name)
         lo, hi = joint.limits
         for i, ph in enumerate(gait.phases):
-            excess = np.maximum(ph.q[:, c] - hi, lo - ph.q[:, c])
+            excess = np.maximum(np.maximum(ph.q[:, c] - hi, lo - ph.q[:, c]), 0.0)
             k = int(np.argmax(excess))
             knots = knots.update(excess[k], f"{joint.name} phases[{i}] knot {k}")
-        excess = np.maximum(s.q[:, c] - hi, lo - s.q[:, c])
+        excess = np.maximum(np.maximum(s.q[:, c] - hi, lo - s.q[:, c]), 0.0)
         k = int(np.argmax(excess))
         between = between.update(excess[k], f"{joint.name} sample {k}")
     lowest = Worst(-np.inf)
