@@ -30,7 +30,16 @@ from dynamics_helpers import random_tree  # noqa: E402
 
 def _models() -> list[RobotModel]:
     return [load_model("five-link"), load_model("seven-link"), random_tree(3, n_links=7),
-            random_tree(11)]
+            random_tree(11), _point_masses()]
+
+
+def _point_masses() -> RobotModel:
+    """The kneed compass gait after Drake's: point-mass legs (inertia 0), which MuJoCo refuses
+    unless the export bounds them (BOUND_INERTIA)."""
+    from gaitopt.robot.urdf import import_urdf
+
+    path = Path(__file__).parent / "data" / "kneed_compass_gait.urdf"
+    return import_urdf(path).model
 
 
 @pytest.mark.parametrize("model", _models(), ids=lambda m: m.name)

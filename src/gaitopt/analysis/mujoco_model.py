@@ -137,7 +137,11 @@ def mujoco_robot(model: RobotModel, *, contact: MjcfContact | None = None,
     source = "gaitopt's MJCF export"
     if mjcf is None:
         text = mjcf_from_model(model, contact=contact)
-        mj = mujoco.MjModel.from_xml_string(text)
+        try:
+            mj = mujoco.MjModel.from_xml_string(text)
+        except ValueError as exc:
+            raise MujocoModelError(f"model {model.name!r}: MuJoCo refuses gaitopt's MJCF "
+                                   f"export: {' '.join(str(exc).split())}") from None
     else:
         path = Path(mjcf)
         source = str(path)

@@ -83,6 +83,12 @@ def _nums(values: tuple[float, ...]) -> str:
     return " ".join(_num(v) for v in values)
 
 
+#: The least mass (kg) and inertia (kg m^2) MuJoCo's compiler gives a body of the export
+#: (``<compiler boundmass boundinertia>``): MuJoCo refuses a moving body without either.
+BOUND_MASS = 1e-12
+BOUND_INERTIA = 1e-12
+
+
 def _xyz(p: tuple[float, float]) -> str:
     """A gaitopt point (x, y) in a link frame as MuJoCo ``pos`` (plane x-z, y = 0)."""
     return f"{_num(p[0])} 0.0 {_num(p[1])}"
@@ -120,7 +126,11 @@ def mjcf_from_model(model: RobotModel, *, contact: MjcfContact | None = None) ->
         "other hinge about -y (angles, limits and torques are gaitopt's). Contact spheres are "
         "centred at gaitopt's contact points and the ground plane is one radius below "
         "gaitopt's ground (z = -radius), so a sphere touches it when its point is at height 0. "))
-    ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
+    # MuJoCo refuses a moving body whose mass or inertia is 0 (a point mass, a massless link
+    # of a URDF import): the compiler raises those to BOUND_INERTIA (kg m^2) and BOUND_MASS
+    # (kg), far below any link's and below the dynamics tests' 1e-9.
+    ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true",
+                  boundmass=_num(BOUND_MASS), boundinertia=_num(BOUND_INERTIA))
     gx, gy = model.gravity
     ET.SubElement(root, "option", timestep=_num(c.timestep), integrator=c.integrator,
                   gravity=f"{_num(gx)} 0.0 {_num(gy)}")
