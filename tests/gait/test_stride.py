@@ -28,7 +28,9 @@ from gaitopt.robot import RobotModel, load_model, model_from_dict
 from gaitopt.robot.symmetry import contact_pairing, swap_matrices
 from tests.gait.conftest import SolveFn, recomputed_cost
 
-FULL = GaitOptions(formulation="full")
+#: Full coordinates on the one grid 16 + 6 per step (knots given: no refinement, so the step
+#: and the stride are compared on like grids).
+FULL = GaitOptions(formulation="full", knots=(16, 6))
 TIPS = {"tip_1": "tip_2", "tip_2": "tip_1"}
 
 

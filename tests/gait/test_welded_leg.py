@@ -31,7 +31,7 @@ def test_the_walk_of_a_kneed_compass_gait_with_a_welded_thigh(solved: SolveFn,
     """12 m/min, 16+6 knots, from the naive start: converged; the equations of motion hold
     (Pinocchio), the step is periodic through ``S_q`` (its base angle after the step is the
     other thigh's, ``base + hip``), the cost is the controls', verify passes."""
-    gait = solved(GaitOptions(formulation="full"), str(KCG)).gait
+    gait = solved(GaitOptions(formulation="full", knots=(16, 6)), str(KCG)).gait
     assert gait.success
     assert_physics(reference(gait.model), gait)
     state, _ = periodicity_errors(gait, controls=())

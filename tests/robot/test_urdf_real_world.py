@@ -65,7 +65,10 @@ def test_kneed_compass_gait_imports_with_the_published_numbers() -> None:
     assert any(line.startswith("warning: no effort on hip_pin, left_knee_pin, right_knee_pin")
                for line in lines)
     assert any(line.startswith("contacts: tip_1, tip_2 (inferred") for line in lines)
-    assert lines[-1].startswith("symmetry: none: the legs are not mirror images")
+    # The left thigh is welded to the hip: the swap pairs the hip (with that thigh) with the
+    # right thigh, a linear map of q (new base angle = base + hip), no permutation.
+    assert lines[-1].startswith("symmetry: hip <-> right_upper_leg, left_lower_leg <-> "
+                                "right_lower_leg, tip_1 <-> tip_2 (inferred")
 
 
 def pinocchio_kcg() -> tuple[object, object, np.ndarray]:
@@ -405,7 +408,7 @@ def test_cli_import_to_stdout_keeps_the_yaml_clean(tmp_path: Path) -> None:
     result = CliRunner().invoke(cli, ["model", "import", str(KCG), "-o", "-"])
     assert result.exit_code == 0
     assert model_from_yaml(result.stdout) == model_from_urdf(KCG)
-    assert "symmetry: none" in result.stderr
+    assert "symmetry: hip <-> right_upper_leg" in result.stderr
 
 
 def test_cli_refuses_a_singular_model_in_one_line(tmp_path: Path) -> None:
