@@ -108,8 +108,10 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
                                         wall_time_s=first.wall_time_s + retry.wall_time_s)
 
     def solve_on(finer: GaitOptions, before: WalkingSolution) -> WalkingSolution:
-        start = guess_from_gait(gait_from_solution(before))
-        again = solve_walking(robot, finer, warm_start=start, progress=progress,
+        # Started from the coarser grid's result (its interpolants at the finer knots): no
+        # gait record needed, so a coarse motion that leaves a leg's reach between knots is
+        # refined too.
+        again = solve_walking(robot, finer, warm_start=before.result, progress=progress,
                               compiled=compiled, check_warm_start=True)
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
