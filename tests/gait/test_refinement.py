@@ -148,3 +148,51 @@ def test_the_command_line_exits_3_when_the_accuracy_is_not_reached(tmp_path: Pat
     assert gait.solver["accuracy"]["refinements"] == MAX_ROUNDS
     verdict = CliRunner().invoke(cli, ["verify", str(out)])
     assert verdict.exit_code == 1 and "accuracy.estimate" in verdict.output
+
+
+# -- the slower default after a failed default-speed solve -----------------------------------
+
+def _fake_solves(monkeypatch: pytest.MonkeyPatch, fails_at: float) -> list[float]:
+    """api.solve_walking replaced by a fake that fails at speed ``fails_at``, succeeds
+    elsewhere; returns the list of speeds it was asked for."""
+    from gaitopt.gait import api
+
+    asked: list[float] = []
+
+    def fake(model: Any, options: GaitOptions, **_: Any) -> Any:
+        asked.append(float(options.speed))
+        ok = not math.isclose(options.speed, fails_at)
+        return FakeSolved(success=ok, options=options, stages=(f"at {options.speed}",))
+
+    monkeypatch.setattr(api, "solve_walking", fake)
+    monkeypatch.setattr(api, "refine_to_accuracy", lambda sol, **_: (sol, {}))
+    return asked
+
+
+@dataclasses.dataclass(frozen=True)
+class FakeSolved:
+    """What solve_gait_solution reads of a solve before the refinement."""
+
+    success: bool
+    options: GaitOptions
+    stages: tuple[str, ...]
+    wall_time_s: float = 1.0
+
+
+def test_a_failed_solve_at_the_default_speed_is_tried_at_the_walks_default(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    model = load_model("seven-link")
+    from gaitopt.gait.model_defaults import default_speed
+
+    heel_toe, walk = default_speed(model, "heel-toe"), default_speed(model, "walk")
+    asked = _fake_solves(monkeypatch, fails_at=heel_toe)
+    solution = solve_gait_solution(model, GaitOptions())
+    assert asked == [pytest.approx(heel_toe), pytest.approx(walk)]
+    assert solution.success and solution.options.speed == pytest.approx(walk)
+    assert solution.stages == (f"at {heel_toe}", f"at {walk}")  # both attempts kept
+
+
+def test_a_speed_the_caller_gave_is_not_changed(monkeypatch: pytest.MonkeyPatch) -> None:
+    asked = _fake_solves(monkeypatch, fails_at=1.2)
+    solution = solve_gait_solution(load_model("seven-link"), GaitOptions(speed=1.2))
+    assert asked == [1.2] and not solution.success
