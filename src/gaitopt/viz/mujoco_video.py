@@ -10,6 +10,7 @@ walks to the right as in gaitopt's figures), 3 m away. Frames are the simulation
 
 from __future__ import annotations
 
+import io
 import os
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,7 @@ from numpy.typing import NDArray
 from PIL import Image
 
 from gaitopt.analysis.checks.samples import points_function
+from gaitopt.fileio import write_bytes_atomic
 from gaitopt.gait.record import point_names
 from gaitopt.robot.model import RobotModel
 from gaitopt.viz.stick import draw_pose
@@ -45,10 +47,7 @@ def write_gif(mujoco: Any, mj: Any, qpos: NDArray[np.float64], path: str | os.Pa
             images.append(Image.fromarray(renderer.render()).quantize(colors=64))
     finally:
         renderer.close()
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    images[0].save(target, save_all=True, append_images=images[1:],
-                   duration=round(1000 / fps), loop=0, optimize=False)
+    _save_gif(images, path, fps)
     return len(images)
 
 
@@ -81,8 +80,16 @@ def write_stick_gif(model: RobotModel, q: NDArray[np.float64], path: str | os.Pa
         images.append(Image.fromarray(rgba[:, :, :3].copy()).quantize(colors=32))
         for line in lines.values():
             line.remove()
+    _save_gif(images, path, fps)
+    return len(images)
+
+
+def _save_gif(images: list[Image.Image], path: str | os.PathLike[str], fps: int) -> None:
+    """Write ``images`` as a looping GIF at ``fps`` frames per second, atomically (a reader
+    never sees a half-written file)."""
+    buffer = io.BytesIO()
+    images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:],
+                   duration=round(1000 / fps), loop=0, optimize=False)
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    images[0].save(target, save_all=True, append_images=images[1:],
-                   duration=round(1000 / fps), loop=0, optimize=False)
-    return len(images)
+    write_bytes_atomic(target, buffer.getvalue())
