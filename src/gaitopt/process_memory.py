@@ -40,14 +40,13 @@ def resident_bytes() -> int:
             pages = int(f.read().split()[1])
         return pages * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError, IndexError):
-        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-        return int(peak) if sys.platform == "darwin" else int(peak) * 1024  # bytes / KiB
+        return peak_resident_bytes()
 
 
 def peak_resident_bytes() -> int:
     """The largest resident set size this process has had, bytes (``getrusage``)."""
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return int(peak) if sys.platform == "darwin" else int(peak) * 1024
+    return int(peak) if sys.platform == "darwin" else int(peak) * 1024  # bytes / KiB
 
 
 def memory_budget_bytes() -> int:
