@@ -33,7 +33,7 @@ from gaitopt.gait.preflight import refuse_unwalkable
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.refinement import refine_to_accuracy
 from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
-from gaitopt.ocp import Guess, PhaseGuess, WarmStart
+from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
 
@@ -108,11 +108,13 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
                                         wall_time_s=first.wall_time_s + retry.wall_time_s)
 
     def solve_on(finer: GaitOptions, before: WalkingSolution) -> WalkingSolution:
-        # Started from the coarser grid's result (its interpolants at the finer knots): no
-        # gait record needed, so a coarse motion that leaves a leg's reach between knots is
-        # refined too.
-        again = solve_walking(robot, finer, warm_start=before.result, progress=progress,
-                              compiled=compiled, check_warm_start=True)
+        # Started from the check grid's result, which is the solution of this very NLP (the
+        # check grid of the coarser grid is the finer grid), values and multipliers: IPOPT
+        # confirms it in a few iterations. Without one, from the coarser grid's result (its
+        # interpolants at the finer knots): no gait record needed, so a coarse motion that
+        # leaves a leg's reach between knots is refined too.
+        again = solve_walking(robot, finer, warm_start=check_result(before) or before.result,
+                              progress=progress, compiled=compiled, check_warm_start=True)
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
 
@@ -122,6 +124,15 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     solution, _ = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
                                      accuracy_of=accuracy_record)
     return solution
+
+
+def check_result(solution: WalkingSolution) -> Result | None:
+    """The converged result of the solve's last ``check grid`` stage (the problem on the
+    check grid of its knots, :meth:`gaitopt.gait.solve._Run.check`), or None."""
+    for name, result in reversed(solution.stage_results):
+        if name.endswith("check grid"):
+            return result if result.success else None
+    return None
 
 
 def slower_default(model: RobotModel, options: GaitOptions) -> float | None:
