@@ -166,6 +166,11 @@ def _step_time(text: str) -> float | None:
 @resting_power_option
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="Weight of an added mean squared torque (u / u_max)^2 term.")
+@click.option("--torque-rate-time", type=click.FloatRange(min=0.0), default=0.0,
+              show_default=True,
+              help="Time tau in s of an added torque-rate term tau^2 int u'^2 dt in the cost "
+                   "(prices torque changes faster than about 1 / (2 pi tau) Hz; "
+                   "docs/feet.md).")
 @control_model_option(
               help="Controls continuous at the heel strike and periodic (paper), or free to "
                    "jump at both events (jumps).")
@@ -205,6 +210,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   free_fractions: bool, stride: bool,
                   gait_kind: str | None, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
+                  torque_rate_time: float,
                   control_model: str | None, mesh_tol: float | None, accuracy: float,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool | None,
@@ -238,7 +244,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses,
         cost=cost,  # type: ignore[arg-type]
-        cost_regularization=regularization,
+        cost_regularization=regularization, torque_rate_time=torque_rate_time,
         mesh_tol=mesh_tol, accuracy=accuracy, swing_clearance=clearance,
         clearance_profile=clearance_profile,  # type: ignore[arg-type]
         free_phase_fractions=free_fractions, stride=stride)

@@ -328,6 +328,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
             control_scales={n: PROJECTION_SCALE for n in proj},
+            control_rate_weights={a: r for a, r in cost.torque_rate_weights(
+                model, options).items() if a in acts},
             intervals=counts[len(phases)] - 1,
             knot_states=None if placed is None else KnotStates(
                 BASE_STATES, _placed_base(model, seq, placed, i_ph))))

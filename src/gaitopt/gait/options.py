@@ -212,6 +212,12 @@ class GaitOptions:
         cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs
             (default 0.01 W for 42 kg on 1 m legs, carried over as a power).
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
+        torque_rate_time: ``tau`` (s, >= 0) of an added torque-rate term ``tau^2 int sum
+            u'(t)^2 dt`` in the numerator of the paper's cost (the costs of transport: ``tau^2
+            W sqrt(g l) int sum (u' / u_max)^2 dt``; :func:`gaitopt.gait.cost.torque_rate_weights`).
+            It prices torque changes faster than about ``1 / (2 pi tau)`` Hz, as a muscle's
+            activation time or a motor's bandwidth does (default 0: none; docs/feet.md,
+            "Flapping feet", measures it against the seven-link model's flapping feet).
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, take every distinct coarse optimum through the
             remaining stages and keep the lowest final one (3-4x the time; a cold solve
@@ -286,6 +292,7 @@ class GaitOptions:
     resting_power: float = 1.2
     cost_smoothing: float = from_model(0.01)
     cost_regularization: float = 0.0
+    torque_rate_time: float = 0.0
     mesh_tol: float | None = None
     accuracy: float | None = 0.01
     control_model: ControlModel = "jumps"
@@ -389,7 +396,8 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
                                     ("efficiency_negative", o.efficiency_negative, 0.0, True),
                                     ("resting_power", o.resting_power, 0.0, False),
                                     ("cost_smoothing", o.cost_smoothing, 0.0, True),
-                                    ("cost_regularization", o.cost_regularization, 0.0, False)):
+                                    ("cost_regularization", o.cost_regularization, 0.0, False),
+                                    ("torque_rate_time", o.torque_rate_time, 0.0, False)):
         v = _finite(name, value)
         if v < lo or (strict and v == lo):
             raise GaitOptionsError(f"{name} = {v:g}: must be {'>' if strict else '>='} {lo:g}")

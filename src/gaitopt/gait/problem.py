@@ -226,6 +226,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         return {n: bounds[n] for n in names}
 
     paper_cost = options.cost == "paper" and options.cost_regularization == 0.0
+    rate_weights = cost.torque_rate_weights(model, options)
 
     def running(point: Callable[[Any, Any, Any], walking.PhasePoint],
                 controls: Sequence[str]) -> Callable[[Any, Any, Any, Any], Any]:
@@ -272,6 +273,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         duration=Duration.of_parameters(lambda p: f * p[_L] / p[_V]),
         state_bounds=state_bounds(ss_states), control_bounds=control_bounds(ss_controls),
         path_constraints=ss_path, lagrange=running(ss, ss_controls),
+        control_rate_weights={n: r for n, r in rate_weights.items() if n in ss_controls},
         intervals=options.knots[0] - 1)
 
     phases = [phase1]
@@ -352,6 +354,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             duration=Duration.of_parameters(lambda p: (1.0 - f) * p[_L] / p[_V]),
             state_bounds=state_bounds(ds_states), control_bounds=control_bounds(ds_controls),
             path_constraints=ds_path, lagrange=running(ds, ds_controls),
+            control_rate_weights={n: r for n, r in rate_weights.items() if n in ds_controls},
             intervals=options.knots[1] - 1)
         phases.append(phase2)
 

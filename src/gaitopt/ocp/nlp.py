@@ -37,7 +37,7 @@ from gaitopt.ocp.functions import (
 from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.mesh import Mesh
 from gaitopt.ocp.method import Method, midpoint_control
-from gaitopt.ocp.problem import Problem
+from gaitopt.ocp.problem import Phase, Problem
 
 Array = NDArray[np.float64]
 
@@ -272,6 +272,7 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
             rows.add(f"{ph.name}/duration", ph.name, "duration", ca.reshape(T, 1, 1), (1,),
                      np.array([spec.lower]), np.array([spec.upper]), np.array([sc]))
         numerator = numerator + ca.sum2(method.quadrature(L[:, :-1], L[:, 1:], L_m, h))
+        numerator = numerator + control_rate_term(ph, U, h)
         t_end = t_start + T
         if fold:  # the ends function computes the last knot's knot states itself
             folded_ends.append((ends_fn.ends_offsets[i] + 2 + n, pf))
@@ -300,6 +301,18 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
     return Assembly(w_hat, f_scaled, g_scaled, g, rows, numerator, den,
                     ca.vertcat(*durations), np.asarray(dependent_index, dtype=np.int64),
                     ca.vertcat(*dependent_values) if dependent_values else sym(0, 1))
+
+
+def control_rate_term(phase: Phase, U: Any, h: Any) -> Any:
+    """``sum_j r_j sum_k (U[j, k+1] - U[j, k])^2 / h_k``: the exact ``sum_j r_j int u_j'^2 dt``
+    of the piecewise-linear controls ``U`` (m, K) on intervals ``h`` (1, K - 1)
+    (:attr:`~gaitopt.ocp.problem.Phase.control_rate_weights`); 0 without weights."""
+    weights = phase.control_rate_weights
+    if not weights or U.shape[1] < 2:
+        return 0.0
+    r = ca.DM([float(weights.get(name, 0.0)) for name in phase.controls])
+    dU = U[:, 1:] - U[:, :-1]
+    return ca.sum2(ca.mtimes(r.T, dU * dU) / h)
 
 
 def _folded_knots(i: int, pf: PhaseFunction, pl: PhaseLayout, X: Any, U: Any, p: Any,
