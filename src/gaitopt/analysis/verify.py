@@ -39,6 +39,7 @@ from gaitopt.analysis.checks.events import event_checks
 from gaitopt.analysis.checks.integration import integration_checks
 from gaitopt.analysis.checks.knots import UnknownStatesError, knot_checks
 from gaitopt.analysis.checks.samples import sample_checks
+from gaitopt.analysis.checks.swing import swing_checks
 from gaitopt.gait.gait_file import Gait
 
 __all__ = ["CHECKS", "LIMITS", "Check", "CheckSpec", "UnknownStatesError", "VerifyReport",
@@ -90,7 +91,8 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
                          f"{tolerance_scale!r}")
     lim = {k: v * tolerance_scale for k, v in LIMITS.items()}
     checks = [*knot_checks(gait, lim), *integration_checks(gait, lim), *event_checks(gait, lim),
-              *sample_checks(gait, lim), _cost_check(gait, lim), _accuracy_check(gait, lim)]
+              *sample_checks(gait, lim), *swing_checks(gait, lim), _cost_check(gait, lim),
+              _accuracy_check(gait, lim)]
     order = list(CHECKS)
     return VerifyReport(tuple(sorted(checks, key=lambda c: order.index(c.id))))
 
