@@ -20,7 +20,11 @@ from gaitopt.gait.contact_sequence import (
 )
 from gaitopt.gait.full_physics import period_map
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.phase_fractions import with_first_fraction_bounds, with_free_fractions
+from gaitopt.gait.phase_fractions import (
+    with_first_fraction_bounds,
+    with_free_fractions,
+    with_shares,
+)
 from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.ocp import Bounds, Problem, Transcription
 from gaitopt.robot.biped import (
@@ -69,6 +73,8 @@ def contact_sequence(model: RobotModel, options: GaitOptions) -> ContactSequence
         seq = with_first_fraction_bounds(seq, options.single_support_fraction_bounds)
     if options.free_phase_fractions:
         seq = with_free_fractions(seq)
+    if options.phase_shares is not None:
+        seq = with_shares(seq, options.phase_shares)
     return seq
 
 

@@ -189,6 +189,12 @@ class GaitOptions:
             min(2 s, 0.95)]`` around its share ``s`` (which is its first guess); full
             formulation, two phases or more. Not with ``single_support_fraction_bounds``.
             See :func:`gaitopt.gait.phase_fractions.fraction_parameters`.
+        phase_shares: ``None``, or each phase's share of the step (one per phase of the
+            contact sequence, in (0, 1)): the first guess of the free fractions instead of the
+            sequence's own, and what the knots per phase follow
+            (:func:`gaitopt.gait.contact_sequence.phase_knots`). A refinement round of a
+            solve with free fractions sets it to the shares it solved for
+            (:mod:`gaitopt.gait.refinement`), so a phase that grew gets more knots.
         gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no
@@ -286,6 +292,7 @@ class GaitOptions:
     contact_sequence: dict[str, Any] | None = None
     single_support_fraction_bounds: tuple[float, float] | None = None
     free_phase_fractions: bool = False
+    phase_shares: tuple[float, ...] | None = None
     cost: CostName = "paper"
     efficiency_positive: float = 0.25
     efficiency_negative: float = 1.2
@@ -420,6 +427,10 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
         if o.single_support_fraction_bounds is not None:
             raise GaitOptionsError("free_phase_fractions and single_support_fraction_bounds: "
                                    "give one of them (free_phase_fractions frees every phase)")
+    if o.phase_shares is not None and not all(
+            isinstance(v, int | float) and 0.0 < float(v) < 1.0 for v in o.phase_shares):
+        raise GaitOptionsError(f"phase_shares = {tuple(o.phase_shares)!r}: each must lie in "
+                               "(0, 1)")
     if o.stride:
         if o.formulation != "full":
             raise GaitOptionsError("stride: a two-step stride needs formulation 'full' (the "
