@@ -106,7 +106,10 @@ def _runs(mask: NDArray[np.bool_]) -> list[NDArray[np.int64]]:
 def distal_joint(gait: Gait, leg: tuple[str, ...]) -> str:
     """The joint of the link carrying the leg's first contact point (module docstring)."""
     model = gait.model
-    return model.links[model.link_index(model.contact(leg[0]).link)].joint.name
+    joint = model.links[model.link_index(model.contact(leg[0]).link)].joint
+    if joint is None:  # a point on the base: no joint moves it
+        raise ValueError(f"contact {leg[0]!r} is on the base link: no distal joint")
+    return joint.name
 
 
 def swings(gait: Gait) -> tuple[Swing, ...]:
