@@ -30,7 +30,11 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from gaitopt.dynamics.backend import Scalar, as_scalars, sqrt
+from gaitopt.dynamics.kinematics import contact_velocity
+from gaitopt.dynamics.reduced import double_support_state
+from gaitopt.gait import walking
 from gaitopt.gait.contact_sequence import sequence_from_dict
+from gaitopt.gait.interpolation import phase_states_at
 from gaitopt.gait.model_scale import REFERENCE, ModelScale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot.model import RobotModel
@@ -174,10 +178,6 @@ def recompute_cost(gait: Any) -> float:
     sequence, not by the event's name; a heel-toe walk's impulse acts at ``toe_off``)."""
     import numpy as np
 
-    from gaitopt.dynamics.kinematics import contact_velocity
-    from gaitopt.gait import walking
-    from gaitopt.gait.interpolation import phase_states_at
-
     model = gait.model
     options = GaitOptions.from_dict(dict(gait.options))
     nq = model.nq
@@ -196,8 +196,6 @@ def recompute_cost(gait: Any) -> float:
             elif ph.name == walking.SINGLE:
                 qd_mid = np.asarray(walking.single_support_to_full(model, x_mid[k])[1], float)
             else:
-                from gaitopt.dynamics.reduced import double_support_state
-
                 z, zd = walking.split_state(x_mid[k], len(ph.state_names) // 2)
                 qd_mid = np.asarray(double_support_state(model, 0, z, zd, walking.ORIGIN,
                                                          (step, 0.0))[1], float)

@@ -24,6 +24,7 @@ from gaitopt.gait.formulation import contact_sequence
 from gaitopt.gait.gait_file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record_costates import solution_costates
+from gaitopt.gait.record_full import full_phases_and_events, full_samples
 from gaitopt.gait.solve import WalkingSolution
 from gaitopt.gait.transcriptions import disk_cached, function_file
 from gaitopt.gait.walking import DOUBLE, SINGLE
@@ -129,8 +130,6 @@ def gait_from_solution(solution: WalkingSolution) -> Gait:
     impulse = max(impulse, 0.0)
     traj = {ph.name: ph for ph in res.phases}
     if options.formulation == "full":
-        from gaitopt.gait.record_full import full_phases_and_events, full_samples
-
         total = sum(ph.duration for ph in res.phases)
         count = max(101, int(np.ceil(total * SAMPLE_RATE)) + 1)
         phase_records, events = full_phases_and_events(

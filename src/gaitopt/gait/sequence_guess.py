@@ -36,7 +36,14 @@ from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.dynamics.reduced import ReachError
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence
-from gaitopt.gait.guess import Array, PhaseGuess, WalkingGuess, _knots, _phase_guess, _smoothstep
+from gaitopt.gait.guess import (
+    Array,
+    PhaseGuess,
+    WalkingGuess,
+    knot_times,
+    phase_guess,
+    smoothstep,
+)
 from gaitopt.gait.model_scale import model_scale
 from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 
@@ -106,7 +113,7 @@ def _target(rows: list[tuple[float, float, float | None]], t: float, lift: float
         return None
     (_, ta, xa), (tb, _, xb) = before[-1], after[0]
     s = (t - ta) / (tb - ta)
-    x = None if xa is None or xb is None else xa + (xb - xa) * float(_smoothstep(np.array(s)))
+    x = None if xa is None or xb is None else xa + (xb - xa) * float(smoothstep(np.array(s)))
     return x, lift * float(np.sin(np.pi * s)), W_SWING
 
 
@@ -187,8 +194,8 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
             q_fine[k] = q
             _check_placed(model, ph.name, float(t), q, targets, step)
         count = knots[min(i, 1)]
-        phases.append(_phase_guess(model, ph.name, t_fine, q_fine,
-                                   _knots(float(ends[i]), float(ends[i + 1] - ends[i]), count),
-                                   ankle, use_ankles, list(ph.held), True))
+        phases.append(phase_guess(model, ph.name, t_fine, q_fine,
+                                  knot_times(float(ends[i]), float(ends[i + 1] - ends[i]), count),
+                                  ankle, use_ankles, list(ph.held), True))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})

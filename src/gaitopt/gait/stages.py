@@ -15,7 +15,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from gaitopt.gait.contact_sequence import sequence_from_dict
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.phase_fractions import free_phases
 from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, Relaxation, parameter_bounds
 from gaitopt.ocp import Bounds, Result, Transcription
 from gaitopt.robot.model import RobotModel
@@ -238,9 +240,6 @@ def frees_fractions(options: GaitOptions) -> bool:
         return True
     if options.contact_sequence is None:
         return False
-    from gaitopt.gait.contact_sequence import sequence_from_dict
-    from gaitopt.gait.phase_fractions import free_phases
-
     return bool(free_phases(sequence_from_dict(options.contact_sequence)))
 
 
