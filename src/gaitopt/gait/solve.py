@@ -67,18 +67,22 @@ import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
 from gaitopt.gait.check_grid import check_knots
-from gaitopt.gait.formulation import biped_for, checked_sequence, contact_sequence, stage_bounds
+from gaitopt.gait.formulation import (
+    biped_for,
+    checked_sequence,
+    contact_sequence,
+    formulation_of,
+    stage_bounds,
+)
 from gaitopt.gait.full_physics import period_map
 from gaitopt.gait.guess import (
     default_running_step,
     default_step_length,
-    naive_guess,
     naive_running_guess,
 )
 from gaitopt.gait.model_defaults import default_gait, default_speed, options_for_model
 from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.phase_fractions import fraction_parameters
 from gaitopt.gait.problem import (
     FRACTION,
     IMPULSE,
@@ -198,9 +202,7 @@ class _Run:
         #: Naive starts no leg could reach: (step length m, longest leg reach m, why).
         self.unplaced: list[tuple[float, float, str]] = []
         #: The free phase fractions' parameters -> first guesses (held by the cold stages).
-        self.fractions = ({fp.name: fp.guess for fp in
-                           fraction_parameters(contact_sequence(model, options))}
-                          if options.formulation == "full" else {})
+        self.fractions = formulation_of(options).fraction_guesses(model, options)
 
     def stage(self, name: str, knots: Grid, relax: Relaxation,
               guess: Guess | Result | WarmStart, bounds: dict[str, Any], *,
@@ -292,10 +294,10 @@ class _Run:
                         stance_fraction=o.single_support_fraction, knots=coarse,
                         ankle=o.ankle, r_max=r_max, ankle_torques=False)
                 else:
-                    guess = naive_guess(self.model, speed=speed, step_length=step0,
-                                        single_support_fraction=o.single_support_fraction,
-                                        knots=coarse, ankle=o.ankle, r_max=r_max,
-                                        ankle_torques=False, full=o.formulation == "full")
+                    guess = formulation_of(o).walk_guess(
+                        self.model, speed=speed, step_length=step0,
+                        single_support_fraction=o.single_support_fraction, knots=coarse,
+                        ankle=o.ankle, r_max=r_max, ankle_torques=False)
             except ReachError as exc:  # this start puts a leg beyond its reach: the next
                 self.unplaced.append((step0, r_max, str(exc)))
                 continue
