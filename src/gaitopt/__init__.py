@@ -19,7 +19,7 @@ import importlib
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, cast
 
-from gaitopt.views import GaitViews, install_gait_views
+from gaitopt import views as _views
 
 __version__ = "0.1.0"
 
@@ -52,13 +52,13 @@ if TYPE_CHECKING:
     from gaitopt.robot import ModelError, RobotModel, load_model
 
 
-def _notebook_views() -> GaitViews:
+def _notebook_views() -> _views.GaitViews:
     """:mod:`gaitopt.viz.notebook`, imported on a gait's first view (:mod:`gaitopt.views`)."""
     module: ModuleType = importlib.import_module("gaitopt.viz.notebook")
-    return cast(GaitViews, module)
+    return cast(_views.GaitViews, module)
 
 
-install_gait_views(_notebook_views)
+_views.install_gait_views(_notebook_views)
 
 
 def __getattr__(name: str) -> Any:
