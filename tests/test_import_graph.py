@@ -57,8 +57,6 @@ DEFERRED: dict[tuple[str, str], str] = {
         "``from gaitopt import GaitOptions`` loads no CasADi (gaitopt.dynamics' package does)",
     ("gaitopt.gait.interpolation", "gaitopt.ocp.hermite_simpson"):
         "reading and drawing a gait file loads no CasADi (gaitopt.ocp's package does)",
-    ("gaitopt.gait.solve", "gaitopt.gait.sequence_guess"):
-        "the paper's walk never loads SciPy's optimizer (0.8 s to import)",
 }
 
 

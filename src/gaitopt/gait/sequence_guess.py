@@ -30,7 +30,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.dynamics.reduced import ReachError
@@ -142,6 +141,10 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     knots of phase ``i`` are ``knots[min(i, 1)]``, as in the full-coordinate problem) over
     its period ``seq.steps L / v``; ``swap``: the contact renaming from the end of the period
     to its start (:meth:`ContactSequence.period_contacts` applies: none for a stride)."""
+    # Imported here: SciPy's optimizer takes 0.8 s to import, and the paper's walk, which
+    # imports this module with the staged solve, never calls it.
+    from scipy.optimize import least_squares
+
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
     v, step = speed, step_length
     swap = seq.period_contacts(swap)

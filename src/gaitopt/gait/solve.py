@@ -92,6 +92,7 @@ from gaitopt.gait.problem import (
     parameter_bounds,
     with_step_time,
 )
+from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.gait.solution import (
     ProgressFn,
     StageReport,
@@ -279,10 +280,6 @@ class _Run:
         for step0 in steps:
             try:
                 if generic:
-                    # Imported here: it needs SciPy's optimizer (0.8 s to import), which the
-                    # paper's walk never uses.
-                    from gaitopt.gait.sequence_guess import sequence_guess
-
                     seq = contact_sequence(self.model, o)
                     guess = sequence_guess(self.model, seq,
                                            period_map(self.model, seq).contacts, speed=speed,
