@@ -5,7 +5,7 @@
 :mod:`gaitopt.gait.record_reduced`) or full coordinates on a contact sequence (:data:`FULL`:
 :mod:`gaitopt.gait.full_coordinates`, :mod:`gaitopt.gait.record_full`). Each is a
 :class:`Formulation`: its legs, its checked contact sequence, its problem, the bounds of a
-stage, the free phase fractions' first guesses, the naive guess of a walk, the record of a
+stage, the free phase fractions' first guesses, the naive guess of a cold start, the record of a
 solution, and its :class:`~gaitopt.gait.formulation_traits.FormulationTraits` (what it supports,
 how its stages are tuned). :func:`formulation_of` is the one place that picks it by name; the
 staged solve (:mod:`gaitopt.gait.solve`), the stages, the record and the command line ask the
@@ -16,7 +16,7 @@ This is the only module that imports both formulations.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +34,7 @@ from gaitopt.gait.formulation_traits import FULL as FULL_TRAITS
 from gaitopt.gait.formulation_traits import REDUCED as REDUCED_TRAITS
 from gaitopt.gait.formulation_traits import FormulationTraits
 from gaitopt.gait.full_physics import period_map
-from gaitopt.gait.guess import WalkingGuess, naive_guess
+from gaitopt.gait.guess import WalkingGuess, naive_guess, naive_running_guess
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.gait.phase_fractions import (
     fraction_parameters,
@@ -45,6 +45,7 @@ from gaitopt.gait.problem import Relaxation, relaxed_bounds, walking_problem
 from gaitopt.gait.record_full import full_record
 from gaitopt.gait.record_points import RecordParts
 from gaitopt.gait.record_reduced import reduced_record
+from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.gait.solution import WalkingSolution
 from gaitopt.ocp import Bounds, Problem, Transcription
 from gaitopt.robot.biped import (
@@ -88,9 +89,15 @@ class Formulation(Protocol):
         """The free phase fractions' parameters -> first guesses (empty: none is free)."""
         ...
 
-    def walk_guess(self, model: RobotModel, **kwargs: Any) -> WalkingGuess:
-        """The naive guess of the two-phase walk (:func:`gaitopt.gait.guess.naive_guess`'s
-        keywords but ``full``) in this formulation's states."""
+    def cold_guess(self, model: RobotModel, options: GaitOptions, *, speed: float,
+                   step_length: float, knots: tuple[int, int], r_max: float) -> WalkingGuess:
+        """The naive guess a cold solve starts from at ``speed`` and ``step_length`` on the
+        coarse grid ``knots``, the ankle torques zero; ``r_max`` (m) the legs' reach.
+
+        Raises:
+            ReachError: the guess puts a leg beyond its reach (the solve tries the next
+                step length).
+        """
         ...
 
     def record(self, solution: WalkingSolution,
@@ -122,8 +129,13 @@ class Reduced:
     def fraction_guesses(self, model: RobotModel, options: GaitOptions) -> dict[str, float]:
         return {}
 
-    def walk_guess(self, model: RobotModel, **kwargs: Any) -> WalkingGuess:
-        return naive_guess(model, **kwargs, full=False)
+    def cold_guess(self, model: RobotModel, options: GaitOptions, *, speed: float,
+                   step_length: float, knots: tuple[int, int], r_max: float) -> WalkingGuess:
+        """The geometric walk (:func:`gaitopt.gait.guess.naive_guess`) in reduced states."""
+        return naive_guess(model, speed=speed, step_length=step_length,
+                           single_support_fraction=options.single_support_fraction,
+                           knots=knots, ankle=options.ankle, r_max=r_max, ankle_torques=False,
+                           full=False)
 
     def record(self, solution: WalkingSolution,
                costates: Callable[[], Mapping[str, Array]]) -> RecordParts:
@@ -165,8 +177,27 @@ class Full:
         return {fp.name: fp.guess
                 for fp in fraction_parameters(contact_sequence(model, options))}
 
-    def walk_guess(self, model: RobotModel, **kwargs: Any) -> WalkingGuess:
-        return naive_guess(model, **kwargs, full=True)
+    def cold_guess(self, model: RobotModel, options: GaitOptions, *, speed: float,
+                   step_length: float, knots: tuple[int, int], r_max: float) -> WalkingGuess:
+        """A model without thigh-shank legs, a heel-toe walk, a given sequence or a stride:
+        :func:`gaitopt.gait.sequence_guess.sequence_guess` on the contact sequence; a run:
+        :func:`gaitopt.gait.guess.naive_running_guess`; else the geometric walk
+        (:func:`gaitopt.gait.guess.naive_guess`) in ``[q, qd]``."""
+        o = options
+        if (self.biped(model) is None or o.gait == "heel-toe"
+                or o.contact_sequence is not None or o.stride):
+            seq = contact_sequence(model, o)
+            return sequence_guess(model, seq, period_map(model, seq).contacts, speed=speed,
+                                  step_length=step_length, knots=knots, ankle=o.ankle,
+                                  ankle_torques=False)
+        if o.gait == "run":
+            return naive_running_guess(model, speed=speed, step_length=step_length,
+                                       stance_fraction=o.single_support_fraction,
+                                       knots=knots, ankle=o.ankle, r_max=r_max,
+                                       ankle_torques=False)
+        return naive_guess(model, speed=speed, step_length=step_length,
+                           single_support_fraction=o.single_support_fraction, knots=knots,
+                           ankle=o.ankle, r_max=r_max, ankle_torques=False, full=True)
 
     def record(self, solution: WalkingSolution,
                costates: Callable[[], Mapping[str, Array]]) -> RecordParts:

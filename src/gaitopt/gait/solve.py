@@ -70,15 +70,12 @@ from gaitopt.gait.check_grid import check_knots
 from gaitopt.gait.formulation import (
     biped_for,
     checked_sequence,
-    contact_sequence,
     formulation_of,
     stage_bounds,
 )
-from gaitopt.gait.full_physics import period_map
 from gaitopt.gait.guess import (
     default_running_step,
     default_step_length,
-    naive_running_guess,
 )
 from gaitopt.gait.model_defaults import default_gait, default_speed, options_for_model
 from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
@@ -92,7 +89,6 @@ from gaitopt.gait.problem import (
     parameter_bounds,
     with_step_time,
 )
-from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.gait.solution import (
     ProgressFn,
     StageReport,
@@ -261,9 +257,8 @@ class _Run:
         """The converged results of :meth:`cold`'s naive guesses: the first one, or with
         ``every_start`` all of them."""
         o, coarse = self.options, coarse_knots(self.options)
-        biped = biped_for(self.model, o)
-        generic = (biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
-                   or o.stride)
+        formulation = formulation_of(o)
+        biped = formulation.biped(self.model)
         r_max = (0.0 if biped is None else
                  min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
         held = {spec.frees for spec in RELEASES if spec.frees and spec.runs(o)}
@@ -279,22 +274,8 @@ class _Run:
         found: list[Result] = []
         for step0 in steps:
             try:
-                if generic:
-                    seq = contact_sequence(self.model, o)
-                    guess = sequence_guess(self.model, seq,
-                                           period_map(self.model, seq).contacts, speed=speed,
-                                           step_length=step0, knots=coarse, ankle=o.ankle,
-                                           ankle_torques=False)
-                elif o.gait == "run":
-                    guess = naive_running_guess(
-                        self.model, speed=speed, step_length=step0,
-                        stance_fraction=o.single_support_fraction, knots=coarse,
-                        ankle=o.ankle, r_max=r_max, ankle_torques=False)
-                else:
-                    guess = formulation_of(o).walk_guess(
-                        self.model, speed=speed, step_length=step0,
-                        single_support_fraction=o.single_support_fraction, knots=coarse,
-                        ankle=o.ankle, r_max=r_max, ankle_torques=False)
+                guess = formulation.cold_guess(self.model, o, speed=speed, step_length=step0,
+                                               knots=coarse, r_max=r_max)
             except ReachError as exc:  # this start puts a leg beyond its reach: the next
                 self.unplaced.append((step0, r_max, str(exc)))
                 continue
