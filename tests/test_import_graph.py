@@ -55,8 +55,6 @@ ROOT_CONSTANTS: frozenset[str] = frozenset({"__version__"})
 DEFERRED: dict[tuple[str, str], str] = {
     ("gaitopt.gait.options", "gaitopt.gait.contact_sequence"):
         "``from gaitopt import GaitOptions`` loads no CasADi (gaitopt.dynamics' package does)",
-    ("gaitopt.gait.interpolation", "gaitopt.ocp.hermite_simpson"):
-        "reading and drawing a gait file loads no CasADi (gaitopt.ocp's package does)",
 }
 
 
