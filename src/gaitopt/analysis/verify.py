@@ -40,7 +40,9 @@ from gaitopt.analysis.checks.integration import integration_checks
 from gaitopt.analysis.checks.knots import UnknownStatesError, knot_checks
 from gaitopt.analysis.checks.samples import sample_checks
 from gaitopt.analysis.checks.swing import swing_checks
+from gaitopt.gait.cost import recompute_cost
 from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.refinement import worst_estimate
 
 __all__ = ["CHECKS", "LIMITS", "Check", "CheckSpec", "UnknownStatesError", "VerifyReport",
            "verify_gait"]
@@ -98,8 +100,6 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
 
 
 def _cost_check(gait: Gait, lim: dict[str, float]) -> Check:
-    from gaitopt.gait.cost import recompute_cost
-
     cost = recompute_cost(gait)
     saved = gait.cost_value
     rel = abs(cost - saved) / max(abs(saved), 1e-12)
@@ -114,7 +114,6 @@ def _accuracy_check(gait: Gait, lim: dict[str, float]) -> Check:
     (:func:`gaitopt.gait.refinement.worst_estimate`) against the accuracy it was asked to
     reach (``solver.accuracy.target``, scaled like every limit). A gait solved on a grid the
     caller chose has no target: the estimate is reported and the check passes."""
-    from gaitopt.gait.refinement import worst_estimate
 
     record = gait.solver.get("accuracy") or {}
     target = record.get("target")

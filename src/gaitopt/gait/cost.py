@@ -32,8 +32,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from gaitopt.dynamics.backend import Scalar, as_scalars, sqrt
+from gaitopt.dynamics.kinematics import contact_velocity
+from gaitopt.dynamics.reduced import double_support_state
+from gaitopt.gait import walking
 from gaitopt.gait.contact_sequence import sequence_from_dict
+from gaitopt.gait.interpolation import phase_states_at
 from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot.model import RobotModel
@@ -96,8 +102,6 @@ def torque_rate_cost(model: RobotModel, options: GaitOptions, t: Any, u: Any) ->
     """``sum_a r_a sum_k (u[k+1, a] - u[k, a])^2 / (t[k+1] - t[k])``: the exact
     :func:`torque_rate_weights` term of one phase's piecewise-linear torques ``u`` (K, n_a;
     N m) at knot times ``t`` (K,; s); 0 without weights."""
-    import numpy as np
-
     weights = torque_rate_weights(model, options)
     if not weights or len(t) < 2:
         return 0.0
@@ -212,12 +216,6 @@ def recompute_cost(gait: Any) -> float:
     piecewise-linear torques. The impulse term of the costs of transport is the work of every
     event that applies the liftoff impulse (:func:`impulse_events`: by the file's contact
     sequence, not by the event's name; a heel-toe walk's impulse acts at ``toe_off``)."""
-    import numpy as np
-
-    from gaitopt.dynamics.kinematics import contact_velocity
-    from gaitopt.gait import walking
-    from gaitopt.gait.interpolation import phase_states_at
-
     model = gait.model
     options = GaitOptions.from_dict(dict(gait.options))
     nq = model.nq
@@ -236,8 +234,6 @@ def recompute_cost(gait: Any) -> float:
             elif ph.name == walking.SINGLE:
                 qd_mid = np.asarray(walking.single_support_to_full(model, x_mid[k])[1], float)
             else:
-                from gaitopt.dynamics.reduced import double_support_state
-
                 z, zd = walking.split_state(x_mid[k], len(ph.state_names) // 2)
                 qd_mid = np.asarray(double_support_state(model, 0, z, zd, walking.ORIGIN,
                                                          (step, 0.0))[1], float)

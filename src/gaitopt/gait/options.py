@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Literal, TypeVar, cast
 
+from gaitopt.gait.formulation_traits import FORMULATION_TRAITS
 from gaitopt.robot.biped import Biped
 from gaitopt.units import format_speed
 
@@ -34,7 +35,7 @@ GaitKind = Literal["walk", "run", "heel-toe"]
 #: The built-in gaits (``GaitOptions.gait``).
 GAITS = ("walk", "run", "heel-toe")
 CostName = Literal["paper", "work", "metabolic"]
-FORMULATIONS: tuple[str, ...] = ("reduced", "full")
+FORMULATIONS: tuple[str, ...] = tuple(FORMULATION_TRAITS)
 ControlModel = Literal["paper", "jumps"]
 #: The control models (see ``docs/walking.md``, "Control model").
 CONTROL_MODELS = ("paper", "jumps")
@@ -397,6 +398,7 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
     if o.formulation not in FORMULATIONS:
         raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
                                f"{', '.join(FORMULATIONS)}")
+    traits = FORMULATION_TRAITS[o.formulation]
     if o.cost not in ("paper", "work", "metabolic"):
         raise GaitOptionsError(f"cost = {o.cost!r}: must be one of paper, work, metabolic")
     for name, value, lo, strict in (("efficiency_positive", o.efficiency_positive, 0.0, True),
@@ -410,7 +412,7 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
             raise GaitOptionsError(f"{name} = {v:g}: must be {'>' if strict else '>='} {lo:g}")
     if o.single_support_fraction_bounds is not None:
         f_lo, f_hi = _bounds("single_support_fraction_bounds", o.single_support_fraction_bounds)
-        if o.formulation != "full":
+        if not traits.contact_sequences:
             raise GaitOptionsError("single_support_fraction_bounds: a free single-support "
                                    "fraction needs formulation 'full'")
         if f_lo < 0.05 or f_hi >= 1.0:
@@ -421,7 +423,7 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
                                    f"must lie in single_support_fraction_bounds "
                                    f"[{f_lo:g}, {f_hi:g}] (it is the first guess)")
     if o.free_phase_fractions:
-        if o.formulation != "full":
+        if not traits.contact_sequences:
             raise GaitOptionsError("free_phase_fractions: free phase fractions need "
                                    "formulation 'full'")
         if o.single_support_fraction_bounds is not None:
@@ -432,7 +434,7 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
         raise GaitOptionsError(f"phase_shares = {tuple(o.phase_shares)!r}: each must lie in "
                                "(0, 1)")
     if o.stride:
-        if o.formulation != "full":
+        if not traits.contact_sequences:
             raise GaitOptionsError("stride: a two-step stride needs formulation 'full' (the "
                                    "reduced coordinates describe one step of the five-link "
                                    "biped, periodic through the leg swap)")
@@ -442,7 +444,7 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
                                    "both steps)")
     if o.gait not in GAITS:
         raise GaitOptionsError(f"gait = {o.gait!r}: must be one of {', '.join(GAITS)}")
-    if (o.gait == "heel-toe" or o.contact_sequence is not None) and o.formulation != "full":
+    if (o.gait == "heel-toe" or o.contact_sequence is not None) and not traits.contact_sequences:
         raise GaitOptionsError("gait = 'heel-toe' and contact_sequence need formulation "
                                "'full'")
     if o.contact_sequence is not None:
@@ -452,16 +454,16 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
             sequence_from_dict(o.contact_sequence)
         except ContactSequenceError as exc:
             raise GaitOptionsError(str(exc)) from None
-    if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0
+    if o.gait == "run" and (not traits.contact_sequences or o.single_support_fraction >= 1.0
                             or o.impulse):
         raise GaitOptionsError(
             "gait = 'run': needs formulation 'full', single_support_fraction < 1 (the stance "
             "share of the step) and impulse off (no liftoff impulse in a run)")
     flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
-    if o.formulation == "full" and not 0.0 <= flex < 1.5:
+    if traits.straight_stance_knee and not 0.0 <= flex < 1.5:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in [0, 1.5) "
                                "(full formulation)")
-    if o.formulation == "reduced" and not 0.0 < flex < 1.5:
+    if not traits.straight_stance_knee and not 0.0 < flex < 1.5:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5) "
                                "in the reduced formulation (its leg inverse kinematics is "
                                "singular at a straight knee; formulation 'full' allows 0)")

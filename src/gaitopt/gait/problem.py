@@ -29,6 +29,7 @@ import casadi as ca
 import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
+from gaitopt.dynamics.kinematics import contact_velocity, point_position
 from gaitopt.gait import cost, walking
 from gaitopt.gait.model_scale import ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions
@@ -283,7 +284,6 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     def landing(ends: Mapping[str, Any], p: Any) -> Any:
         q, _ = walking.single_support_to_full(model, ends[SINGLE].xf)
         c = model.contact(swing.contact)
-        from gaitopt.dynamics.kinematics import point_position
 
         tip = as_scalars(point_position(model, q, c.link, model.link(c.link).local_point(*c.at)),
                          2, "tip")
@@ -416,7 +416,6 @@ def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition
                  magnitude: Any) -> Any:
     """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
     lifting = reduced_biped(model).stance.contact
-    from gaitopt.dynamics.kinematics import contact_velocity
 
     v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
     return cost.impulse_cost(model, options, tr.impulses[lifting], v_after, magnitude)

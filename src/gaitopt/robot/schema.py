@@ -51,6 +51,7 @@ from gaitopt.robot.model import (
     Shape,
     SymmetrySpec,
 )
+from gaitopt.robot.symmetry import SymmetryError, swap_matrices
 
 DEFAULT_GRAVITY: tuple[float, float] = (0.0, -9.81)
 
@@ -116,8 +117,6 @@ class _Validator(FieldReader):
                            gravity=gravity, description=description, symmetry=symmetry)
         check_positive_definite(model, source=self.source)
         if symmetry is not None:
-            from gaitopt.robot.symmetry import SymmetryError, swap_matrices
-
             try:
                 swap_matrices(model)
             except SymmetryError as exc:
