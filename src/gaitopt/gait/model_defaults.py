@@ -18,6 +18,8 @@ marked with the model's value, so ``GaitOptions()`` means the same problem from 
   ``cost_smoothing``: the reference biped's values carried over by
   :class:`~gaitopt.gait.model_scale.ModelScale` (speeds by ``sqrt(g l)``, lengths by ``l``,
   rates by ``sqrt(g / l)``, impulses by ``m sqrt(g l)``, powers by ``m g sqrt(g l)``).
+* a run's stance share, free within :data:`RUN_STANCE_BOUNDS`, and its step length bounds,
+  :data:`RUN_STEP_LENGTH_BOUNDS` (docs/running.md); every other gait's fraction 0.85.
 
 For the five-link biped every resolved value equals the marked one exactly.
 """
@@ -45,6 +47,20 @@ MULTI_PHASE_KNOTS = (24, 16)
 #: of the default grid is 0.00-0.03 %; at 12 and 30 m/min it is 34 % and 18 %,
 #: docs/walking.md "Defaults that follow the model"), the run the walk's.
 DEFAULT_SPEEDS: dict[str, float] = {"walk": 0.2, "run": 0.2, "heel-toe": 1.25}
+
+#: A run's stance share (``single_support_fraction``: the stance phase's share of the step
+#: time) is free by default within these bounds (``single_support_fraction_bounds``), unless
+#: the caller gives the fraction, its bounds, ``free_phase_fractions`` or a stride: people's
+#: duty factor of 0.25-0.45 (stance per stride) is a stance share of 0.5-0.9 of a step, and
+#: the bounds leave the optimum room on both sides (docs/running.md).
+RUN_STANCE_BOUNDS = (0.2, 0.95)
+#: The first guess of a run's free stance share (the coarse stages hold it there until the
+#: fractions are released): people's at running speeds (duty factor 0.35).
+RUN_STANCE_GUESS = 0.7
+#: A run's step length bounds on the reference biped (legs of 1 m; times ``l / 1 m``): a
+#: flight carries the step beyond the legs' reach (people take 1.2-1.6 m steps at 240 m/min
+#: on 0.9 m legs), where the walk's 0.8 m would cap it.
+RUN_STEP_LENGTH_BOUNDS = (0.02, 3.0)
 
 
 def legs_contacts(model: RobotModel) -> tuple[tuple[str, ...], ...]:
@@ -118,6 +134,21 @@ def _phase_count(options: GaitOptions, gait: str) -> int:
     return 4 if gait == "heel-toe" else 2
 
 
+def _stance_share(options: GaitOptions, run: bool) -> dict[str, Any]:
+    """The fraction left to the model: a run's free within :data:`RUN_STANCE_BOUNDS` (its
+    guess :data:`RUN_STANCE_GUESS`, within given bounds), any other gait's 0.85."""
+    o = options
+    if not run:
+        return {"single_support_fraction": float(o.single_support_fraction)}
+    if o.single_support_fraction_bounds is not None:
+        lo, hi = o.single_support_fraction_bounds
+        return {"single_support_fraction": min(max(RUN_STANCE_GUESS, lo), hi)}
+    if o.free_phase_fractions or o.stride:
+        return {"single_support_fraction": RUN_STANCE_GUESS}
+    return {"single_support_fraction": RUN_STANCE_GUESS,
+            "single_support_fraction_bounds": RUN_STANCE_BOUNDS}
+
+
 def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
     """``options`` with every default that follows the model (module docstring) replaced by
     the model's value; the values the caller gave stay.
@@ -160,7 +191,10 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
     if follows_model(o.speed_bounds):
         changes["speed_bounds"] = tuple(scale.speed(v) for v in o.speed_bounds)
     if follows_model(o.step_length_bounds):
-        changes["step_length_bounds"] = tuple(scale.length(v) for v in o.step_length_bounds)
+        bounds = RUN_STEP_LENGTH_BOUNDS if gait == "run" and not custom else o.step_length_bounds
+        changes["step_length_bounds"] = tuple(scale.length(v) for v in bounds)
+    if follows_model(o.single_support_fraction):
+        changes |= _stance_share(o, gait == "run" and not custom)
     if follows_model(o.rate_bound):
         changes["rate_bound"] = scale.rate(o.rate_bound)
     if follows_model(o.max_impulse):
