@@ -105,15 +105,16 @@ def default_gait(model: RobotModel) -> str:
 
 def gait_problem(model: RobotModel, gait: str) -> str | None:
     """Why ``model`` cannot do the built-in ``gait`` (one line naming the gait it can), or
-    None if it can (the walk and the run need one point per leg, the heel-toe walk two) or
+    None if it can (the walk needs one point per leg, the heel-toe walk two, the run either:
+    on feet it runs on the toes) or
     if no built-in gait fits (the gait's own checks then name what the model lacks)."""
     try:
         allowed = default_gait(model)
     except GaitOptionsError:
         return None
-    if gait == allowed or (gait == "run" and allowed == "walk"):
-        return None
-    also = " or 'run'" if allowed == "walk" else ""
+    if gait in (allowed, "run"):
+        return None  # a run stands on one point per leg, or on the toes of feet
+    also = " or 'run'"
     return (f"gait = {gait!r}: {_describe(model)}: use gait {allowed!r}{also} "
             f"(--gait {allowed}, the default)")
 
