@@ -17,10 +17,10 @@ from gaitopt.gait.builtin_sequences import running_sequence
 from gaitopt.gait.formulation import biped_for
 from gaitopt.gait.model_defaults import (
     RUN_STANCE_BOUNDS,
-    RUN_STANCE_GUESS,
     RUN_STEP_LENGTH_BOUNDS,
     gait_problem,
     options_for_model,
+    run_stance_guess,
 )
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import load_model
@@ -85,7 +85,7 @@ def test_the_cli_refuses_bad_speed_bounds_and_an_impulse_in_a_run() -> None:
 
 def test_a_run_frees_its_stance_share_and_lengthens_its_steps() -> None:
     run = _resolved("five-link", GaitOptions(gait="run", impulse=False, speed=2.5))
-    assert run.single_support_fraction == RUN_STANCE_GUESS
+    assert run.single_support_fraction == run_stance_guess(load_model("five-link"), 2.5)
     assert run.single_support_fraction_bounds == RUN_STANCE_BOUNDS
     assert run.step_length_bounds == pytest.approx(RUN_STEP_LENGTH_BOUNDS, rel=1e-12)
     assert run.formulation == "full"
@@ -102,6 +102,16 @@ def test_a_run_frees_its_stance_share_and_lengthens_its_steps() -> None:
     assert walk.single_support_fraction == 0.85
     assert walk.single_support_fraction_bounds is None
     assert walk.step_length_bounds == pytest.approx((0.02, 0.8), rel=1e-12)
+
+
+def test_the_stance_share_guess_falls_with_the_froude_number() -> None:
+    five, adult = load_model("five-link"), load_model("adult-point-feet")
+    assert run_stance_guess(five, 1.0) == 0.9  # a walk's Froude number: the upper clip
+    assert run_stance_guess(five, 2.0) == pytest.approx(0.95 - 0.3 * 4.0 / 9.81, rel=1e-12)
+    assert run_stance_guess(five, 20.0) == 0.4
+    assert run_stance_guess(adult, 2.5) > run_stance_guess(adult, 4.0)
+    speed_free = _resolved("five-link", GaitOptions(gait="run", impulse=False, speed=None))
+    assert speed_free.single_support_fraction == run_stance_guess(five, 0.2)
 
 
 def test_a_run_with_the_impulse_on_is_refused_by_name() -> None:

@@ -54,9 +54,13 @@ DEFAULT_SPEEDS: dict[str, float] = {"walk": 0.2, "run": 0.2, "heel-toe": 1.25}
 #: duty factor of 0.25-0.45 (stance per stride) is a stance share of 0.5-0.9 of a step, and
 #: the bounds leave the optimum room on both sides (docs/running.md).
 RUN_STANCE_BOUNDS = (0.2, 0.95)
-#: The first guess of a run's free stance share (the coarse stages hold it there until the
-#: fractions are released): people's at running speeds (duty factor 0.35).
-RUN_STANCE_GUESS = 0.7
+#: The first guess of a run's free stance share is ``clip(a - b Fr, lo, hi)`` with
+#: ``(a, b, lo, hi)`` these numbers and ``Fr = v^2 / (g l)`` the Froude number of the speed
+#: (:func:`run_stance_guess`): the coarse stages hold the share at its guess until the
+#: fractions are released, and from a guess far from the optimum they fail first (the
+#: five-link run at 120 m/min fails from 0.7 and converges from 0.83 or 0.9). The optima
+#: measured in docs/running.md: 0.95 (the bound) at Fr 0.1-0.25, 0.73 at 0.69, 0.48 at 1.76.
+RUN_STANCE_GUESS = (0.95, 0.3, 0.4, 0.9)
 #: A run's step length bounds on the reference biped (legs of 1 m; times ``l / 1 m``): a
 #: flight carries the step beyond the legs' reach (people take 1.2-1.6 m steps at 240 m/min
 #: on 0.9 m legs), where the walk's 0.8 m would cap it.
@@ -135,18 +139,30 @@ def _phase_count(options: GaitOptions, gait: str) -> int:
     return 4 if gait == "heel-toe" else 2
 
 
-def _stance_share(options: GaitOptions, run: bool) -> dict[str, Any]:
-    """The fraction left to the model: a run's free within :data:`RUN_STANCE_BOUNDS` (its
-    guess :data:`RUN_STANCE_GUESS`, within given bounds), any other gait's 0.85."""
+def run_stance_guess(model: RobotModel, speed: float) -> float:
+    """The first guess of a run's stance share at ``speed`` (m/s) on ``model``
+    (:data:`RUN_STANCE_GUESS`: 0.9 at a walk's Froude numbers, 0.74 at 150 m/min and 0.42
+    at 240 m/min on 0.93 m legs)."""
+    a, b, lo, hi = RUN_STANCE_GUESS
+    scale = model_scale(model)
+    froude = speed * speed / (scale.gravity * scale.leg_length)
+    return min(max(a - b * froude, lo), hi)
+
+
+def _stance_share(options: GaitOptions, guess: float | None) -> dict[str, Any]:
+    """The fraction left to the model: a run's (``guess`` given) free within
+    :data:`RUN_STANCE_BOUNDS` from ``guess`` (moved into bounds the caller gave; fixed at it
+    with ``free_phase_fractions`` or a stride, which free it their own way or not at all),
+    any other gait's 0.85."""
     o = options
-    if not run:
+    if guess is None:
         return {"single_support_fraction": float(o.single_support_fraction)}
     if o.single_support_fraction_bounds is not None:
         lo, hi = o.single_support_fraction_bounds
-        return {"single_support_fraction": min(max(RUN_STANCE_GUESS, lo), hi)}
+        return {"single_support_fraction": min(max(guess, lo), hi)}
     if o.free_phase_fractions or o.stride:
-        return {"single_support_fraction": RUN_STANCE_GUESS}
-    return {"single_support_fraction": RUN_STANCE_GUESS,
+        return {"single_support_fraction": guess}
+    return {"single_support_fraction": guess,
             "single_support_fraction_bounds": RUN_STANCE_BOUNDS}
 
 
@@ -195,7 +211,11 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
         bounds = RUN_STEP_LENGTH_BOUNDS if gait == "run" and not custom else o.step_length_bounds
         changes["step_length_bounds"] = tuple(scale.length(v) for v in bounds)
     if follows_model(o.single_support_fraction):
-        changes |= _stance_share(o, gait == "run" and not custom)
+        speed = changes.get("speed", o.speed)
+        guess = (run_stance_guess(model, speed if speed is not None
+                                  else default_speed(model, "run"))
+                 if gait == "run" and not custom else None)
+        changes |= _stance_share(o, guess)
     if follows_model(o.rate_bound):
         changes["rate_bound"] = scale.rate(o.rate_bound)
     if follows_model(o.max_impulse):

@@ -148,8 +148,8 @@ class GaitOptions:
         single_support_fraction: phase-1 share of the step time, in (0, 1]; 1 gives the
             single-support gait (no double support, the trailing leg leaves at heel strike).
             Default 0.85; a run's stance share is free by default
-            (:data:`gaitopt.gait.model_defaults.RUN_STANCE_BOUNDS`, from
-            :data:`~gaitopt.gait.model_defaults.RUN_STANCE_GUESS`).
+            (:data:`gaitopt.gait.model_defaults.RUN_STANCE_BOUNDS`, from a guess that falls
+            with the speed, :func:`~gaitopt.gait.model_defaults.run_stance_guess`).
         knots: grid points per phase (single support, double support): 16 + 6 by default
             (the cost within 0.1 % of the fine-grid limit with ``control_model="jumps"``);
             the paper's 8 + 5 with :meth:`paper`; 24 + 16 for steps of more than two phases
