@@ -54,13 +54,22 @@ def running_sequence(model: RobotModel, stance_fraction: float) -> ContactSequen
         ((c1, 0.0), (c2, 1.0)))
 
 
+def legs_contacts(model: RobotModel) -> tuple[tuple[str, ...], ...]:
+    """The contact points of each leg: grouped by the first link below the base on the chain
+    from the base to each contact (a contact on the base is a group of its own), legs in the
+    order of their first contact point."""
+    groups: dict[str, list[str]] = {}
+    for c in model.contacts:
+        chain = model.chain(model.link_index(c.link))
+        root = model.links[chain[1]].name if len(chain) > 1 else model.base.name
+        groups.setdefault(root, []).append(c.name)
+    return tuple(tuple(g) for g in groups.values())
+
+
 def run_points(model: RobotModel) -> tuple[str, str]:
     """The points a run stands on: the model's first two contact points, or, on two feet with
     two points each (heel and toe), the front one of each foot in the standing pose (all
     coordinates 0)."""
-    from gaitopt.dynamics.kinematics import contact_position
-    from gaitopt.gait.model_defaults import legs_contacts
-
     legs = legs_contacts(model)
     if len(legs) != 2 or [len(g) for g in legs] != [2, 2]:
         return _two_contacts(model)

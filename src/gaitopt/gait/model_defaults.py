@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from gaitopt.gait.builtin_sequences import legs_contacts
 from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
 from gaitopt.gait.formulation import default_formulation
 from gaitopt.gait.model_scale import model_scale
@@ -65,18 +66,6 @@ RUN_STANCE_GUESS = (0.95, 0.3, 0.4, 0.9)
 #: flight carries the step beyond the legs' reach (people take 1.2-1.6 m steps at 240 m/min
 #: on 0.9 m legs), where the walk's 0.8 m would cap it.
 RUN_STEP_LENGTH_BOUNDS = (0.02, 3.0)
-
-
-def legs_contacts(model: RobotModel) -> tuple[tuple[str, ...], ...]:
-    """The contact points of each leg: grouped by the first link below the base on the chain
-    from the base to each contact (a contact on the base is a group of its own), legs in the
-    order of their first contact point."""
-    groups: dict[str, list[str]] = {}
-    for c in model.contacts:
-        chain = model.chain(model.link_index(c.link))
-        root = model.links[chain[1]].name if len(chain) > 1 else model.base.name
-        groups.setdefault(root, []).append(c.name)
-    return tuple(tuple(g) for g in groups.values())
 
 
 def _describe(model: RobotModel) -> str:
