@@ -112,6 +112,9 @@ def test_the_stance_share_guess_falls_with_the_froude_number() -> None:
     assert run_stance_guess(adult, 2.5) > run_stance_guess(adult, 4.0)
     speed_free = _resolved("five-link", GaitOptions(gait="run", impulse=False, speed=None))
     assert speed_free.single_support_fraction == run_stance_guess(five, 0.2)
+    fast = _resolved("five-link", GaitOptions(gait="run", impulse=False, speed=None,
+                                              speed_bounds=(2.5, 6.0)))
+    assert fast.single_support_fraction == run_stance_guess(five, 2.5)
 
 
 def test_a_run_with_the_impulse_on_is_refused_by_name() -> None:
@@ -150,5 +153,17 @@ def test_a_run_at_150_m_per_min_converges_and_verifies() -> None:
     assert gait.speed == pytest.approx(2.5, rel=1e-9)
     assert gait.solver["accuracy"]["within_target"]
     assert 0.6 < gait.step_length < 1.4  # measured 0.99 m
+    report = verify_gait(gait)
+    assert report.passed, report.failed_ids
+
+
+def test_a_free_speed_run_starts_within_its_speed_bounds() -> None:
+    """Speed free within 150-400 m/min (``--speed-bounds 150m/min,400m/min``): the solve
+    starts at the bound nearest the reference speed (12 m/min), not outside the bounds, and
+    the run's cost per metre grows with the speed, so the optimum is the lower bound."""
+    gait = solve_gait("adult-point-feet", GaitOptions(gait="run", impulse=False, speed=None,
+                                                      speed_bounds=(2.5, 6.0)))
+    assert gait.success
+    assert gait.speed == pytest.approx(2.5, rel=1e-5)  # measured: the bound
     report = verify_gait(gait)
     assert report.passed, report.failed_ids

@@ -201,9 +201,10 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
         changes["step_length_bounds"] = tuple(scale.length(v) for v in bounds)
     if follows_model(o.single_support_fraction):
         speed = changes.get("speed", o.speed)
-        guess = (run_stance_guess(model, speed if speed is not None
-                                  else default_speed(model, "run"))
-                 if gait == "run" and not custom else None)
+        if speed is None:  # a free speed starts from the run's default, within its bounds
+            lo, hi = changes.get("speed_bounds", o.speed_bounds)
+            speed = min(max(default_speed(model, "run"), lo), hi)
+        guess = run_stance_guess(model, speed) if gait == "run" and not custom else None
         changes |= _stance_share(o, guess)
     if follows_model(o.rate_bound):
         changes["rate_bound"] = scale.rate(o.rate_bound)
