@@ -77,7 +77,8 @@ def full_mass_matrix(m: object, d: object) -> np.ndarray:
 
 def dynamics_errors(source: Path | str, imp: MjcfImport) -> tuple[float, float]:
     """The largest entry of ``M + diag(armature) - P M_mujoco P^T`` and of
-    ``bias - P qfrc_bias`` over the random states (armature is dropped by the import)."""
+    ``bias - P (qfrc_bias - qfrc_passive)`` over the random states (armature is dropped by the
+    import; the hinges' damping kept)."""
     p = imp.coordinates.velocity_matrix()
     worst_m = worst_b = 0.0
     for q, qd in random_states(imp.model.nq, seed=24):
@@ -86,7 +87,11 @@ def dynamics_errors(source: Path | str, imp: MjcfImport) -> tuple[float, float]:
         ours = np.asarray(crba(imp.model, q)) + np.diag(imp.armature)
         worst_m = max(worst_m, float(np.max(np.abs(ours - p @ full @ p.T))))
         bias = np.asarray(bias_forces(imp.model, q, qd)).ravel()
-        worst_b = max(worst_b, float(np.max(np.abs(bias - p @ d.qfrc_bias))))
+        # gaitopt's bias holds the hinges' damping D qd, MuJoCo's passive force is -D qd (the
+        # floating base's damping is dropped by the import).
+        passive = p @ d.qfrc_passive
+        passive[:3] = 0.0
+        worst_b = max(worst_b, float(np.max(np.abs(bias - (p @ d.qfrc_bias - passive)))))
     return worst_m, worst_b
 
 
@@ -170,7 +175,9 @@ def test_walker2d_imports_what_mujoco_compiled() -> None:
     assert [a.joint for a in model.actuators] == list(imp.coordinates.names[3:])
     assert imp.armature == (0.0,) * 3 + (0.01,) * 6
     notes = "\n".join(imp.notes)
-    assert "armature: dropped" in notes and "damping: dropped" in notes
+    assert "armature: dropped" in notes and "damping: kept as joint damping" in notes
+    hinges = [link.joint for link in model.links[1:]]
+    assert [j.damping for j in hinges] == pytest.approx([0.1] * 6)  # type: ignore[union-attr]
     assert "torso = -rooty" in notes
 
 
@@ -313,7 +320,7 @@ def test_cli_imports_walker2d_and_prints_what_it_assumed(tmp_path: Path) -> None
     for start in ("floating base: body 'torso'", "contacts: heel_1, toe_1, heel_2, toe_2",
                   "  heel_1 at (0, -0.06), toe_1 at (0.2, -0.06) m in link 'foot'",
                   "actuators: [-100, 100] N m on thigh_joint", "armature: dropped",
-                  "damping: dropped",
+                  "damping: kept as joint damping",
                   "symmetry: thigh <-> thigh_left"):
         assert any(line.startswith(start) for line in lines), (start, lines)
     assert load_model(out) == import_mjcf(walker2d_path()).model

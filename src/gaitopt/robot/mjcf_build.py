@@ -231,9 +231,13 @@ class Builder:
             origin = self.d.xanchor[j].copy()
             at = self.xy(origin - links[k].origin)
             links[k].points.append(at)
-            links.append(Link(self.name("body", b), k, origin, bodies=[b], joint={
+            joint: dict[str, Any] = {
                 "name": self.name("joint", j), "at": at,
-                "limits": [x if math.isfinite(x) else None for x in (lo, hi)]}))  # null: none
+                "limits": [x if math.isfinite(x) else None for x in (lo, hi)]}  # null: none
+            damping = float(m.dof_damping[m.jnt_dofadr[j]])
+            if damping:  # MuJoCo's passive -b qd, the same torque as gaitopt's joint damping
+                joint["damping"] = damping
+            links.append(Link(self.name("body", b), k, origin, bodies=[b], joint=joint))
             link_of[b] = len(links) - 1
             coords.append((j, len(coords), sign, 0.0))
         self.notes.append(self.joints_note(coords[N_BASE:]))
@@ -358,13 +362,13 @@ class Builder:
         return [float(out[0]), float(out[1])]
 
     def dropped(self, cmap: CoordinateMap) -> None:
-        """Notes on what gaitopt models have no place for: armature, damping, friction loss,
-        stiffness (per joint, grouped by value)."""
+        """Notes on what gaitopt models have no place for: armature, friction loss, stiffness
+        (per joint, grouped by value); the hinges' damping is kept (``joint.damping``), the
+        floating base's dropped with a note."""
         m = self.m
         fields = (("armature", m.dof_armature, "kg m^2",
                    "no rotor inertia in gaitopt models; MuJoCo adds it to the mass matrix's "
                    "diagonal"),
-                  ("damping", m.dof_damping, "N m s/rad", "no joint friction in gaitopt"),
                   ("frictionloss", m.dof_frictionloss, "N m", "no joint friction in gaitopt"),
                   ("stiffness", m.jnt_stiffness[m.dof_jntid], "N m/rad",
                    "no joint springs in gaitopt"))
@@ -373,3 +377,12 @@ class Builder:
                      if values[d] != 0.0}
             if found:
                 self.notes.append(f"{label}: dropped ({why}): {_values(found, unit)}")
+        damping = {cmap.names[i]: float(m.dof_damping[d]) for i, d in enumerate(cmap.dof_index)
+                   if m.dof_damping[d] != 0.0}
+        base = {n: v for n, v in damping.items() if n in cmap.names[:N_BASE]}
+        hinges = {n: v for n, v in damping.items() if n not in base}
+        if hinges:
+            self.notes.append(f"damping: kept as joint damping: {_values(hinges, 'N m s/rad')}")
+        if base:
+            self.notes.append("damping: dropped on the floating base (no damping of the base "
+                              f"coordinates in gaitopt): {_values(base, 'N m s/rad')}")
