@@ -68,7 +68,8 @@ def test_flat_foot_dynamics_solve_the_kkt_system(seven: RobotModel) -> None:
         sol = contact_dynamics(seven, q, qd, tau, ["heel_1", "toe_1:y"])
         m = pin.crba(pm, pd, P(q))
         m = back(np.triu(m) + np.triu(m, 1).T)
-        h = back(pin.nonLinearEffects(pm, pd, P(q), P(qd)))
+        # Pinocchio has no joint damping: the model's (the ankles') is added as D qd.
+        h = back(pin.nonLinearEffects(pm, pd, P(q), P(qd))) + np.asarray(seven.coordinate_damping) * qd
         pin.computeJointJacobians(pm, pd, P(q))
         pin.forwardKinematics(pm, pd, P(q), P(qd), np.zeros(seven.nq))
         pin.updateFramePlacements(pm, pd)
