@@ -53,7 +53,7 @@ ROOT_CONSTANTS: frozenset[str] = frozenset({"__version__"})
 #: each keeps a heavy third-party library out of a process that does not need it (they
 #: follow the layering and close no cycle all the same).
 DEFERRED: dict[tuple[str, str], str] = {
-    ("gaitopt.gait.options", "gaitopt.gait.contact_sequence"):
+    ("gaitopt.gait.options.gait_options", "gaitopt.gait.sequence.contact_sequence"):
         "``from gaitopt import GaitOptions`` loads no CasADi (gaitopt.dynamics' package does)",
 }
 
