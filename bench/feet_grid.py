@@ -11,7 +11,7 @@ process: the first point of each variant also builds the NLP.
 
 Run: ``python bench/feet_grid.py [--model seven-link] [--gait heel-toe] [--knots 24,16]
 [--speeds 12 30 ...] [--no-free] [--set FIELD=VALUE ...] [--json FILE]``; ``--set`` passes any
-other :class:`gaitopt.gait.options.GaitOptions` field (a JSON value, e.g.
+other :class:`gaitopt.gait.options.gait_options.GaitOptions` field (a JSON value, e.g.
 ``--set min_stance_knee_flexion=0.1``).
 """
 
@@ -29,8 +29,8 @@ from typing import Any
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from gait_grid import load_average  # noqa: E402  (the five-link grid's helpers)

@@ -30,8 +30,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from gait_grid import VARIANTS, load_average, verify_summary  # noqa: E402
 
 from gaitopt.gait.api import solve_gait_solution  # noqa: E402
-from gaitopt.gait.options import GaitOptions  # noqa: E402
-from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution  # noqa: E402
+from gaitopt.gait.options.gait_options import GaitOptions  # noqa: E402
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution  # noqa: E402
 
 FORMS = ("hermite-simpson", "hermite-simpson-separated")
 SHORT_FORM = {"hermite-simpson": "compressed", "hermite-simpson-separated": "separated"}

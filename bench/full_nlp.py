@@ -52,13 +52,13 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import gaitopt.ocp.transcription as transcription  # noqa: E402
-from gaitopt.gait import full_coordinates as full  # noqa: E402
-from gaitopt.gait import transcriptions  # noqa: E402
 from gaitopt.gait.api import solve_gait_solution  # noqa: E402
-from gaitopt.gait.full_coordinates import HELD, STEP_LENGTH  # noqa: E402
-from gaitopt.gait.gait_file import Gait  # noqa: E402
-from gaitopt.gait.options import GaitOptions  # noqa: E402
-from gaitopt.gait.record import gait_from_solution  # noqa: E402
+from gaitopt.gait.formulations.full import problem as full  # noqa: E402
+from gaitopt.gait.formulations.full.problem import HELD, STEP_LENGTH  # noqa: E402
+from gaitopt.gait.options.gait_options import GaitOptions  # noqa: E402
+from gaitopt.gait.record.file import Gait  # noqa: E402
+from gaitopt.gait.solve import transcriptions  # noqa: E402
+from gaitopt.gait.solve.record import gait_from_solution  # noqa: E402
 from gaitopt.ocp.solver import EVAL_KINDS  # noqa: E402
 from gaitopt.ocp.transcription import Transcription  # noqa: E402
 from gaitopt.robot import load_model  # noqa: E402

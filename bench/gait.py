@@ -63,11 +63,11 @@ from pathlib import Path
 from typing import Any
 
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
-from gaitopt.gait.solve import WalkingSolution, solve_walking
-from gaitopt.gait.transcriptions import clear_cache
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.record import gait_from_solution
+from gaitopt.gait.solve.staged import WalkingSolution, solve_walking
+from gaitopt.gait.solve.transcriptions import clear_cache
 from gaitopt.ocp import Result
 from gaitopt.ocp.result import METHODS
 from gaitopt.ocp.transcription import Transcription

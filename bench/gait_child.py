@@ -49,9 +49,9 @@ def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str,
     """Cold solve (NLPs built in this process), the same again, the gait saved to ``path``,
     then the warm start from it at +5 % speed (best of ``repeat``)."""
     from gaitopt.gait.api import solve_gait_solution
-    from gaitopt.gait.gait_file import Gait
-    from gaitopt.gait.options import GaitOptions
-    from gaitopt.gait.record import gait_from_solution
+    from gaitopt.gait.options.gait_options import GaitOptions
+    from gaitopt.gait.record.file import Gait
+    from gaitopt.gait.solve.record import gait_from_solution
     from gaitopt.robot import load_model
 
     model = load_model("five-link")
@@ -87,8 +87,8 @@ def first_warm(knots: tuple[int, int], transcription: str, path: str,
     """The first warm start in this process from the gait file ``path`` (+5 % speed)."""
     start = time.perf_counter()
     from gaitopt.gait.api import solve_gait_solution
-    from gaitopt.gait.gait_file import Gait
-    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.options.gait_options import GaitOptions
+    from gaitopt.gait.record.file import Gait
     from gaitopt.robot import load_model
 
     imports = time.perf_counter() - start

@@ -34,9 +34,9 @@ import numpy as np
 from gaitopt.analysis.verify import LIMITS, verify_gait
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import KNOT_SPACINGS, TRANSCRIPTIONS, GaitOptions
-from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.options.gait_options import KNOT_SPACINGS, TRANSCRIPTIONS, GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
 
 VARIANTS = {
     "ankle+impulse": {"ankle": True, "impulse": True},

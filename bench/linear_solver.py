@@ -43,7 +43,7 @@ used (CasADi's MUMPS has AMD, AMF, METIS and QAMD; it replaces SCOTCH and PORD b
 
 The sets are merged over the options the stages ask for, so a set that leaves a key out
 keeps the stage's value: on the full walk's fine grids that is
-``gaitopt.gait.stages.FULL_WALK_FINE_GRID_OPTIONS`` (``mumps_permuting_scaling`` 0), which a
+``gaitopt.gait.solve.stages.FULL_WALK_FINE_GRID_OPTIONS`` (``mumps_permuting_scaling`` 0), which a
 set overrides only by naming the key.
 
 Run: ``PYTHONPATH=src python bench/linear_solver.py [--suite representative grid full seven
@@ -73,8 +73,8 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 from gaitopt.gait.api import solve_gait_solution  # noqa: E402
-from gaitopt.gait.options import GaitOptions  # noqa: E402
-from gaitopt.gait.transcriptions import clear_cache  # noqa: E402
+from gaitopt.gait.options.gait_options import GaitOptions  # noqa: E402
+from gaitopt.gait.solve.transcriptions import clear_cache  # noqa: E402
 from gaitopt.ocp import Transcription  # noqa: E402
 from gaitopt.ocp.solver import merge_options  # noqa: E402
 from gaitopt.robot import load_model  # noqa: E402

@@ -35,9 +35,9 @@ from typing import Any
 import numpy as np
 
 from gaitopt.gait.api import guess_from_gait
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.solve import solve_walking
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.staged import solve_walking
 from gaitopt.ocp import Result
 from gaitopt.robot import load_model
 from gaitopt.study.grid_error import CHECK_DIR, MAX_REFINE_LEVELS, refine_dir_name, sweep_grid

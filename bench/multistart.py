@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot import load_model
 from gaitopt.study.driver import run_sweep
 from gaitopt.study.plan import SweepSpec

@@ -1,7 +1,7 @@
 """Benchmark: warm starts across grids with mapped multipliers (gaitopt.ocp.regrid) or values.
 
 Every case is solved twice in this process by ``solve_walking``: first as main does
-(``gaitopt.gait.solve.REGRID_MOVES`` empty: a move to another grid starts IPOPT from the
+(``gaitopt.gait.solve.staged.REGRID_MOVES`` empty: a move to another grid starts IPOPT from the
 previous solution's values only, with ``PRIMAL_WARM_OPTIONS``), then with the mapped
 multipliers on the grid moves ``--moves`` for every contact sequence (``REGRID_MOVES``;
 default the check grid only), the transcription's ``WARM_START_OPTIONS`` with ``--mu`` as
@@ -36,9 +36,9 @@ import os
 import time
 from dataclasses import dataclass
 
-from gaitopt.gait import solve as walking
-from gaitopt.gait.options import GAITS, GaitOptions
-from gaitopt.gait.solve import solve_walking
+from gaitopt.gait.options.gait_options import GAITS, GaitOptions
+from gaitopt.gait.solve import staged as walking
+from gaitopt.gait.solve.staged import solve_walking
 from gaitopt.robot import load_model
 
 #: The stages that move between grids (cold solves without ``mesh_tol``).

@@ -21,9 +21,9 @@ import os
 import time
 
 from gaitopt.cli.gait import multistart_default
-from gaitopt.gait.accuracy import accuracy_record
-from gaitopt.gait.options import KNOT_SPACINGS, GaitOptions
-from gaitopt.gait.solve import solve_walking
+from gaitopt.gait.options.gait_options import KNOT_SPACINGS, GaitOptions
+from gaitopt.gait.solve.accuracy import accuracy_record
+from gaitopt.gait.solve.staged import solve_walking
 from gaitopt.robot import load_model
 from gaitopt.study.summary import variant_flags
 

@@ -30,8 +30,8 @@ import time
 from pathlib import Path
 
 from gaitopt.cli.study import parse_speeds
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.solve import transcription_for
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve.staged import transcription_for
 from gaitopt.robot import load_model
 from gaitopt.study.driver import run_sweep
 from gaitopt.study.executors import local_backend

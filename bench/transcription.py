@@ -5,10 +5,10 @@ compressed form, and ``hermite-simpson-separated``) on the default problem (five
 ankle torques and liftoff impulse, 12 m/min, step length free), every figure measured in
 fresh worker processes of this run (so each starts with empty CasADi and NLP caches):
 
-* ``cold``: the default staged solve (:func:`gaitopt.gait.solve.solve_walking`) from the naive
-  guess, NLP builds included: wall time, stages, IPOPT iterations, cost and step length;
+* ``cold``: the default staged solve (:func:`gaitopt.gait.solve.staged.solve_walking`) from the
+  naive guess, NLP builds included: wall time, stages, IPOPT iterations, cost and step length;
 * ``cold, exact fine``: the same with the target-grid stages solved with the exact Hessian
-  instead of solve.py's limited-memory one (only for grids finer than 8 + 5);
+  instead of staged.py's limited-memory one (only for grids finer than 8 + 5);
 * ``NLP build``: building the target grid's transcription (NLP assembly and SX expansion,
   no solver);
 * ``first warm solve``: in a fresh process, the transcription built and solved from the
@@ -45,15 +45,15 @@ SPEED_STEP = 1.05  # the neighbouring gait of the warm start
 
 
 def _options(form: str, knots: tuple[int, int], speed: float = SPEED) -> Any:
-    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.options.gait_options import GaitOptions
 
     return GaitOptions.paper(speed=speed, knots=knots, transcription=form)  # type: ignore[arg-type]
 
 
 def worker_cold(form: str, knots: tuple[int, int], exact_fine: bool, out: str) -> dict[str, Any]:
     """A fresh process: the default cold solve; its Result is pickled to ``out``."""
-    from gaitopt.gait import solve as gait_solve
-    from gaitopt.gait import stages
+    from gaitopt.gait.solve import staged as gait_solve
+    from gaitopt.gait.solve import stages
     from gaitopt.robot import load_model
 
     if exact_fine:
@@ -75,7 +75,7 @@ def worker_cold(form: str, knots: tuple[int, int], exact_fine: bool, out: str) -
 def worker_warm(form: str, knots: tuple[int, int], start_file: str,
                 repeat: int) -> dict[str, Any]:
     """A fresh process: NLP build, first and repeated warm solves at +5 % speed."""
-    from gaitopt.gait.solve import PRIMAL_WARM_OPTIONS, solve_walking, transcription_for
+    from gaitopt.gait.solve.staged import PRIMAL_WARM_OPTIONS, solve_walking, transcription_for
     from gaitopt.ocp.solver import merge_options
     from gaitopt.robot import load_model
 

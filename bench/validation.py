@@ -3,8 +3,8 @@
 Measured in one run, each pydantic figure beside the hand-written one and their ratio:
 
 * **lines**: code lines (no blank, comment or docstring lines) of the hand-written checks of
-  the options (:func:`gaitopt.gait.options.validate_options` and its helpers) and of the
-  gait-file schema (``gait_fields``, ``gait_checks``, the parts' ``__post_init__``, the
+  the options (:func:`gaitopt.gait.options.gait_options.validate_options` and its helpers) and of
+  the gait-file schema (``gait_fields``, ``gait_checks``, the parts' ``__post_init__``, the
   reader's checks in ``gait_file``), and of the prototype (``bench/validation_pydantic.py``:
   its validators, constrained types and message layer; the 37 field declarations, which the
   dataclass has too, are counted apart);
@@ -43,11 +43,11 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.gait.formulation import biped_for
-from gaitopt.gait.gait_fields import GaitFileError
-from gaitopt.gait.gait_parts import GaitPhase
-from gaitopt.gait.model_defaults import options_for_model
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.formulations.select import biped_for
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.options.model_defaults import options_for_model
+from gaitopt.gait.record.fields import GaitFileError
+from gaitopt.gait.record.parts import GaitPhase
 from gaitopt.robot import load_model
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -63,20 +63,20 @@ except ImportError:  # pragma: no cover - the figures of one side only
     pydantic = None  # type: ignore[assignment]
 
 #: (file, qualified names) of the hand-written checks; ``*`` is the whole module.
-HAND_OPTIONS = [("options.py", ["GaitOptionsError", "_finite", "_bounds", "validate_options",
-                                "GaitOptions.from_dict"])]
+HAND_OPTIONS = [("options/gait_options.py", ["GaitOptionsError", "_finite", "_bounds",
+                                             "validate_options", "GaitOptions.from_dict"])]
 HAND_SCHEMA = [
-    ("gait_fields.py", ["*"]),
-    ("gait_checks.py", ["check_solver", "check_consistency", "SOLVER_KEYS"]),
-    ("gait_parts.py", ["GaitPhase.__post_init__", "GaitEvent.__post_init__",
+    ("record/fields.py", ["*"]),
+    ("record/checks.py", ["check_solver", "check_consistency", "SOLVER_KEYS"]),
+    ("record/parts.py", ["GaitPhase.__post_init__", "GaitEvent.__post_init__",
                        "GaitSamples.__post_init__"]),
-    ("gait_file.py", ["Gait.__post_init__", "_gait_from_dict", "_major_version", "_with_path",
+    ("record/file.py", ["Gait.__post_init__", "_gait_from_dict", "_major_version", "_with_path",
                       "_strings"]),
 ]
-HAND_PHASE = [("gait_fields.py", ["GaitFileError", "bad_field", "array_of", "_shape_text",
+HAND_PHASE = [("record/fields.py", ["GaitFileError", "bad_field", "array_of", "_shape_text",
                                   "mapping_of", "check_increasing"]),
-              ("gait_parts.py", ["GaitPhase.__post_init__"]),
-              ("gait_file.py", ["_with_path", "_strings"])]
+              ("record/parts.py", ["GaitPhase.__post_init__"]),
+              ("record/file.py", ["_with_path", "_strings"])]
 PROTO_OPTIONS = ["_fail", "_ordered", "Finite", "Positive", "NonNegative", "Fraction", "Bounds",
                  "PositiveBounds", "Knots", "OptionsModel", "_RULES", "path_of", "_INTERVALS",
                  "_interval", "one_line"]

@@ -1,6 +1,7 @@
 """Prototype (throwaway, for ``bench/validation.py``): the walking options and one gait-file
-phase as pydantic v2 models, with the checks of :func:`gaitopt.gait.options.validate_options`
-and :class:`gaitopt.gait.gait_parts.GaitPhase`, so that their messages, speed and length can
+phase as pydantic v2 models, with the checks of
+:func:`gaitopt.gait.options.gait_options.validate_options`
+and :class:`gaitopt.gait.record.parts.GaitPhase`, so that their messages, speed and length can
 be compared with the hand-written ones. Not used by gaitopt (issue 26, item 5: the decision is
 in docs/architecture.md, "Validation").
 
@@ -64,8 +65,8 @@ Knots = tuple[Annotated[int, Field(ge=2, le=400, strict=True)],
 
 
 class OptionsModel(BaseModel):
-    """The 37 fields of :class:`gaitopt.gait.options.GaitOptions` with their checks; field
-    order matters: a cross-field check sits on the later field."""
+    """The 37 fields of :class:`gaitopt.gait.options.gait_options.GaitOptions` with their checks;
+    field order matters: a cross-field check sits on the later field."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
@@ -222,7 +223,10 @@ class OptionsModel(BaseModel):
         if v is not None and info.data.get("formulation") != "full":
             raise _fail("formulation", "a contact sequence needs formulation 'full'")
         if v is not None:
-            from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
+            from gaitopt.gait.sequence.contact_sequence import (
+                ContactSequenceError,
+                sequence_from_dict,
+            )
 
             try:
                 sequence_from_dict(v)
@@ -360,7 +364,7 @@ class Interpolation(BaseModel):
 
 
 class PhaseModel(BaseModel):
-    """One phase of the gait file, as :class:`gaitopt.gait.gait_parts.GaitPhase` checks it;
+    """One phase of the gait file, as :class:`gaitopt.gait.record.parts.GaitPhase` checks it;
     a shape that depends on another field (K knots, nq columns) is checked on the later
     field from ``info.data``."""
 
@@ -427,7 +431,7 @@ class PhaseModel(BaseModel):
 
 
 def phase_line(exc: ValidationError, prefix: str) -> tuple[str, str]:
-    """(path, message) of the first error, as :class:`gaitopt.gait.gait_fields.GaitFileError`
+    """(path, message) of the first error, as :class:`gaitopt.gait.record.fields.GaitFileError`
     carries them."""
     err = exc.errors(include_url=False)[0]
     rule = _RULES.get(err["type"])

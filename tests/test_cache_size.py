@@ -12,7 +12,7 @@ import casadi as ca
 import pytest
 
 from gaitopt import codegen
-from gaitopt.gait import transcriptions
+from gaitopt.gait.solve import transcriptions
 
 
 @pytest.fixture

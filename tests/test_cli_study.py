@@ -12,7 +12,7 @@ from PIL import Image
 from gaitopt.cli import UserError, cli
 from gaitopt.cli.report import sweep_dirs
 from gaitopt.cli.study import parse_speeds, parse_variants
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.grid_error import grid_error
 from gaitopt.study.plan import SweepSpec

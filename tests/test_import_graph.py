@@ -11,6 +11,9 @@ import) and under ``if TYPE_CHECKING:``. The rules:
   (``gaitopt/__init__.py``, ``gaitopt/__main__.py``) is outside the layering: it re-exports
   from every package. ``TYPE_CHECKING`` imports count here too: an annotation that names a
   lower layer's type is a dependency on that layer's concept all the same.
+* **The bottom of gait/.** Its sub-packages are concepts (docs/architecture.md, "gait/ by
+  concept"); the two at the bottom, the gait record (numpy only) and the contact sequences,
+  import no other module of ``gait/``.
 * **Lazy imports** (inside a function) are allowed only in ``viz/`` and ``cli/``, where they
   keep ``gaitopt solve`` from loading the figures or the study, and they follow the layering
   like any other.
@@ -45,6 +48,8 @@ LAYERS: tuple[str, ...] = ("robot", "dynamics", "ocp", "gait", "analysis", "stud
 HELPERS: frozenset[str] = frozenset({"fileio", "units", "codegen", "process_memory", "views"})
 #: The front door: re-exports from everywhere, outside the layering.
 FRONT_DOOR: frozenset[str] = frozenset({"gaitopt", "gaitopt.__main__"})
+#: The sub-packages at the bottom of gait/: they import no other module of gait/.
+GAIT_BOTTOM: frozenset[str] = frozenset({"gaitopt.gait.record", "gaitopt.gait.sequence"})
 #: Packages whose modules may import lazily (inside a function).
 LAZY_ALLOWED: frozenset[str] = frozenset({"viz", "cli"})
 #: Names any module may import from the root: constants it defines before any import.
@@ -53,7 +58,7 @@ ROOT_CONSTANTS: frozenset[str] = frozenset({"__version__"})
 #: each keeps a heavy third-party library out of a process that does not need it (they
 #: follow the layering and close no cycle all the same).
 DEFERRED: dict[tuple[str, str], str] = {
-    ("gaitopt.gait.options", "gaitopt.gait.contact_sequence"):
+    ("gaitopt.gait.options.gait_options", "gaitopt.gait.sequence.contact_sequence"):
         "``from gaitopt import GaitOptions`` loads no CasADi (gaitopt.dynamics' package does)",
 }
 
@@ -355,6 +360,19 @@ def test_each_package_imports_only_the_packages_above_it() -> None:
             offences.append(f"{edge.where}: {edge.importer} ({package_name(edge.importer)}/) "
                             f"imports {edge.target}, which is below it")
     assert not offences, ("imports against the layering of docs/architecture.md:\n"
+                          + offences_text(offences))
+
+
+def test_the_bottom_of_gait_imports_nothing_else_of_gait() -> None:
+    def subpackage(module: str) -> str:
+        return ".".join(module.split(".")[:3])
+
+    assert all(package in MODULES for package in GAIT_BOTTOM)
+    offences = [f"{e.where}: {e.importer} imports {e.target}" for e in GRAPH.edges
+                if subpackage(e.importer) in GAIT_BOTTOM
+                and (e.target + ".").startswith("gaitopt.gait.")
+                and subpackage(e.target) != subpackage(e.importer)]
+    assert not offences, ("gait/record/ and gait/sequence/ import another part of gait/:\n"
                           + offences_text(offences))
 
 

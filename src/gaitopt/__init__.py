@@ -26,10 +26,10 @@ __version__ = "0.1.0"
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
     "solve_gait": "gaitopt.gait.api",
-    "GaitOptions": "gaitopt.gait.options",
-    "GaitOptionsError": "gaitopt.gait.options",
-    "Gait": "gaitopt.gait.gait_file",
-    "GaitFileError": "gaitopt.gait.gait_file",
+    "GaitOptions": "gaitopt.gait.options.gait_options",
+    "GaitOptionsError": "gaitopt.gait.options.gait_options",
+    "Gait": "gaitopt.gait.record.file",
+    "GaitFileError": "gaitopt.gait.record.file",
     "verify_gait": "gaitopt.analysis.verify",
     "VerifyReport": "gaitopt.analysis.verify",
     "load_model": "gaitopt.robot",
@@ -47,8 +47,8 @@ if TYPE_CHECKING:
     from gaitopt.analysis.stability import StabilityReport, gait_stability
     from gaitopt.analysis.verify import VerifyReport, verify_gait
     from gaitopt.gait.api import solve_gait
-    from gaitopt.gait.gait_file import Gait, GaitFileError
-    from gaitopt.gait.options import GaitOptions, GaitOptionsError
+    from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
+    from gaitopt.gait.record.file import Gait, GaitFileError
     from gaitopt.robot import ModelError, RobotModel, load_model
 
 

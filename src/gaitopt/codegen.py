@@ -5,7 +5,7 @@ command, so a changed model, problem or compiler flag gives a new library and an
 is loaded from disk without compiling. The cache folder is ``$GAITOPT_CACHE`` if set, else
 ``$XDG_CACHE_HOME/gaitopt`` (``~/.cache/gaitopt``).
 
-The folder also holds the pickled symbolic functions of :mod:`gaitopt.gait.transcriptions`,
+The folder also holds the pickled symbolic functions of :mod:`gaitopt.gait.solve.transcriptions`,
 keyed by the gaitopt sources among others, so every new version (or edit) of gaitopt adds
 files and never reuses the old ones. :func:`prune_cache` bounds the folder's size: whenever a
 file is added and the folder holds more than ``$GAITOPT_CACHE_MAX_MB`` megabytes

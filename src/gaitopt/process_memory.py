@@ -1,6 +1,6 @@
 """The process's memory: what it holds now, what it may hold, and handing freed memory back.
 
-gaitopt's in-memory caches (the transcriptions of :mod:`gaitopt.gait.transcriptions`) are
+gaitopt's in-memory caches (the transcriptions of :mod:`gaitopt.gait.solve.transcriptions`) are
 bounded in bytes of the whole process, not in a count of entries: a compressed-form NLP on a
 fine grid takes over a gigabyte, a point-wise one a few megabytes, so no count suits both.
 

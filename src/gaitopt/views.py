@@ -1,7 +1,7 @@
 """The views of a gait (its notebook summary, figures and animation), as the gait record sees
 them: a protocol and the one place its implementation is found.
 
-:class:`~gaitopt.gait.gait_file.Gait` has ``_repr_html_``, ``plot`` and ``animate``, but
+:class:`~gaitopt.gait.record.file.Gait` has ``_repr_html_``, ``plot`` and ``animate``, but
 ``gait/`` sits below ``viz/`` (docs/architecture.md) and may not import it, not even inside a
 function. So the record asks this module for a :class:`GaitViews`, and the front door
 (``gaitopt/__init__.py``, which alone may import every package) installs the loader of the

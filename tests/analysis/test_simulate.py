@@ -17,7 +17,7 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before MuJoCo loads: headless rendering
 mujoco = pytest.importorskip("mujoco")

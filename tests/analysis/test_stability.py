@@ -38,8 +38,8 @@ from gaitopt.analysis.stability import (
 )
 from gaitopt.cli import cli
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import RobotModel, load_model
 
 DATA = Path(__file__).parent / "data"

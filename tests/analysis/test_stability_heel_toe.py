@@ -17,7 +17,7 @@ import pytest
 
 from gaitopt.analysis.return_map import section_constraints, simulate_step
 from gaitopt.analysis.stability import gait_stability, gait_start, step_from_gait
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 
 DATA = Path(__file__).parent / "data"
 GAINS = (300.0, 30.0)

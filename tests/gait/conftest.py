@@ -3,7 +3,7 @@
 Solving is the expensive part: :func:`solved` memoises solves for the whole session (keyed
 by the model's content hash and the options), so the default gait of the paper is solved once
 and every test module that needs it, or a variant, shares the result. The solver's own
-process-wide transcription cache (:func:`gaitopt.gait.solve.transcription_for`) means a
+process-wide transcription cache (:func:`gaitopt.gait.solve.staged.transcription_for`) means a
 variant that differs from an earlier solve only in its speed or step length reuses the NLP.
 
 The checks here never use the solver's equations: the equations of motion, contact
@@ -24,10 +24,10 @@ import pytest
 from numpy.typing import NDArray
 
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.gait_file import Gait, GaitPhase
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
-from gaitopt.gait.solve import WalkingSolution
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait, GaitPhase
+from gaitopt.gait.solve.record import gait_from_solution
+from gaitopt.gait.solve.staged import WalkingSolution
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.symmetry import swap_matrices
 from tests.dynamics.pinocchio_model import PinModel, build

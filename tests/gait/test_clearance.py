@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from gaitopt.gait import walking
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.formulations.reduced import physics as walking
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot.biped import biped_of
 from tests.gait.conftest import Reference, Solved, SolveFn
 

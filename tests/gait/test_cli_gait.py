@@ -14,9 +14,9 @@ import pytest
 from click.testing import CliRunner, Result
 
 from gaitopt.cli import cli
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import MotionOutOfReachError
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.record import MotionOutOfReachError
 from tests.gait.conftest import SolveFn
 from tests.gait.test_walking_errors import one_legged_model_file
 
@@ -56,7 +56,7 @@ def no_solve(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuse(*args: Any, **kwargs: Any) -> Any:
         raise AssertionError("a solve was started for a request that should be refused")
 
-    monkeypatch.setattr("gaitopt.gait.solve.transcription_for", refuse)
+    monkeypatch.setattr("gaitopt.gait.solve.staged.transcription_for", refuse)
 
 
 BAD_REQUESTS: dict[str, tuple[list[str], tuple[str, ...]]] = {
@@ -169,7 +169,7 @@ def test_motion_out_of_reach_exits_1_with_the_reason_and_writes_nothing(
                                     "in phase double_support; solve on a finer grid")
 
     monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", converged)
-    monkeypatch.setattr("gaitopt.gait.record.gait_from_solution", unrecordable)
+    monkeypatch.setattr("gaitopt.gait.solve.record.gait_from_solution", unrecordable)
     out = tmp_path / "g.gait.json"
     result = solve("-o", str(out))
     assert result.exit_code == 1, result.output

@@ -10,8 +10,8 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import biped_of
 

@@ -6,16 +6,16 @@ import numpy as np
 import pytest
 
 from gaitopt.dynamics.kinematics import contact_position
-from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
-from gaitopt.gait.contact_sequence import (
+from gaitopt.gait.formulations.full.physics import per_point, projection_names
+from gaitopt.gait.formulations.select import checked_sequence, default_formulation
+from gaitopt.gait.guess.sequence import sequence_guess
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
+from gaitopt.gait.sequence.builtin import heel_toe_sequence, walking_sequence
+from gaitopt.gait.sequence.contact_sequence import (
     ContactSequenceError,
     check_sequence,
     sequence_from_dict,
 )
-from gaitopt.gait.formulation import checked_sequence, default_formulation
-from gaitopt.gait.full_physics import per_point, projection_names
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.sequence_guess import sequence_guess
 from gaitopt.robot.loader import load_model
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import leg_swap
@@ -85,7 +85,7 @@ def test_options_and_formulation_defaults(five: RobotModel, seven: RobotModel) -
     assert default_formulation(five, "walk", True) == "full"
     assert default_formulation(seven, "walk", False) == "full"
     with pytest.raises(GaitOptionsError, match="need formulation 'full'"):
-        from gaitopt.gait.options import validate_options
+        from gaitopt.gait.options.gait_options import validate_options
 
         validate_options(GaitOptions(contact_sequence=PAPER), None)
     with pytest.raises(GaitOptionsError, match="two contact points on the foot"):
@@ -132,7 +132,7 @@ def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> 
 
 
 def test_phase_knots_keep_the_density_of_phase_0(five: RobotModel, seven: RobotModel) -> None:
-    from gaitopt.gait.contact_sequence import phase_knots
+    from gaitopt.gait.sequence.contact_sequence import phase_knots
 
     assert phase_knots(walking_sequence(five, 0.85, impulse=True), (8, 5)) == (8, 5)
     assert phase_knots(walking_sequence(five, 1.0, impulse=False), (8, 5)) == (8,)

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.solve import transcription_for
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve.staged import transcription_for
 from gaitopt.robot import load_model
 from tests.gait.conftest import Solved, SolveFn
 

@@ -1,4 +1,4 @@
-"""The gait record's costates (gaitopt.gait.record_costates) on the paper's default gait."""
+"""The gait record's costates (gaitopt.gait.solve.costates) on the paper's default gait."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.record_costates import solution_costates
-from gaitopt.gait.transcriptions import transcription_for
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.costates import solution_costates
+from gaitopt.gait.solve.transcriptions import transcription_for
 from gaitopt.ocp import costates
 from tests.gait.conftest import Solved
 

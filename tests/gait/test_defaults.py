@@ -18,8 +18,8 @@ from click.testing import CliRunner
 
 from gaitopt.cli import cli
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import PAPER_GRID, GaitOptions
+from gaitopt.gait.options.gait_options import PAPER_GRID, GaitOptions
+from gaitopt.gait.record.file import Gait
 from tests.gait.conftest import SolveFn
 
 

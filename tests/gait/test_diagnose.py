@@ -19,9 +19,9 @@ from click.testing import CliRunner
 
 from gaitopt.cli import cli
 from gaitopt.gait.api import solve_gait, solve_gait_solution
-from gaitopt.gait.diagnose import diagnose
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.solve import WalkingSolution, transcription_for
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
+from gaitopt.gait.solve.diagnose import diagnose
+from gaitopt.gait.solve.staged import WalkingSolution, transcription_for
 from gaitopt.robot import load_model, model_from_dict, model_to_yaml
 from tests.gait.conftest import Solved
 

@@ -9,7 +9,7 @@ import yaml
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot import model_from_dict
 from gaitopt.robot.loader import builtin_text
 

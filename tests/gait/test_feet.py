@@ -13,9 +13,9 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.contact_sequence import sequence_from_dict
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.contact_sequence import sequence_from_dict
 from gaitopt.robot.model import RobotModel
 from tests.gait.conftest import EOM_RTOL, Reference, eom_residuals
 

@@ -1,4 +1,5 @@
-"""The linear-algebra options of the fine-grid stages (``gaitopt.gait.stages.fine_grid_options``):
+"""The linear-algebra options of the fine-grid stages
+(``gaitopt.gait.solve.stages.fine_grid_options``):
 the two-phase walk solves its target and check grids with IPOPT's fast step computation (in
 either formulation) and, in full coordinates, with MUMPS's permuting scaling off; its coarse
 stages and every other problem keep IPOPT's and MUMPS's defaults (the measurements behind
@@ -12,8 +13,8 @@ from typing import Any
 import pytest
 
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.stages import (
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve.stages import (
     FULL_WALK_FINE_GRID_OPTIONS,
     WALK_FINE_GRID_OPTIONS,
     fine_grid_options,

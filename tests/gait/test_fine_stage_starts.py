@@ -1,11 +1,11 @@
 """How the stages on finer grids start and stop (docs/walking.md, section "Stages"):
 
 * the held stage (step length and speed held at the coarse solution's) is solved to
-  :data:`gaitopt.gait.stages.HELD_STAGE_TOL` when its release follows: it is only the
+  :data:`gaitopt.gait.solve.stages.HELD_STAGE_TOL` when its release follows: it is only the
   release's start. The answer must not change, and a held stage that is the answer keeps
   the user's tolerance;
 * the walk's check grid starts its barrier at 1e-8
-  (:data:`~gaitopt.gait.stages.CHECK_GRID_OPTIONS`): its cost must be the one a start at
+  (:data:`~gaitopt.gait.solve.stages.CHECK_GRID_OPTIONS`): its cost must be the one a start at
   1e-6 reaches, within the solve's accuracy."""
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ from typing import Any
 
 import pytest
 
-from gaitopt.gait import stages
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.solution import WalkingSolution
-from gaitopt.gait.stages import CHECK_GRID_OPTIONS, HELD_STAGE_TOL, held_stage_options
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve import stages
+from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.stages import CHECK_GRID_OPTIONS, HELD_STAGE_TOL, held_stage_options
 from gaitopt.ocp import Transcription
 from gaitopt.robot import load_model
 

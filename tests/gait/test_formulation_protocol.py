@@ -1,5 +1,5 @@
 """Each formulation is one object behind one protocol, picked in one place
-(:func:`gaitopt.gait.formulation.formulation_of`): no other module compares
+(:func:`gaitopt.gait.formulations.select.formulation_of`): no other module compares
 ``formulation`` with a formulation's name (docs/architecture.md, "The formulations")."""
 
 from __future__ import annotations
@@ -9,14 +9,15 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.gait.formulation import FORMULATIONS, FULL, REDUCED, formulation_of
-from gaitopt.gait.formulation_traits import FORMULATION_TRAITS
-from gaitopt.gait.options import FORMULATIONS as OPTION_FORMULATIONS
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.formulations.select import FORMULATIONS, FULL, REDUCED, formulation_of
+from gaitopt.gait.formulations.traits import FORMULATION_TRAITS
+from gaitopt.gait.options.gait_options import FORMULATIONS as OPTION_FORMULATIONS
+from gaitopt.gait.options.gait_options import GaitOptions
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "gaitopt"
 #: The modules that may name a formulation: the selection and the traits table.
-SELECTION = {SRC / "gait" / "formulation.py", SRC / "gait" / "formulation_traits.py"}
+SELECTION = {SRC / "gait" / "formulations" / "select.py",
+             SRC / "gait" / "formulations" / "traits.py"}
 
 
 def names_formulation(node: ast.expr) -> bool:

@@ -14,16 +14,16 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
-from gaitopt.gait.contact_sequence import (
+from gaitopt.gait.formulations.select import checked_sequence, contact_sequence, problem_for
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.builtin import heel_toe_sequence, walking_sequence
+from gaitopt.gait.sequence.contact_sequence import (
     ContactSequenceError,
     check_sequence,
     sequence_from_dict,
 )
-from gaitopt.gait.formulation import checked_sequence, contact_sequence, problem_for
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.phase_fractions import (
+from gaitopt.gait.sequence.phase_fractions import (
     FRACTION_PARAMETER,
     fraction_parameters,
     phase_share,

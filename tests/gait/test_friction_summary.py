@@ -9,8 +9,8 @@ import pytest
 
 from gaitopt.analysis.metrics import NORMAL_FLOOR, gait_metrics
 from gaitopt.cli.gait_summary import FRICTION_SHOWN, friction_text
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from tests.gait.conftest import SolveFn
 
 

@@ -11,16 +11,16 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.builtin_sequences import running_sequence, walking_sequence
-from gaitopt.gait.contact_sequence import (
+from gaitopt.gait.formulations.full.physics import state_names
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.builtin import running_sequence, walking_sequence
+from gaitopt.gait.sequence.contact_sequence import (
     ContactSequence,
     ContactSequenceError,
     PhaseSpec,
     check_sequence,
 )
-from gaitopt.gait.full_physics import state_names
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import load_model, model_from_dict
 from gaitopt.robot.biped import biped_of
 from gaitopt.robot.model import RobotModel

@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitopt.gait.gait_file import (
+from gaitopt.gait.record.file import (
     FAILED_WARNING,
     Gait,
     GaitFileError,
     GaitPhase,
 )
-from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
+from gaitopt.gait.record.interpolation import phase_controls_at, phase_states_at
 from gaitopt.robot import load_model
 from gaitopt.robot.symmetry import swap_names, swap_permutations
 from tests.viz.synthetic import forward_kinematics, synthetic_gait
@@ -275,7 +275,7 @@ def test_swap_names_follow_the_models_symmetry() -> None:
 def test_the_record_interpolant_is_the_transcriptions_bit_for_bit() -> None:
     """:func:`cubic_hermite` (NumPy, the gait file's rule) and the transcription's
     ``HermiteSimpson.state_at`` do the same arithmetic: equal on identical inputs."""
-    from gaitopt.gait.interpolation import cubic_hermite
+    from gaitopt.gait.record.interpolation import cubic_hermite
     from gaitopt.ocp.hermite_simpson import HermiteSimpson
 
     rng = np.random.default_rng(3)

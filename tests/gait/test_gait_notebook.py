@@ -93,7 +93,7 @@ def test_animate_to_a_file_returns_the_path(default_gait: Gait, tmp_path: Path) 
 
 
 def test_the_gait_file_module_imports_no_plotting() -> None:
-    code = ("import sys, gaitopt.gait.gait_file; "
+    code = ("import sys, gaitopt.gait.record.file; "
             "print([m for m in ('matplotlib', 'gaitopt.viz.notebook') if m in sys.modules])")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)

@@ -1,8 +1,8 @@
 """The events that apply the liftoff impulse are those the gait file's contact sequence marks
 (``impulse``), whatever they are called: the walk's ``liftoff``, the heel-toe walk's
-``toe_off`` (:func:`gaitopt.gait.cost.impulse_events`); only a file without a sequence is read
-by the name ``liftoff``. The recomputed cost charges their work, the parameter check compares
-their impulse with ``liftoff_impulse``, and the friction check exempts their lifting tip.
+``toe_off`` (:func:`gaitopt.gait.formulations.cost.impulse_events`); only a file without a sequence
+is read by the name ``liftoff``. The recomputed cost charges their work, the parameter check
+compares their impulse with ``liftoff_impulse``, and the friction check exempts their lifting tip.
 
 The gaits are the default five-link walk with its ``liftoff`` given a chosen impulse through
 the liftoff map and renamed: renaming changes no physics, so every result must stay the same.
@@ -22,10 +22,10 @@ from numpy.typing import NDArray
 from gaitopt.analysis.metrics import gait_metrics
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.dynamics.functions import liftoff_function
-from gaitopt.gait import cost
-from gaitopt.gait.full_physics import per_point
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.formulations import cost
+from gaitopt.gait.formulations.full.physics import per_point
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from tests.gait.conftest import Reference
 
 Array = NDArray[np.float64]

@@ -1,6 +1,6 @@
 """Another topology through the same mechanism: a knee-less biped (a torso on two rigid legs
 with point tips, hip torques only; ``tests/gait/data/compass.yaml``). It has no thigh-shank
-legs, so it takes the generic guess (:mod:`gaitopt.gait.sequence_guess`); its gaits are
+legs, so it takes the generic guess (:mod:`gaitopt.gait.guess.sequence`); its gaits are
 checked against Pinocchio's equations of motion at every knot and by verify."""
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ import yaml
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.formulation import biped_for, contact_sequence
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.sequence_guess import sequence_guess
+from gaitopt.gait.formulations.select import biped_for, contact_sequence
+from gaitopt.gait.guess.sequence import sequence_guess
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.robot import load_model, model_from_dict
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import leg_swap

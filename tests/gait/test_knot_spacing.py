@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.solve import solve_walking
-from gaitopt.gait.transcriptions import cosine_knots, target_grid
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.solve.staged import solve_walking
+from gaitopt.gait.solve.transcriptions import cosine_knots, target_grid
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import reduced_biped
 
@@ -72,9 +72,9 @@ def test_cosine_knots_converge_where_uniform_ones_do_not() -> None:
 def test_cosine_grid_of_a_four_phase_sequence() -> None:
     """Cosine spacing follows the problem's phases: the heel-toe walk's four phases get their
     own knot counts (the density rule), and the transcription builds on that mesh."""
-    from gaitopt.gait.contact_sequence import phase_knots
-    from gaitopt.gait.formulation import contact_sequence
-    from gaitopt.gait.transcriptions import transcription_for
+    from gaitopt.gait.formulations.select import contact_sequence
+    from gaitopt.gait.sequence.contact_sequence import phase_knots
+    from gaitopt.gait.solve.transcriptions import transcription_for
 
     model = load_model("seven-link")
     options = GaitOptions(formulation="full", gait="heel-toe", knots=(8, 5),

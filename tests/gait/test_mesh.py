@@ -16,10 +16,10 @@ import pytest
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import guess_from_gait, solve_gait_solution
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
-from gaitopt.gait.solve import solve_walking
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.record import gait_from_solution
+from gaitopt.gait.solve.staged import solve_walking
 from gaitopt.robot import load_model
 from tests.gait.conftest import Solved, SolveFn
 

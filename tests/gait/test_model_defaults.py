@@ -14,10 +14,11 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait import cost
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.guess import default_running_step, default_step_length
-from gaitopt.gait.model_defaults import (
+from gaitopt.gait.formulations import cost
+from gaitopt.gait.guess.naive import default_running_step, default_step_length
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, follows_model
+from gaitopt.gait.options.model_defaults import (
     DEFAULT_SPEEDS,
     MULTI_PHASE_KNOTS,
     default_gait,
@@ -26,10 +27,9 @@ from gaitopt.gait.model_defaults import (
     legs_contacts,
     options_for_model,
 )
-from gaitopt.gait.model_scale import REFERENCE, leg_length, model_scale
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, follows_model
-from gaitopt.gait.preflight import UnwalkableModelError, preflight
-from gaitopt.gait.solve import REFERENCE_SPEED, reference_speed
+from gaitopt.gait.options.model_scale import REFERENCE, leg_length, model_scale
+from gaitopt.gait.options.preflight import UnwalkableModelError, preflight
+from gaitopt.gait.solve.staged import REFERENCE_SPEED, reference_speed
 from gaitopt.robot import load_model
 from tests.gait.conftest import SolveFn
 
@@ -232,7 +232,7 @@ def test_the_seven_link_default_command_converges_and_verifies(tmp_path: Path) -
     """``gaitopt solve --model seven-link`` with no other option: the heel-toe walk at
     72.2 m/min on 24 + 16 knots, its error estimate within 1 %, and ``verify`` passes
     (about 40-70 s)."""
-    from gaitopt.gait.gait_file import Gait
+    from gaitopt.gait.record.file import Gait
 
     out = tmp_path / "g.gait.json"
     result = CliRunner().invoke(cli, ["solve", "--model", "seven-link", "-o", str(out)])

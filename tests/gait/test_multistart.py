@@ -15,9 +15,9 @@ from click.testing import CliRunner
 
 from gaitopt.cli import cli
 from gaitopt.cli.gait import multistart_default
-from gaitopt.gait.formulation import FORMULATIONS
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.solve import SAME_COST, SAME_STEP, distinct
+from gaitopt.gait.formulations.select import FORMULATIONS
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve.staged import SAME_COST, SAME_STEP, distinct
 from tests.gait.conftest import SolveFn
 
 

@@ -12,9 +12,9 @@ import pytest
 import yaml
 
 import gaitopt.ocp.transcription as transcription_module
-from gaitopt.gait import solve as gait_solve
-from gaitopt.gait import transcriptions
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve import staged as gait_solve
+from gaitopt.gait.solve import transcriptions
 from gaitopt.robot import load_model
 from gaitopt.robot.loader import builtin_text
 from gaitopt.robot.schema import model_from_dict
@@ -84,7 +84,7 @@ def test_a_changed_model_or_option_or_a_corrupt_file_builds_anew(fresh: Path) ->
 
 
 def test_compiled_walking_nlp_is_the_point_derivatives_or_refused() -> None:
-    from gaitopt.gait.options import GaitOptionsError
+    from gaitopt.gait.options.gait_options import GaitOptionsError
 
     separated = OPTIONS.replace(transcription="hermite-simpson-separated")
     assert transcriptions.evaluation_mode(separated, None) == "points"

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
-from gaitopt.gait import full_coordinates as full
-from gaitopt.gait import transcriptions
-from gaitopt.gait.formulation import contact_sequence
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.solve import solve_walking
+from gaitopt.gait.formulations.full import problem as full
+from gaitopt.gait.formulations.select import contact_sequence
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve import transcriptions
+from gaitopt.gait.solve.staged import solve_walking
 from gaitopt.ocp import transcribe
 from gaitopt.robot import load_model
 from gaitopt.robot.model import RobotModel

@@ -13,9 +13,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from gaitopt.gait import record_reduced as record
-from gaitopt.gait import walking
-from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.gait.formulations.reduced import extract as record
+from gaitopt.gait.formulations.reduced import physics as walking
+from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
 from gaitopt.robot import load_model
 
 

@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from gaitopt.gait import full_physics as full
-from gaitopt.gait import record_full
+from gaitopt.gait.formulations.full import extract as record_full
+from gaitopt.gait.formulations.full import physics as full
 from gaitopt.robot import load_model
 
 HELD = ("tip_1", "tip_2:y")

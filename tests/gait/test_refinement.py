@@ -1,4 +1,4 @@
-"""A solve refines its grid until its estimates are within ``accuracy`` (gait.refinement):
+"""A solve refines its grid until its estimates are within ``accuracy`` (gait.solve.refinement):
 the relative estimates, the loop's rules on fake solves, and real solves through the API and
 the command line (refined, within; not reachable, exit status 3 and verify failing
 ``accuracy.estimate``; knots given, no refinement and no target)."""
@@ -17,18 +17,18 @@ from click.testing import CliRunner
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.cli import cli
 from gaitopt.gait.api import solve_gait_solution
-from gaitopt.gait.contact_sequence import ContactSequenceError, phase_knots
-from gaitopt.gait.formulation import checked_sequence, contact_sequence
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.refinement import (
+from gaitopt.gait.formulations.select import checked_sequence, contact_sequence
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.contact_sequence import ContactSequenceError, phase_knots
+from gaitopt.gait.solve.refinement import (
     MAX_ROUNDS,
     refine_to_accuracy,
     relative_estimates,
     solved_shares,
     worst_estimate,
 )
-from gaitopt.gait.solution import WalkingSolution
+from gaitopt.gait.solve.solution import WalkingSolution
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import reduced_biped
 
@@ -184,7 +184,7 @@ def test_a_solve_above_its_accuracy_is_refined_until_within() -> None:
 
 
 def _gait(solution: WalkingSolution) -> Gait:
-    from gaitopt.gait.record import gait_from_solution
+    from gaitopt.gait.solve.record import gait_from_solution
 
     return gait_from_solution(solution)
 
@@ -243,7 +243,7 @@ class FakeSolved:
 def test_a_failed_solve_at_the_default_speed_is_tried_at_the_walks_default(
         monkeypatch: pytest.MonkeyPatch) -> None:
     model = load_model("seven-link")
-    from gaitopt.gait.model_defaults import default_speed
+    from gaitopt.gait.options.model_defaults import default_speed
 
     heel_toe, walk = default_speed(model, "heel-toe"), default_speed(model, "walk")
     asked = _fake_solves(monkeypatch, fails_at=heel_toe)

@@ -13,16 +13,16 @@ from gaitopt.cli import cli
 from gaitopt.cli.base import UserError
 from gaitopt.cli.gait import speed_bounds
 from gaitopt.gait.api import solve_gait
-from gaitopt.gait.builtin_sequences import running_sequence
-from gaitopt.gait.formulation import biped_for
-from gaitopt.gait.model_defaults import (
+from gaitopt.gait.formulations.select import biped_for
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.options.model_defaults import (
     RUN_STANCE_BOUNDS,
     RUN_STEP_LENGTH_BOUNDS,
     gait_problem,
     options_for_model,
     run_stance_guess,
 )
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.sequence.builtin import running_sequence
 from gaitopt.robot import load_model
 
 

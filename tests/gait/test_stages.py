@@ -8,9 +8,9 @@ import dataclasses
 
 import pytest
 
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, parameter_bounds
-from gaitopt.gait.stages import (
+from gaitopt.gait.formulations.reduced.problem import FRACTION, IMPULSE, SPEED, parameter_bounds
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve.stages import (
     ANKLES,
     COARSE_COMPLETION,
     COLD_CONTROL_MODEL,
@@ -18,7 +18,7 @@ from gaitopt.gait.stages import (
     RELEASES,
     held_bounds,
 )
-from gaitopt.gait.transcriptions import BOUNDS_ONLY_OPTIONS, NlpStructure
+from gaitopt.gait.solve.transcriptions import BOUNDS_ONLY_OPTIONS, NlpStructure
 from gaitopt.robot import load_model
 
 FIELDS = {f.name for f in dataclasses.fields(GaitOptions)}

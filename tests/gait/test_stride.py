@@ -15,15 +15,15 @@ from gaitopt.analysis.checks.events import period_maps
 from gaitopt.analysis.stability import StabilityError, step_from_gait
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.cli import cli
-from gaitopt.gait.builtin_sequences import heel_toe_sequence, walking_sequence
-from gaitopt.gait.contact_sequence import (
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.builtin import heel_toe_sequence, walking_sequence
+from gaitopt.gait.sequence.contact_sequence import (
     check_sequence,
     phase_knots,
     sequence_from_dict,
     stride_sequence,
 )
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.robot import RobotModel, load_model, model_from_dict
 from gaitopt.robot.symmetry import contact_pairing, swap_matrices
 from tests.gait.conftest import SolveFn, recomputed_cost

@@ -10,8 +10,8 @@ from collections.abc import Iterator
 import pytest
 
 from gaitopt import process_memory
-from gaitopt.gait import transcriptions as tc
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.solve import transcriptions as tc
 from gaitopt.robot import load_model
 
 PAPER = GaitOptions.paper()

@@ -19,11 +19,11 @@ from gaitopt.analysis.checks.knots import full_state_function
 from gaitopt.analysis.checks.samples import points_function
 from gaitopt.analysis.verify import CHECKS, VerifyReport, verify_gait
 from gaitopt.cli import cli
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.gait_parts import GaitSamples
-from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.walking import DOUBLE, SINGLE
+from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.record.interpolation import phase_controls_at, phase_states_at
+from gaitopt.gait.record.parts import GaitSamples
 from tests.gait.conftest import (
     Reference,
     SolveFn,

@@ -14,8 +14,8 @@ import pytest
 from gaitopt.analysis.checks.knots import full_state_names, state_map
 from gaitopt.analysis.verify import UnknownStatesError, verify_gait
 from gaitopt.dynamics.kinematics import contact_position, point_position
-from gaitopt.gait.gait_file import Gait, GaitPhase
-from gaitopt.gait.interpolation import phase_states_at
+from gaitopt.gait.record.file import Gait, GaitPhase
+from gaitopt.gait.record.interpolation import phase_states_at
 from gaitopt.robot import load_model
 from tests.gait.test_verify import CORRUPTIONS
 

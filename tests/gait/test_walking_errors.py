@@ -12,9 +12,9 @@ import pytest
 import yaml
 
 from gaitopt.gait.api import solve_gait, solve_gait_solution
-from gaitopt.gait.gait_file import FAILED_WARNING, Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions, GaitOptionsError
-from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
+from gaitopt.gait.record.file import FAILED_WARNING, Gait, GaitFileError
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.robot import ModelError, load_model
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.robot.loader import builtin_text
@@ -30,7 +30,7 @@ def no_solve(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuse(*args: Any, **kwargs: Any) -> Any:
         raise AssertionError("a solve was started for a request that should be refused")
 
-    monkeypatch.setattr("gaitopt.gait.solve.transcription_for", refuse)
+    monkeypatch.setattr("gaitopt.gait.solve.staged.transcription_for", refuse)
 
 
 def one_legged_model_file(folder: Path) -> Path:

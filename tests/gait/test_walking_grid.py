@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from gaitopt.gait.api import solve_gait, solve_gait_solution
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import gait_from_solution
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.record import gait_from_solution
 
 VARIANTS = {
     "ankle+impulse": {"ankle": True, "impulse": True},

@@ -13,8 +13,8 @@ import pytest
 import yaml
 
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.loader import builtin_text
 from tests.gait.conftest import (

@@ -12,8 +12,8 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.walking import DOUBLE, SINGLE, control_names
+from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE, control_names
+from gaitopt.gait.record.file import Gait
 from tests.gait.conftest import (
     EOM_RTOL,
     Reference,

@@ -15,9 +15,9 @@ import pytest
 
 from gaitopt.analysis.metrics import gait_metrics
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.walking import SINGLE, control_names
+from gaitopt.gait.formulations.reduced.physics import SINGLE, control_names
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from tests.gait.conftest import (
     Reference,
     SolveFn,

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from gaitopt.gait.api import restart_point, solve_gait
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import load_model
 from tests.gait.conftest import Solved
 

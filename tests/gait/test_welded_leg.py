@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot.model import RobotModel
 from tests.gait.conftest import (
     Reference,

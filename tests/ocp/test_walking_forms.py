@@ -14,15 +14,15 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.problem import (
+from gaitopt.gait.formulations.reduced.problem import (
     Relaxation,
     parameter_bounds,
     relaxed_bounds,
     walking_problem,
     with_step_time,
 )
-from gaitopt.gait.solve import (
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
+from gaitopt.gait.solve.staged import (
     PRIMAL_WARM_OPTIONS,
     WalkingSolution,
     solve_walking,

@@ -253,7 +253,7 @@ def test_rewritten_urdf_gives_the_same_dynamics() -> None:
 @pytest.mark.slow
 def test_rewritten_urdf_gives_the_same_optimal_gait() -> None:
     from gaitopt.gait.api import solve_gait
-    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.options.gait_options import GaitOptions
 
     original, imported = five_link(), model_from_urdf(rewritten_five_link())
     assert imported.content_hash() != original.content_hash()  # not a cached copy

@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.loader import model_from_dict
 from gaitopt.study.cost_findings import COST_FINDING_IDS, assess_cost_findings, ranked

@@ -7,7 +7,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.driver import run_sweep
 from gaitopt.study.executors import Backend, InlineExecutor

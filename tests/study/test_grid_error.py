@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.study.grid_error import (
     CHECK_DIR,
     REFINE_DIR,

@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.study.summary import SUMMARY_FILE, SummaryError, read_summary
 
 SRC = Path(__file__).resolve().parents[2] / "src"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot import load_model
 from gaitopt.study.driver import check_points
 from gaitopt.study.plan import (

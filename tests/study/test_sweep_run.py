@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import load_model
 from gaitopt.study.driver import SweepReport, run_sweep
 from gaitopt.study.plan import SETTINGS_FILE, SweepSpec

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from gaitopt.gait.gait_file import (
+from gaitopt.gait.record.file import (
     Gait,
     GaitEvent,
     GaitPhase,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.viz.animation import animate_gait, contact_forces_at, frame_times, gif_delays_ms
 from tests.viz.synthetic import synthetic_gait
 

@@ -9,7 +9,7 @@ import pytest
 from matplotlib.figure import Figure
 from PIL import Image
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.study.summary import SummaryRow, failed_row, variant_name
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
 from gaitopt.viz.stick import stick_strip_figure

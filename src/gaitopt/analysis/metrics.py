@@ -12,8 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.analysis.checks.samples import phase_of_samples
-from gaitopt.gait.cost import impulse_events
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.formulations.cost import impulse_events
+from gaitopt.gait.record.file import Gait
 
 #: Normal forces/impulses below this (N, N s) are treated as zero in friction ratios.
 NORMAL_FLOOR = 1e-6

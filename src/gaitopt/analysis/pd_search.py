@@ -33,7 +33,7 @@ import numpy as np
 
 from gaitopt.analysis.return_map import StepSimulationError
 from gaitopt.analysis.stability import StabilityError, gait_stability
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 
 KP_GRID: tuple[float, ...] = (300.0, 1000.0, 3000.0, 10000.0)
 KD_GRID: tuple[float, ...] = (15.0, 50.0, 150.0, 500.0)

@@ -17,7 +17,7 @@ all the time). The next step is the same motion with the legs swapped
 its origin at the new stance point's measured position.
 
 Within a phase the reference is the gait file's own interpolation
-(:mod:`gaitopt.gait.interpolation`: states cubic Hermite, mapped to ``q``, ``qd``; torques
+(:mod:`gaitopt.gait.record.interpolation`: states cubic Hermite, mapped to ``q``, ``qd``; torques
 piecewise linear), tabulated every :data:`TABLE_STEP` s and read linearly in between, indexed
 
 * ``tracking="time"``: by the phase's own clock from its start (the last value held if the
@@ -57,8 +57,8 @@ from gaitopt.analysis.mujoco_model import MujocoRobot, import_mujoco, mujoco_rob
 from gaitopt.analysis.stability import step_from_gait
 from gaitopt.dynamics.actuation import actuation_rows
 from gaitopt.dynamics.kinematics import contact_position
-from gaitopt.gait.gait_file import Gait, GaitPhase
-from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
+from gaitopt.gait.record.file import Gait, GaitPhase
+from gaitopt.gait.record.interpolation import phase_controls_at, phase_states_at
 from gaitopt.robot.mjcf_export import MjcfContact
 from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 from gaitopt.robot.symmetry import leg_swap

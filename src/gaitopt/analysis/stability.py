@@ -54,8 +54,8 @@ from gaitopt.dynamics.crba import crba
 from gaitopt.dynamics.kinematics import contact_jacobian, contact_position
 from gaitopt.dynamics.rnea import gravity_forces
 from gaitopt.dynamics.tree import holds
-from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.contact_sequence import ContactSequenceError, sequence_from_dict
 from gaitopt.robot.model import BASE_POSITION
 from gaitopt.robot.symmetry import leg_swap, swap_matrices
 

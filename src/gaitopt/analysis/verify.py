@@ -18,12 +18,12 @@ The checks (stable ids, see :data:`CHECKS` and ``docs/outputs.md``, section "Ver
 * the dense samples (:mod:`.checks.samples`): on the phases' interpolants, points at the
   kinematics, normal forces between knots, torque bounds, joint limits, swing clearance;
 * the solve's own grid-error estimates within the accuracy it was asked to reach
-  (``accuracy.estimate``; :mod:`gaitopt.gait.refinement`);
-* the cost recomputed from the file (:func:`gaitopt.gait.cost.recompute_cost`): for the
+  (``accuracy.estimate``; :mod:`gaitopt.gait.solve.refinement`);
+* the cost recomputed from the file (:func:`gaitopt.gait.formulations.cost.recompute_cost`): for the
   paper's cost the exact integral of the squared piecewise-linear controls plus the impulse
   squared, over the step length; the costs of transport by the transcription's quadrature,
   with the liftoff impulse's work at the event the file's contact sequence marks impulsive
-  (:func:`gaitopt.gait.cost.impulse_events`: ``toe_off`` in a heel-toe walk).
+  (:func:`gaitopt.gait.formulations.cost.impulse_events`: ``toe_off`` in a heel-toe walk).
 
 What the transcription imposes exactly (knots, events, periodicity, cost) is checked to about
 1e-6 (relative where it says so); what it cannot impose between knots against the accuracy of
@@ -40,9 +40,9 @@ from gaitopt.analysis.checks.integration import integration_checks
 from gaitopt.analysis.checks.knots import UnknownStatesError, knot_checks
 from gaitopt.analysis.checks.samples import sample_checks
 from gaitopt.analysis.checks.swing import swing_checks
-from gaitopt.gait.cost import recompute_cost
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.refinement import worst_estimate
+from gaitopt.gait.formulations.cost import recompute_cost
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.refinement import worst_estimate
 
 __all__ = ["CHECKS", "LIMITS", "Check", "CheckSpec", "UnknownStatesError", "VerifyReport",
            "verify_gait"]
@@ -111,7 +111,7 @@ def _cost_check(gait: Gait, lim: dict[str, float]) -> Check:
 
 def _accuracy_check(gait: Gait, lim: dict[str, float]) -> Check:
     """``accuracy.estimate``: the largest relative grid-error estimate the solve recorded
-    (:func:`gaitopt.gait.refinement.worst_estimate`) against the accuracy it was asked to
+    (:func:`gaitopt.gait.solve.refinement.worst_estimate`) against the accuracy it was asked to
     reach (``solver.accuracy.target``, scaled like every limit). A gait solved on a grid the
     caller chose has no target: the estimate is reported and the check passes."""
 

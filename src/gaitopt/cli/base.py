@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, TypeVar, get_args
 import click
 
 from gaitopt import __version__
-from gaitopt.gait.options import ControlModel, CostName, Formulation
+from gaitopt.gait.options.gait_options import ControlModel, CostName, Formulation
 from gaitopt.robot import ModelError
 
 if TYPE_CHECKING:
@@ -114,8 +114,8 @@ def model_option(f: F) -> F:
 
 def knots_option(f: F) -> F:
     """``--knots SINGLE,DOUBLE`` (text or None: the default grid; see :func:`grid_choice`)."""
-    from gaitopt.gait.model_defaults import MULTI_PHASE_KNOTS
-    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.options.gait_options import GaitOptions
+    from gaitopt.gait.options.model_defaults import MULTI_PHASE_KNOTS
 
     return click.option("--knots", default=None,
                         help="Grid points per phase: single support, double support [default: "
@@ -135,9 +135,9 @@ def paper_grid_option(f: F) -> F:
 
 def knot_spacing_option(help: str) -> Callable[[F], F]:
     """``--knot-spacing uniform|cosine`` with this help text (None when not given: the
-    :class:`~gaitopt.gait.options.GaitOptions` default, uniform with ``--paper-grid``; see
-    :func:`grid_choice`)."""
-    from gaitopt.gait.options import KNOT_SPACINGS, GaitOptions
+    :class:`~gaitopt.gait.options.gait_options.GaitOptions` default, uniform with ``--paper-grid``;
+    see :func:`grid_choice`)."""
+    from gaitopt.gait.options.gait_options import KNOT_SPACINGS, GaitOptions
 
     return click.option("--knot-spacing", type=click.Choice(list(KNOT_SPACINGS)),
                         default=None,
@@ -174,7 +174,7 @@ def cost_option(help: str) -> Callable[[F], F]:
 def control_model_option(help: str) -> Callable[[F], F]:
     """``--control-model paper|jumps`` with this help text (None: the default, see
     :func:`grid_choice`)."""
-    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.options.gait_options import GaitOptions
 
     return click.option("--control-model", type=click.Choice(get_args(ControlModel)),
                         default=None,
@@ -186,9 +186,9 @@ def grid_choice(knots: str | None, control_model: str | None,
     """The ``knots``, ``control_model`` and ``knot_spacing`` of ``--knots``,
     ``--control-model``, ``--knot-spacing`` and ``--paper-grid`` (the paper's 8 + 5 uniform
     knots, control model and compressed transcription, ``GaitOptions.paper``); unset ones
-    keep the :class:`~gaitopt.gait.options.GaitOptions` defaults. ``--paper-grid`` with
+    keep the :class:`~gaitopt.gait.options.gait_options.GaitOptions` defaults. ``--paper-grid`` with
     ``--knots``, ``--control-model`` or cosine knots is a usage error."""
-    from gaitopt.gait.options import PAPER_GRID
+    from gaitopt.gait.options.gait_options import PAPER_GRID
 
     if paper_grid:
         given = [o for o, v in (("--knots", knots), ("--control-model", control_model)) if v]

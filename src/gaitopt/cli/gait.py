@@ -28,11 +28,13 @@ from gaitopt.cli.base import (
     parse_pair,
     resting_power_option,
 )
-from gaitopt.gait.formulation import Formulation, biped_for, checked_sequence, formulation_of
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.model_defaults import MULTI_PHASE_KNOTS, options_for_model
-from gaitopt.gait.model_scale import model_scale
-from gaitopt.gait.options import (
+from gaitopt.gait.formulations.select import (
+    Formulation,
+    biped_for,
+    checked_sequence,
+    formulation_of,
+)
+from gaitopt.gait.options.gait_options import (
     GAITS,
     TRANSCRIPTIONS,
     GaitOptions,
@@ -40,8 +42,11 @@ from gaitopt.gait.options import (
     follows_model,
     validate_options,
 )
-from gaitopt.gait.preflight import refuse_unwalkable
-from gaitopt.gait.solve import REFERENCE_SPEED, StageReport, reference_speed
+from gaitopt.gait.options.model_defaults import MULTI_PHASE_KNOTS, options_for_model
+from gaitopt.gait.options.model_scale import model_scale
+from gaitopt.gait.options.preflight import refuse_unwalkable
+from gaitopt.gait.record.file import Gait, GaitFileError
+from gaitopt.gait.solve.staged import REFERENCE_SPEED, StageReport, reference_speed
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
 
@@ -70,7 +75,7 @@ def multistart_default(speed: float | None, formulation: Formulation,
     ``--no-multistart`` is given: for the paper's walk in reduced coordinates (where it was
     measured) at a given speed at least ``far`` (:data:`FAR_FROM_REFERENCE` on the reference
     biped) from the ``reference`` speed (12 m/min on the reference biped: the speed-free
-    optimal walk starts there; a model's: :func:`gaitopt.gait.solve.reference_speed`)."""
+    optimal walk starts there; a model's: :func:`gaitopt.gait.solve.staged.reference_speed`)."""
     return (formulation.traits.multistart_by_default and speed is not None
             and abs(speed - reference) >= far - 1e-12)
 
@@ -78,7 +83,7 @@ def multistart_default(speed: float | None, formulation: Formulation,
 def read_sequence(path: Path) -> dict[str, Any]:
     """A contact sequence file (YAML): its data, checked for form (the model check comes with
     the options)."""
-    from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
+    from gaitopt.gait.sequence.contact_sequence import ContactSequenceError, sequence_from_dict
     from gaitopt.robot.loader import parse_yaml
 
     try:
@@ -248,7 +253,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.cli.gait_summary import summary_table
     from gaitopt.gait.api import as_model, solve_gait_solution, warm_start_usable
-    from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
+    from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
 
     console = make_console()
     model = as_model(model_name)
@@ -349,7 +354,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:
-        from gaitopt.gait.diagnose import diagnose
+        from gaitopt.gait.solve.diagnose import diagnose
 
         diagnosis = diagnose(solution)
         console.print("FAILED: " + diagnosis.text())
@@ -372,7 +377,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
     console.print(f"wrote {output}")
     record = gait.solver.get("accuracy", {})
     if record.get("within_target") is False:
-        from gaitopt.gait.refinement import MAX_ROUNDS, describe
+        from gaitopt.gait.solve.refinement import MAX_ROUNDS, describe
 
         worst = (record.get("worst_estimate") or float("inf"),
                  record.get("worst_estimate_of", "cost"))

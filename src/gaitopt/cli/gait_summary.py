@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 from rich.table import Table
 
-from gaitopt.gait.contact_sequence import ContactSequence
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.contact_sequence import ContactSequence
 from gaitopt.units import format_speed
 
 if TYPE_CHECKING:

@@ -10,7 +10,7 @@ import click
 from rich.console import Console
 
 from gaitopt.cli.base import UserError, cli, make_console
-from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.study.plan import SETTINGS_FILE
 from gaitopt.study.summary import SUMMARY_FILE, SummaryError
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.cli.stability import resolve_gains
-from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.record.file import Gait, GaitFileError
 
 #: Exit status of a refused simulation (no stabilising gains).
 REFUSED = 3

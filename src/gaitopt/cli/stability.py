@@ -14,7 +14,7 @@ from rich.table import Table
 from gaitopt.analysis.stability import StabilityError
 from gaitopt.cli.base import UserError, cli, make_console
 from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.record.file import Gait, GaitFileError
 
 
 def _gains(text: str | None) -> tuple[float, float] | None:

@@ -36,8 +36,8 @@ from gaitopt.cli.cost_study import run_cost_study
 from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.cli.sweep_grid import make_spec, parse_speeds, parse_variants
 from gaitopt.cli.sweep_progress import run_with_progress
-from gaitopt.gait.formulation import default_formulation
-from gaitopt.gait.options import GAITS, GaitOptions, GaitOptionsError
+from gaitopt.gait.formulations.select import default_formulation
+from gaitopt.gait.options.gait_options import GAITS, GaitOptions, GaitOptionsError
 from gaitopt.study.driver import default_workers
 from gaitopt.study.grid_error import (
     CHECK_DIR,
@@ -121,7 +121,7 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
     console = make_console()
     if gait_kind is None or formulation is None:
         from gaitopt.gait.api import as_model
-        from gaitopt.gait.model_defaults import default_gait
+        from gaitopt.gait.options.model_defaults import default_gait
 
         try:
             model = as_model(model_name)

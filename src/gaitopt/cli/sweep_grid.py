@@ -10,7 +10,7 @@ import math
 from typing import Any
 
 from gaitopt.cli.base import UserError, parse_free_or_value, parse_knots
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.study.plan import SweepSpec, SweepSpecError
 from gaitopt.study.summary import VARIANTS
 

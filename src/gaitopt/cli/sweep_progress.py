@@ -23,7 +23,7 @@ from rich.progress import (
 )
 
 from gaitopt.cli.base import UserError
-from gaitopt.gait.options import GaitOptionsError
+from gaitopt.gait.options.gait_options import GaitOptionsError
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.driver import Counts, SweepReport, SweepSettingsError, SweepStart, run_sweep
 from gaitopt.study.executors import Backend, BackendError

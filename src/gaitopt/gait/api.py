@@ -25,16 +25,16 @@ import os
 
 import numpy as np
 
-from gaitopt.gait.accuracy import accuracy_record
-from gaitopt.gait.diagnose import SolveFailedError, diagnose
-from gaitopt.gait.full_physics import actuator_names
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.model_defaults import default_speed, options_for_model
-from gaitopt.gait.options import GaitOptions, follows_model
-from gaitopt.gait.preflight import refuse_unwalkable
-from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
-from gaitopt.gait.refinement import refine_to_accuracy
-from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking, transcription_for
+from gaitopt.gait.formulations.full.physics import actuator_names
+from gaitopt.gait.options.gait_options import GaitOptions, follows_model
+from gaitopt.gait.options.model_defaults import default_speed, options_for_model
+from gaitopt.gait.options.preflight import refuse_unwalkable
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.accuracy import accuracy_record
+from gaitopt.gait.solve.diagnose import SolveFailedError, diagnose
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.solve.refinement import refine_to_accuracy
+from gaitopt.gait.solve.staged import ProgressFn, WalkingSolution, solve_walking, transcription_for
 from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
@@ -80,7 +80,7 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`.
 
     ``refine``: whether the solve refines its grid to ``options.accuracy``
-    (:mod:`gaitopt.gait.refinement`); None: where the knots are left to the model's default.
+    (:mod:`gaitopt.gait.solve.refinement`); None: where the knots are left to the model's default.
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
@@ -88,7 +88,7 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
 
     Raises:
         UnwalkableModelError: something in the model prevents walking
-            (:func:`gaitopt.gait.preflight.preflight`); nothing was solved.
+            (:func:`gaitopt.gait.options.preflight.preflight`); nothing was solved.
     """
     robot = as_model(model)
     given = options or GaitOptions()
@@ -129,7 +129,7 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
 
 def check_result(solution: WalkingSolution) -> Result | None:
     """The converged result of the solve's last ``check grid`` stage (the problem on the
-    check grid of its knots, :meth:`gaitopt.gait.solve._Run.check`), or None."""
+    check grid of its knots, :meth:`gaitopt.gait.solve.staged._Run.check`), or None."""
     for name, result in reversed(solution.stage_results):
         if name.endswith("check grid"):
             return result if result.success else None
@@ -138,7 +138,7 @@ def check_result(solution: WalkingSolution) -> Result | None:
 
 def slower_default(model: RobotModel, options: GaitOptions) -> float | None:
     """The speed (m/s) a failed solve at the model's default speed tries next: the walk's
-    default at equal Froude number (:func:`gaitopt.gait.model_defaults.default_speed`: 12
+    default at equal Froude number (:func:`gaitopt.gait.options.model_defaults.default_speed`: 12
     m/min on 1 m legs), if it is under 90 % of ``options.speed``; else None. A model whose
     hips only swing backward, like MuJoCo's Walker2d, walks slowly with its torso leaning
     back and fails at the heel-toe walk's faster default."""
@@ -179,16 +179,16 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
         model: a :class:`RobotModel`, a built-in model name or a model file.
         options: the variant, targets and bounds (default: the paper's problem at 12 m/min
             for the five-link biped; on another model the defaults that follow it, as
-            ``gaitopt solve --model M``: :mod:`gaitopt.gait.model_defaults`).
+            ``gaitopt solve --model M``: :mod:`gaitopt.gait.options.model_defaults`).
         warm_start: a neighbouring gait to start from (the cold path is the fallback).
-        progress: called with a :class:`~gaitopt.gait.solution.StageReport` after every stage.
+        progress: called with a :class:`~gaitopt.gait.solve.solution.StageReport` after every stage.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
 
     Raises:
         MotionOutOfReachError: the converged solution's motion between knots leaves a leg's
             reach (it cannot be recorded as a gait; solve on a finer grid).
         SolveFailedError: the solve failed and its last values cannot even be recorded; the
-            message is the diagnosis (:func:`gaitopt.gait.diagnose.diagnose`).
+            message is the diagnosis (:func:`gaitopt.gait.solve.diagnose.diagnose`).
     """
     solution = solve_gait_solution(model, options, warm_start=warm_start, progress=progress,
                                    compiled=compiled)

@@ -348,7 +348,7 @@ def contact_pairing(model: RobotModel) -> dict[str, str]:
     contact pairs of the symmetry (declared, or inferred from the chains), or, for legs no
     symmetry pairs (unequal chains), the first two contact points (one per leg, as the
     built-in sequences take them). Needs no swap of the coordinates: a stride
-    (:func:`gaitopt.gait.contact_sequence.stride_sequence`) only renames its points."""
+    (:func:`gaitopt.gait.sequence.contact_sequence.stride_sequence`) only renames its points."""
     names = {c.name: c.name for c in model.contacts}
     try:
         return names | _mapping(model_symmetry(model).contacts)

@@ -50,8 +50,14 @@ from typing import Any, Literal
 
 from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import FORMULATIONS, KNOT_SPACINGS, Formulation, GaitOptions, KnotSpacing
+from gaitopt.gait.options.gait_options import (
+    FORMULATIONS,
+    KNOT_SPACINGS,
+    Formulation,
+    GaitOptions,
+    KnotSpacing,
+)
+from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.cost_start import AUTO_START, StartChoice, auto_start_speed, given_start

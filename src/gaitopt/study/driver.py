@@ -39,9 +39,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from gaitopt.gait.formulation import biped_for
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptionsError, validate_options
+from gaitopt.gait.formulations.select import biped_for
+from gaitopt.gait.options.gait_options import GaitOptionsError, validate_options
+from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.ocp import Result
 from gaitopt.study.executors import (
     BROKEN_ERRORS,

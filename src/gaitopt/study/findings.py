@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.study.summary import VARIANTS, SummaryRow, rows_of
 
 PAPER_OPTIMAL_SPEED_M_MIN = 12.0

@@ -38,7 +38,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from gaitopt.gait.check_grid import CHECK_KNOTS, check_knots, first_order_factor
+from gaitopt.gait.solve.check_grid import CHECK_KNOTS, check_knots, first_order_factor
 from gaitopt.study.plan import SETTINGS_FILE
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, read_summary
 

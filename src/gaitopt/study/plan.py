@@ -29,7 +29,7 @@ from functools import cached_property
 from typing import Any
 
 from gaitopt import __version__
-from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import VARIANTS, SpeedMode, gait_relpath, variant_flags
 

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 
 SpeedMode = Literal["fixed", "free"]
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.study.plan import (
     SETTINGS_FILE,
     SETTINGS_FORMAT,

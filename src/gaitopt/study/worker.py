@@ -10,7 +10,7 @@ from a gait file kept from an earlier run travels as the file's text (:class:`Sa
 read by the driver. Everything in these objects pickles (a task with a Result to start from
 is about 13 kB, an outcome about 60 kB).
 
-Transcriptions are cached per process by :mod:`gaitopt.gait.solve`; the outcome says which
+Transcriptions are cached per process by :mod:`gaitopt.gait.solve.staged`; the outcome says which
 problem structures this process has built, so the driver can send a process more points of a
 structure it already has.
 """
@@ -30,10 +30,10 @@ from pathlib import Path
 from typing import Any
 
 from gaitopt.gait.api import guess_from_gait
-from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import GaitOptions
-from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
-from gaitopt.gait.solve import WalkingSolution, solve_walking
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait, GaitFileError
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.solve.staged import WalkingSolution, solve_walking
 from gaitopt.ocp import Guess, Result
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags

@@ -24,8 +24,8 @@ from matplotlib.patches import FancyArrow
 from numpy.typing import NDArray
 from PIL import Image
 
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.interpolation import phase_forces_at
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.record.interpolation import phase_forces_at
 from gaitopt.robot.symmetry import swap_names
 from gaitopt.viz.stick import draw_pose, pose_at, pose_segments
 from gaitopt.viz.style import LEG_COLORS, new_figure

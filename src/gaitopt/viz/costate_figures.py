@@ -1,4 +1,4 @@
-"""The costates a gait record carries (:attr:`gaitopt.gait.gait_parts.GaitPhase.costates`).
+"""The costates a gait record carries (:attr:`gaitopt.gait.record.parts.GaitPhase.costates`).
 
 The costate ``lambda_j`` of state ``j`` is the sensitivity of the cost to that state at that
 instant (cost per unit of the state; sign convention ``H = L + lambda^T f``,
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from matplotlib.figure import Figure
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.viz.style import EVENT_LINE, gait_style, new_figure
 
 

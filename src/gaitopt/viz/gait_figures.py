@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 from gaitopt.viz.stick import draw_pose_row
 from gaitopt.viz.style import BOUND_LINE, EVENT_LINE, gait_style, new_figure
 

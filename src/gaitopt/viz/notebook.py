@@ -1,8 +1,8 @@
 """A gait in a notebook: its summary table, a figure, an animation.
 
-:class:`~gaitopt.gait.gait_file.Gait` calls these from ``_repr_html_`` (Jupyter shows the
-summary table when a gait is the value of a cell), :meth:`~gaitopt.gait.gait_file.Gait.plot`
-and :meth:`~gaitopt.gait.gait_file.Gait.animate`. The gait record sits below ``viz/`` and
+:class:`~gaitopt.gait.record.file.Gait` calls these from ``_repr_html_`` (Jupyter shows the
+summary table when a gait is the value of a cell), :meth:`~gaitopt.gait.record.file.Gait.plot`
+and :meth:`~gaitopt.gait.record.file.Gait.animate`. The gait record sits below ``viz/`` and
 never imports this module: it finds it through :mod:`gaitopt.views` (this module is a
 :class:`~gaitopt.views.GaitViews`), where the front door installs its loader; nothing here is
 imported until a view is first asked for.
@@ -30,7 +30,7 @@ from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import BOUND_LINE, EVENT_LINE, gait_style, new_figure
 
 if TYPE_CHECKING:
-    from gaitopt.gait.gait_file import Gait
+    from gaitopt.gait.record.file import Gait
 
 #: Figure kinds of :func:`gait_figure`.
 KINDS = ("overview", "torques", "hip", "heights", "poses", "costates")

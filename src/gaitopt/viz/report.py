@@ -40,7 +40,7 @@ from typing import Any
 from matplotlib.figure import Figure
 
 from gaitopt.fileio import write_text_atomic
-from gaitopt.gait.gait_file import Gait, GaitFileError
+from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.study.findings import (
     FAST_SPEED_M_MIN,
     PAPER_OPTIMAL_SPEED_M_MIN,

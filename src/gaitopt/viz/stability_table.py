@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from gaitopt.analysis.stability import StabilityError, StabilityReport, gait_stability
-from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.record.file import Gait
 
 #: PD gains (kp N m/rad, kd N m s/rad) of the report's tracked column.
 REPORT_PD: tuple[float, float] = (300.0, 30.0)

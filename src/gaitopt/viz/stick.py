@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from numpy.typing import NDArray
 
-from gaitopt.gait.gait_file import Gait, GaitSamples
+from gaitopt.gait.record.file import Gait, GaitSamples
 from gaitopt.viz.style import LEG_COLORS, new_figure
 
 Points = Mapping[str, NDArray[np.float64]]

@@ -26,9 +26,9 @@ from numpy.typing import NDArray
 from gaitopt.analysis.checks.check import Check, Worst
 from gaitopt.dynamics.functions import impact_function, liftoff_function
 from gaitopt.dynamics.tree import hold_name
-from gaitopt.gait.contact_sequence import ContactSequence, EventSpec, sequence_from_dict
-from gaitopt.gait.full_physics import per_point
-from gaitopt.gait.gait_file import Gait, GaitEvent
+from gaitopt.gait.formulations.full.physics import per_point
+from gaitopt.gait.record.file import Gait, GaitEvent
+from gaitopt.gait.sequence.contact_sequence import ContactSequence, EventSpec, sequence_from_dict
 from gaitopt.robot.symmetry import swap_matrices, swap_names
 
 Array = NDArray[np.float64]
@@ -71,7 +71,7 @@ def _apply(gait: Gait, event: GaitEvent, q: Array, held: tuple[str, ...], i: int
     """``(qd_after, impulses, contacts held after)`` of ``event`` (at the end of phase ``i``)
     from ``(q, qd_before)``. With the gait's contact sequence, the event's kind and the hold
     specs after it come from there (:meth:`ContactSequence.holds_after`); impulses are
-    ``(2,)`` per point (:func:`gaitopt.gait.full_physics.per_point`)."""
+    ``(2,)`` per point (:func:`gaitopt.gait.formulations.full.physics.per_point`)."""
     model = gait.model
     spec = _sequence_event(gait, i, event)
     if spec is not None:

@@ -32,8 +32,8 @@ from scipy.integrate import solve_ivp
 from gaitopt.analysis.checks.check import LIMITS, Check, Worst
 from gaitopt.analysis.checks.knots import state_map
 from gaitopt.dynamics.functions import contact_dynamics_function
-from gaitopt.gait.contact_sequence import phase_holds
-from gaitopt.gait.gait_file import Gait, GaitPhase
+from gaitopt.gait.record.file import Gait, GaitPhase
+from gaitopt.gait.sequence.contact_sequence import phase_holds
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]

@@ -18,7 +18,7 @@ At each knot of a phase with the contacts ``C`` held (``phase.contacts``), from 
 
 The events that apply the liftoff impulse (whose lifting tip is exempt from friction and
 carries the parameter's magnitude) are those the file's contact sequence marks
-(:func:`gaitopt.gait.cost.impulse_events`: ``liftoff`` in the walk, ``toe_off`` in the
+(:func:`gaitopt.gait.formulations.cost.impulse_events`: ``liftoff`` in the walk, ``toe_off`` in the
 heel-toe walk), by the name ``liftoff`` only in a file without a sequence.
 """
 
@@ -40,10 +40,10 @@ from gaitopt.dynamics.kinematics import (
 )
 from gaitopt.dynamics.reduced import N_DOUBLE, double_support_state
 from gaitopt.dynamics.rnea import rnea
-from gaitopt.gait import walking
-from gaitopt.gait.contact_sequence import phase_holds, sequence_from_dict
-from gaitopt.gait.cost import impulse_events
-from gaitopt.gait.gait_file import Gait, GaitPhase
+from gaitopt.gait.formulations.cost import impulse_events
+from gaitopt.gait.formulations.reduced import physics as walking
+from gaitopt.gait.record.file import Gait, GaitPhase
+from gaitopt.gait.sequence.contact_sequence import phase_holds, sequence_from_dict
 from gaitopt.robot.biped import biped_of
 from gaitopt.robot.model import RobotModel
 
@@ -65,10 +65,10 @@ def state_map(model: RobotModel, state_names: tuple[str, ...]) -> ca.Function:
     """``(q, qd, qdd) -> (x, xdot)`` of a phase with these ``state_names``.
 
     Full-coordinate phases (:func:`full_state_names`): ``x = [q, qd]``. Reduced phases (the
-    names of :func:`gaitopt.gait.walking.state_names`): the existing reduced maps
-    (:func:`~gaitopt.gait.walking.full_to_single_support`,
-    :func:`~gaitopt.gait.walking.full_to_double_support`; hip polar about tip 1 at the
-    origin). ``xdot = dx/dq qd + dx/dqd qdd`` in both cases.
+    names of :func:`gaitopt.gait.formulations.reduced.physics.state_names`): the existing reduced
+    maps (:func:`~gaitopt.gait.formulations.reduced.physics.full_to_single_support`,
+    :func:`~gaitopt.gait.formulations.reduced.physics.full_to_double_support`; hip polar about tip 1
+    at the origin). ``xdot = dx/dq qd + dx/dqd qdd`` in both cases.
 
     Raises:
         UnknownStatesError: other state names.

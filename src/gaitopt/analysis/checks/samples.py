@@ -11,7 +11,7 @@ there; one a rounding error after it belongs to the next phase).
   the same);
 * ``samples.controls``: the sample's ``u`` equals the phase's piecewise-linear controls at t;
 * ``samples.points``: each named point equals the forward kinematics of the sample's ``q``
-  (:func:`gaitopt.gait.record.sample_points`: ``hip``, the base origin; a joint's name, the
+  (:func:`gaitopt.gait.solve.record.sample_points`: ``hip``, the base origin; a joint's name, the
   origin of the link it moves; a contact's name, that point; ``torso_top``, the base link's
   far end);
 * ``samples.normal_force``: normal forces recomputed from the sample's ``q, qd, u`` with the
@@ -33,11 +33,11 @@ from gaitopt.analysis.checks.check import Check, Worst
 from gaitopt.analysis.checks.knots import full_state_function
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.dynamics.kinematics import point_position
-from gaitopt.gait.contact_sequence import phase_holds
-from gaitopt.gait.full_physics import hold_axes
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
-from gaitopt.gait.record_points import point_names, sample_points
+from gaitopt.gait.formulations.full.physics import hold_axes
+from gaitopt.gait.formulations.record_points import point_names, sample_points
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.record.interpolation import phase_controls_at, phase_states_at
+from gaitopt.gait.sequence.contact_sequence import phase_holds
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -57,7 +57,7 @@ def phase_of_samples(gait: Gait) -> list[NDArray[np.bool_]]:
 @functools.lru_cache(maxsize=16)
 def points_function(model: RobotModel, names: tuple[str, ...]) -> ca.Function:
     """``q -> (2, len(names))`` world positions of the named sample points
-    (:func:`gaitopt.gait.record.sample_points`)."""
+    (:func:`gaitopt.gait.solve.record.sample_points`)."""
     where = {name: (link, p) for name, link, p in sample_points(model)}
     q = ca.SX.sym("q", model.nq)
     cols = [point_position(model, q, *where[name]) for name in names]

@@ -1,7 +1,7 @@
 """The swing of each leg, read off a gait file: how often its foot reverses, how high it rises.
 
 A leg's *swing* is the time none of its contact points is held (the contact points of a leg:
-:func:`gaitopt.gait.model_defaults.legs_contacts`). A period (one step, or a stride) may cut
+:func:`gaitopt.gait.options.model_defaults.legs_contacts`). A period (one step, or a stride) may cut
 a swing in two: a leg released before the period ends lands after the next one starts. The
 two runs are joined through the period map: after one step through the leg swap (the other
 leg's run at the start of the step is what this leg does next), after a stride the leg's own
@@ -28,8 +28,8 @@ from numpy.typing import NDArray
 
 from gaitopt.analysis.checks.check import Check
 from gaitopt.analysis.checks.samples import phase_of_samples
-from gaitopt.gait.gait_file import Gait
-from gaitopt.gait.model_defaults import legs_contacts
+from gaitopt.gait.options.model_defaults import legs_contacts
+from gaitopt.gait.record.file import Gait
 
 Array = NDArray[np.float64]
 

@@ -1,0 +1,1 @@
+"""gaitopt.gait.formulations.full: full coordinates ``[q, qd]`` on any contact sequence."""

@@ -1,0 +1,1 @@
+"""gaitopt.gait.guess: the naive first guesses of a cold start, from geometry alone."""

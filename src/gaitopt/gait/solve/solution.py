@@ -1,0 +1,117 @@
+"""What a staged solve returns: a report per stage and the solution, and the judgement of one
+stage's IPOPT result (converged or not, the best of several).
+
+A stage converges when IPOPT says so and, at its "acceptable" level (which CasADi reports as
+success, with a constraint violation up to ``acceptable_constr_viol_tol``), only if the
+constraint violation is at most :data:`ACCEPTABLE_VIOLATION`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.ocp import Guess, PhaseGuess, Result
+from gaitopt.robot.model import RobotModel
+
+#: Largest constraint violation (in the constraints' own units) of a solution that IPOPT
+#: accepted at its "acceptable" level for it to count as converged: the tolerance to which
+#: verify checks what the transcription imposes exactly.
+ACCEPTABLE_VIOLATION = 1e-6
+
+ProgressFn = Callable[["StageReport"], None]
+
+
+@dataclass(frozen=True)
+class StageReport:
+    """What one stage did: its name, the grid, the outcome and the time it took."""
+
+    name: str
+    knots: tuple[int, int]
+    status: str
+    success: bool
+    iterations: int
+    objective: float
+    violation: float
+    wall_time_s: float
+    parameters: dict[str, float]
+    #: Solves the target problem itself (no relaxation, nothing held): its objective is
+    #: comparable between grids (the cost error estimate uses it).
+    full_problem: bool = False
+
+    def line(self) -> str:
+        p = self.parameters
+        return (f"{self.name:<22} {self.knots[0]}+{self.knots[1]} knots  "
+                f"{'ok ' if self.success else 'FAILED'} {self.status:<28} "
+                f"it {self.iterations:>4}  J {self.objective:10.4g}  "
+                f"v {p.get('speed', float('nan')) * 60:6.2f} m/min  "
+                f"L {p.get('step_length', float('nan')):.4f} m  "
+                f"viol {self.violation:.1e}  {self.wall_time_s:6.2f} s")
+
+
+@dataclass(frozen=True)
+class WalkingSolution:
+    """The outcome of :func:`~gaitopt.gait.solve.staged.solve_walking`: the final OCP result and
+    every stage."""
+
+    model: RobotModel
+    options: GaitOptions
+    result: Result
+    stages: tuple[StageReport, ...]
+    wall_time_s: float
+    stage_results: tuple[tuple[str, Result], ...] = ()
+    """Every stage's name and result, in order (for diagnosing a failure)."""
+    #: The full-problem stages that converged, (knots per phase, cost), in order: the grids
+    #: the cost was computed on (the cost error estimate compares the last two).
+    grid_costs: tuple[tuple[tuple[int, ...], float], ...] = ()
+    #: What the refinement to an accuracy adds to the gait file's ``solver.accuracy``
+    #: (:func:`gaitopt.gait.solve.refinement.refine_to_accuracy`); None before it ran.
+    accuracy_extra: Mapping[str, Any] | None = None
+
+    @property
+    def success(self) -> bool:
+        return self.result.success
+
+    @property
+    def failed_stage(self) -> StageReport | None:
+        """The last failed stage when the solve failed."""
+        if self.success:
+            return None
+        failed = [s for s in self.stages if not s.success]
+        return failed[-1] if failed else None
+
+
+def converged_or_failed(result: Result) -> Result:
+    """``result``, marked failed if IPOPT stopped at its acceptable level (which CasADi reports
+    as success) with a constraint violation above :data:`ACCEPTABLE_VIOLATION`: such a point
+    does not meet the requested tolerances. A feasible acceptable-level point stays a success
+    and keeps its status ``Solved_To_Acceptable_Level``, which the gait file records."""
+    if (result.success and result.status == "Solved_To_Acceptable_Level"
+            and result.constraint_violation > ACCEPTABLE_VIOLATION):
+        return dataclasses.replace(
+            result, success=False,
+            message=f"IPOPT stopped at its acceptable level with a constraint violation of "
+                    f"{result.constraint_violation:.2g} (more than {ACCEPTABLE_VIOLATION:g})")
+    return result
+
+
+def result_guess(result: Result) -> Guess:
+    """A result's knot values and parameters as a guess (values only, no multipliers)."""
+    phases = {ph.name: PhaseGuess(x=ph.x, u=ph.u, tau=(ph.t - ph.t[0]) / (ph.t[-1] - ph.t[0]))
+              for ph in result.phases}
+    return Guess(phases=phases, parameters=dict(result.parameters))
+
+
+def best_of(results: Sequence[Result | None]) -> Result | None:
+    """The converged result with the lowest objective (None if none converged)."""
+    ok = [r for r in results if r is not None and r.success]
+    return min(ok, key=lambda r: r.objective) if ok else None
+
+
+def as_failed(result: Result, failed: Result) -> Result:
+    """``result``'s values with the failed stage's status (never reported as converged)."""
+    return dataclasses.replace(result, success=False, status=failed.status,
+                               message=f"{failed.message} (values of an earlier stage)")
