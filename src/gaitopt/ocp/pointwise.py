@@ -51,7 +51,7 @@ import numpy as np
 
 from gaitopt import codegen
 from gaitopt.ocp.method import Method
-from gaitopt.ocp.nlp import Assembly
+from gaitopt.ocp.nlp import Assembly, IntervalInputs, interval_terms
 
 #: C compiler flags of the point libraries: ``-O1`` compiles the five-link biped's point
 #: Hessians about twice as fast as ``-O2`` (3-6 s against 4-13 s per phase on an idle
@@ -188,6 +188,18 @@ class _Group:
     y: ca.SX
 
 
+@dataclass(frozen=True)
+class _IntervalGroup:
+    """The N intervals of one phase: the function of one interval, its inputs v (nv, N) as
+    an SX expression of w and of the point outputs, the normalised interval lengths dtau
+    (1, N) and the symbols standing for its outputs (nr, N)."""
+
+    template: ca.Function
+    v: ca.SX
+    dtau: ca.DM
+    r: ca.SX
+
+
 class PointRecorder:
     """A :data:`gaitopt.ocp.nlp.PointCalls` that records the inputs of every point call
     (SX) and returns fresh symbols for the outputs; :meth:`ends` does the same for the ends
@@ -195,6 +207,7 @@ class PointRecorder:
 
     def __init__(self) -> None:
         self.groups: list[_Group] = []
+        self.interval_groups: list[_IntervalGroup] = []
 
     def _record(self, point: ca.Function, z: ca.SX) -> list[ca.SX]:
         """Record the calls of ``point`` on the columns of ``z`` (its inputs stacked); its
@@ -225,6 +238,84 @@ class PointRecorder:
                            ["E", "p"], ["linkages", "boundary"])
         link, bnd = self._record(rows, z)
         return [link, bnd, *fn.call([E, p])[2:]]
+
+
+    def intervals(self, i: int, inp: IntervalInputs) -> tuple[Any, Any, Any]:
+        """Record the terms of the phase's intervals (:data:`gaitopt.ocp.nlp.IntervalCalls`):
+        their inputs (a selection of w and of the point outputs, one column per interval) and
+        symbols for their outputs (defects, midpoint defects, quadrature); the function of
+        one interval is :func:`interval_template`."""
+        n, N = int(inp.x_k.shape[0]), int(inp.x_k.shape[1])
+        template = interval_template(inp)
+        v = ca.vertcat(*[c for c in (inp.x_k, inp.x_k1, inp.xm, inp.f_k, inp.f_k1, inp.f_m,
+                                     inp.l_k, inp.l_k1, inp.l_m) if c is not None],
+                       ca.repmat(inp.t_source, 1, N))
+        assert v.shape == (template.size1_in(0), N), (v.shape, template.size_in(0))
+        nr = template.size1_out(0)
+        r = ca.SX.sym(f"r{len(self.interval_groups)}", nr, N)
+        self.interval_groups.append(_IntervalGroup(template, v, inp.dtau, r))
+        return r[:n, :], (None if inp.xm is None else r[n:2 * n, :]), r[nr - 1:, :]
+
+
+def interval_template(inp: IntervalInputs) -> ca.Function:
+    """The terms of one interval of ``inp`` (:func:`gaitopt.ocp.nlp.interval_terms`) as a
+    function ``(v, dtau) -> [defects; midpoint defects; quadrature]`` of one column ``v =
+    [x_k; x_k1; xm; f_k; f_k1; f_m; l_k; l_k1; l_m; t_source]`` (the parts the method has)
+    and the normalised interval length: a function of the phase's sizes, the method and the
+    duration's form only, the same on every mesh."""
+    n, s = int(inp.x_k.shape[0]), int(inp.t_source.shape[0])
+    mid = inp.f_m is not None
+    names = ["x_k", "x_k1", *(["xm"] if inp.xm is not None else []), "f_k", "f_k1",
+             *(["f_m"] if mid else [])]
+    parts = {name: ca.SX.sym(name, n) for name in names}
+    parts |= {name: ca.SX.sym(name) for name in ("l_k", "l_k1", *(["l_m"] if mid else []))}
+    t_source, dtau = ca.SX.sym("t", s), ca.SX.sym("dtau")
+    local = IntervalInputs(inp.method, parts["x_k"], parts["x_k1"], parts.get("xm"),
+                           parts["f_k"], parts["f_k1"], parts.get("f_m"), parts["l_k"],
+                           parts["l_k1"], parts.get("l_m"), None, ca.DM(), t_source, inp.t_of)
+    defects, mid_defects, quadrature = interval_terms(local, inp.t_of(t_source), dtau)
+    out = ca.vertcat(defects, *([] if mid_defects is None else [mid_defects]), quadrature)
+    v = ca.vertcat(*parts.values(), t_source)
+    return ca.Function("interval", [v, dtau], [out], ["v", "dtau"], ["r"])
+
+
+@dataclass(frozen=True)
+class IntervalDerivatives:
+    """The derivatives of an :func:`interval_template` ``r(v, dtau)``: ``jacobian(v, dtau)
+    -> (r, dr/dv)`` and ``hessian(v, dtau, mu) -> (dr/dv, (dr/dv)^T mu, Hess_v (mu^T r))``
+    (SX functions, evaluated in CasADi's VM)."""
+
+    value: ca.Function
+    jacobian: ca.Function
+    hessian: ca.Function
+
+
+#: The derivatives of every interval template derived in this process, by a hash of the
+#: serialized template: a template is derived once, whatever the mesh.
+_INTERVAL_DERIVATIVES: dict[str, IntervalDerivatives] = {}
+#: How many interval templates this process has derived (a test checks that a second mesh
+#: of a problem derives none).
+interval_derivations = 0
+
+
+def interval_derivatives(template: ca.Function) -> IntervalDerivatives:
+    """The (process-wide cached) :class:`IntervalDerivatives` of ``template``."""
+    global interval_derivations
+    key = hashlib.sha256(template.serialize().encode()).hexdigest()
+    if key not in _INTERVAL_DERIVATIVES:
+        v, dtau = ca.SX.sym("v", template.size1_in(0)), ca.SX.sym("dtau")
+        r = template(v, dtau)
+        mu = ca.SX.sym("mu", r.shape[0])
+        jac = ca.jacobian(r, v)
+        hess, grad = ca.hessian(ca.dot(mu, r), v)
+        _INTERVAL_DERIVATIVES[key] = IntervalDerivatives(
+            template,
+            ca.Function("interval_jac", [v, dtau], list(ca.cse([r, jac])), ["v", "dtau"],
+                        ["r", "J"]),
+            ca.Function("interval_hess", [v, dtau, mu], list(ca.cse([jac, grad, hess])),
+                        ["v", "dtau", "mu"], ["J", "g", "H"]))
+        interval_derivations += 1
+    return _INTERVAL_DERIVATIVES[key]
 
 
 def _block_diagonal(mapped: ca.MX, block: ca.Sparsity, count: int) -> ca.MX:
@@ -270,29 +361,164 @@ class PointwiseNlp:
     point_functions: tuple[ca.Function, ...] = ()
 
 
-def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
-                    ) -> PointwiseNlp:
+def _selection(v: ca.SX, u: ca.SX) -> ca.DM:
+    """The constant matrix S with ``v = S u`` for ``v`` a selection of scaled entries of
+    ``u`` (each entry of v a constant times one entry of u), found from the sparsity and
+    one evaluation instead of by differentiation; any other linear ``v`` by its Jacobian."""
+    sp = ca.jacobian_sparsity(v, u)
+    rows, cols = (np.asarray(a, dtype=int) for a in sp.get_triplet())
+    f = ca.Function("v", [u], [v])
+    nv, nu = int(v.shape[0]), int(u.shape[0])
+    at_one = np.asarray(f(np.ones(nu)), dtype=float).ravel()
+    at_zero = np.asarray(f(np.zeros(nu)), dtype=float).ravel()
+    if np.bincount(rows, minlength=nv).max(initial=0) <= 1 and not at_zero.any():
+        return ca.DM.triplet(rows.tolist(), cols.tolist(), at_one[rows].tolist(), nv, nu)
+    return ca.evalf(ca.jacobian(v, u))
+
+
+class _Outer:
+    """The outer functions of the SX ``assembly`` (defects, quadrature, linkages, scaling)
+    and their derivatives with respect to w and the point outputs Y, as MX functions of
+    ``(W, Y)``: :meth:`g` (G), :meth:`jacobian` (G, G_w, G_Y) and :meth:`hessian` (L_ww,
+    L_wY, L_YY, L_Y = mu) of ``L = sigma F + lambda^T G``.
+
+    The terms of the intervals (defects, midpoint defects, quadrature: ``R``, recorded as
+    symbols, ``R = r(v(w, Y))`` with ``v = S [w; Y]`` a selection) come from the interval
+    templates, derived once per template (:func:`interval_derivatives`) and mapped over the
+    intervals; what remains, ``F(w, Y, R)`` and ``G(w, Y, R)``, is affine in Y and R apart
+    from the ends' objective terms (Mayer, parameter cost, denominator) and the duration
+    rows, and is derived for every mesh (cheap: no products of the mesh's variables). With
+    ``A = blockdiag(dr/dv) S`` and the residual Lagrangian ``L0(u, R)``, ``u = [w; Y]``::
+
+        G_u  = G0_u + G0_R A
+        L_u  = L0_u + S^T (dr/dv)^T L0_R
+        L_uu = L0_uu + L0_uR A + (L0_uR A)^T + A^T L0_RR A + S^T blockdiag(Hess_v(mu_R^T r)) S
+    """
+
+    def __init__(self, assembly: Assembly, Y: ca.SX, intervals: list[_IntervalGroup]
+                 ) -> None:
+        w = assembly.w_hat
+        self.nw, self.ny = int(w.shape[0]), int(Y.shape[0])
+        ng = int(assembly.g.shape[0])
+        self.intervals = [ig for ig in intervals if ig.r.shape[1] > 0]
+        R = ca.vertcat(*[ca.vec(ig.r) for ig in self.intervals]) if self.intervals else \
+            ca.SX(0, 1)
+        self.derivs = [interval_derivatives(ig.template) for ig in self.intervals]
+        F, G = assembly.f, assembly.g
+        sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
+        lagrangian = sigma * F + ca.dot(lam, G)
+        G_Y, G_R = ca.jacobian(G, Y), ca.jacobian(G, R)
+        self._g = ca.Function("outer_g", [w, Y, R], [G])
+        self._jac = ca.Function("outer_jac", [w, Y, R], [G, ca.jacobian(G, w), G_Y, G_R])
+        # mu = L_Y from G_Y (sparse, G is affine in Y for collocation) rather than by reverse
+        # AD of the whole Lagrangian, and L_wY as the transpose of d(mu)/dw: mu depends on few
+        # entries of w (durations, parameters), where the Jacobian of the large gradient graph
+        # L_w with respect to Y took 4x as long (60 + 15 knots, full coordinates: 0.014 s
+        # against 0.061 s). The same for R.
+        L_Y = ca.mtimes(G_Y.T, lam) + sigma * ca.gradient(F, Y)
+        L_R = ca.mtimes(G_R.T, lam) + sigma * ca.gradient(F, R)
+        self._hess = ca.Function(
+            "outer_hess", [w, Y, R, sigma, lam],
+            [ca.hessian(lagrangian, w)[0], ca.jacobian(L_Y, w).T, ca.jacobian(L_Y, Y), L_Y,
+             L_R, ca.jacobian(L_R, w).T, ca.jacobian(L_R, Y).T, ca.jacobian(L_R, R)])
+        if self.intervals:
+            V = ca.vertcat(*[ca.vec(ig.v) for ig in self.intervals])
+            S = _selection(V, ca.vertcat(w, Y))
+            self.S, self.S_w, self.S_Y = S, S[:, :self.nw], S[:, self.nw:]
+
+    def _inputs(self, W: ca.MX, Yv: ca.MX) -> list[ca.MX]:
+        """The inputs v (nv, N) of each interval group."""
+        V = ca.mtimes(self.S, ca.vertcat(W, Yv))
+        out, pos = [], 0
+        for ig in self.intervals:
+            nv, N = int(ig.v.shape[0]), int(ig.v.shape[1])
+            out.append(ca.reshape(V[pos:pos + nv * N], nv, N))
+            pos += nv * N
+        return out
+
+    def _values(self, Vs: list[ca.MX]) -> ca.MX:
+        if not self.intervals:
+            return ca.MX(0, 1)
+        return ca.vertcat(*[ca.vec(d.value.map(int(ig.r.shape[1]))(v, ig.dtau))
+                            for d, ig, v in zip(self.derivs, self.intervals, Vs, strict=True)])
+
+    def g(self, W: ca.MX, Yv: ca.MX) -> ca.MX:
+        """G at (W, Y)."""
+        return self._g(W, Yv, self._values(self._inputs(W, Yv)) if self.intervals
+                       else ca.MX(0, 1))
+
+    def jacobian(self, W: ca.MX, Yv: ca.MX) -> tuple[ca.MX, ca.MX, ca.MX]:
+        """(G, G_w, G_Y) at (W, Y)."""
+        if not self.intervals:
+            G, G_w, G_Y, _ = self._jac(W, Yv, ca.MX(0, 1))
+            return G, G_w, G_Y
+        calls = [d.jacobian.map(int(ig.r.shape[1]))(v, ig.dtau)
+                 for d, ig, v in zip(self.derivs, self.intervals, self._inputs(W, Yv),
+                                     strict=True)]
+        Rv = ca.vertcat(*[ca.vec(c[0]) for c in calls])
+        BJ = ca.diagcat(*[_block_diagonal(c[1], d.jacobian.sparsity_out(1), int(ig.r.shape[1]))
+                          for c, d, ig in zip(calls, self.derivs, self.intervals, strict=True)])
+        G, G_w, G_Y, G_R = self._jac(W, Yv, Rv)
+        return (G, G_w + ca.mtimes([G_R, BJ, self.S_w]), G_Y + ca.mtimes([G_R, BJ, self.S_Y]))
+
+    def hessian(self, W: ca.MX, Yv: ca.MX, S: ca.MX, Lam: ca.MX
+                ) -> tuple[ca.MX, ca.MX, ca.MX, ca.MX]:
+        """(L_ww, L_wY, L_YY, L_Y) at (W, Y, sigma, lambda)."""
+        if not self.intervals:
+            L_ww, L_wY, L_YY, L_Y, *_ = self._hess(W, Yv, ca.MX(0, 1), S, Lam)
+            return L_ww, L_wY, L_YY, L_Y
+        Vs = self._inputs(W, Yv)
+        L_ww, L_wY, L_YY, L_Y, L_R, L_wR, L_YR, L_RR = self._hess(W, Yv, self._values(Vs), S,
+                                                                 Lam)
+        calls, pos = [], 0
+        for d, ig, v in zip(self.derivs, self.intervals, Vs, strict=True):
+            nr, N = int(ig.r.shape[0]), int(ig.r.shape[1])
+            calls.append(d.hessian.map(N)(v, ig.dtau, ca.reshape(L_R[pos:pos + nr * N], nr, N)))
+            pos += nr * N
+        BJ = ca.diagcat(*[_block_diagonal(c[0], d.hessian.sparsity_out(0), int(ig.r.shape[1]))
+                          for c, d, ig in zip(calls, self.derivs, self.intervals, strict=True)])
+        BH = ca.diagcat(*[_block_diagonal(c[2], d.hessian.sparsity_out(2), int(ig.r.shape[1]))
+                          for c, d, ig in zip(calls, self.derivs, self.intervals, strict=True)])
+        grads = ca.vertcat(*[ca.vec(c[1]) for c in calls])
+        A_w, A_Y = ca.mtimes(BJ, self.S_w), ca.mtimes(BJ, self.S_Y)
+        S_w, S_Y = self.S_w, self.S_Y
+        cross_w = ca.mtimes(L_wR, A_w)
+        L_ww = L_ww + cross_w + cross_w.T + ca.mtimes([S_w.T, BH, S_w])
+        L_wY = (L_wY + ca.mtimes(L_wR, A_Y) + ca.mtimes(A_w.T, L_YR.T)
+                + ca.mtimes([S_w.T, BH, S_Y]))
+        cross_Y = ca.mtimes(L_YR, A_Y)
+        L_YY = L_YY + cross_Y + cross_Y.T + ca.mtimes([S_Y.T, BH, S_Y])
+        if L_RR.nnz() > 0:
+            L_ww = L_ww + ca.mtimes([A_w.T, L_RR, A_w])
+            L_wY = L_wY + ca.mtimes([A_w.T, L_RR, A_Y])
+            L_YY = L_YY + ca.mtimes([A_Y.T, L_RR, A_Y])
+        return L_ww, L_wY, L_YY, L_Y + ca.mtimes(S_Y.T, grads)
+
+    def objective(self, F: ca.SX) -> ca.SX:
+        """``F`` with the interval terms it reads (the quadrature) as SX expressions of w
+        and the point outputs (the interval templates inlined)."""
+        if not self.intervals:
+            return F
+        R = ca.vertcat(*[ca.vec(ig.r) for ig in self.intervals])
+        read = sorted(set(ca.jacobian_sparsity(F, R).get_col()))
+        if not read:
+            return F
+        values = ca.vertcat(*[ca.vec(ig.template.map(int(ig.r.shape[1]))(ig.v, ig.dtau))
+                              for ig in self.intervals])
+        return ca.substitute(F, R[read], values[read])
+
+
+def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool,
+                    intervals: list[_IntervalGroup] | None = None) -> PointwiseNlp:
     """The exact derivative functions of the SX ``assembly`` whose point outputs are the
-    recorded ``groups`` (see the module docstring)."""
+    recorded ``groups`` and whose interval terms are the recorded ``intervals`` (see the
+    module docstring and :class:`_Outer`)."""
     w = assembly.w_hat
     nw = int(w.shape[0])
     ng = int(assembly.g.shape[0])
     Y = ca.vertcat(*[ca.vec(gr.y) for gr in groups])
     Z = ca.vertcat(*[ca.vec(gr.z) for gr in groups])
-    F, G = assembly.f, assembly.g
-    sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
-    lagrangian = sigma * F + ca.dot(lam, G)
-    G_Y_sym = ca.jacobian(G, Y)
-    outer_jac = ca.Function("outer_jac", [w, Y], [G, ca.jacobian(G, w), G_Y_sym])
-    # mu = L_Y from G_Y (sparse, G is affine in Y for collocation) rather than by reverse AD
-    # of the whole Lagrangian, and L_wY as the transpose of d(mu)/dw: mu depends on few
-    # entries of w (durations, parameters), where the Jacobian of the large gradient graph
-    # L_w with respect to Y took 4x as long (60 + 15 knots, full coordinates: 0.014 s
-    # against 0.061 s).
-    L_Y = ca.mtimes(G_Y_sym.T, lam) + sigma * ca.gradient(F, Y)
-    L_YY = ca.jacobian(L_Y, Y)
-    outer_hess = ca.Function("outer_hess", [w, Y, sigma, lam],
-                             [ca.hessian(lagrangian, w)[0], ca.jacobian(L_Y, w).T, L_YY, L_Y])
+    outer = _Outer(assembly, Y, intervals or [])
     nu = ca.SX.sym("nu", Z.shape[0])
     Dz_sym = ca.jacobian(Z, w)
     z_of_w = ca.Function("z_of_w", [w], [Z, Dz_sym])
@@ -327,28 +553,27 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
         return ca.diagcat(*blocks)
 
     Yv = values()
-    # The constraints from the mapped point values (compiled) and the outer function.
-    outer_g = ca.Function("outer_g", [w, Y], [G])
     # The objective as one SX graph with the point outputs it reads (the integrand L) inlined
     # at every point, and its gradient by reverse AD of that graph: small next to the
     # dynamics, and smaller than the point Jacobians the chain rule would need.
+    F = outer.objective(assembly.f)
     F_sx = ca.substitute(F, *_inlined_outputs(F, groups))
     P_sx = ca.SX.sym("p", 0)
     fns: dict[str, ca.Function] = {
         "nlp_f": ca.Function("nlp_f", [w, P_sx], [F_sx], ["x", "p"], ["f"]),
-        "nlp_g": ca.Function("nlp_g", [W, P], [outer_g(W, Yv)], ["x", "p"], ["g"]),
+        "nlp_g": ca.Function("nlp_g", [W, P], [outer.g(W, Yv)], ["x", "p"], ["g"]),
         "nlp_grad_f": ca.Function("nlp_grad_f", [w, P_sx], [F_sx, ca.gradient(F_sx, w)],
                                   ["x", "p"], ["f", "grad_f_x"]),
     }
     jac_calls = [d.jacobian.map(s[2])(z) for d, s, z in zip(derivs, sizes, Zs, strict=True)]
     Yj = ca.vertcat(*[ca.vec(c[0]) for c in jac_calls])
     JD = ca.mtimes(jacobian_of_points([c[1] for c in jac_calls]), Dz)
-    g1, G_w, G_Y = outer_jac(W, Yj)
+    g1, G_w, G_Y = outer.jacobian(W, Yj)
     fns["nlp_jac_g"] = ca.Function("nlp_jac_g", [W, P], [g1, G_w + ca.mtimes(G_Y, JD)],
                                    ["x", "p"], ["g", "jac_g_x"])
 
     S, Lam = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", ng)
-    L_ww, L_wY, L_YYv, mu = outer_hess(W, Yv, S, Lam)
+    L_ww, L_wY, L_YYv, mu = outer.hessian(W, Yv, S, Lam)
     mus = split(mu, 1)
     hess_calls = [d.hessian.map(s[2])(z, m)
                   for d, s, z, m in zip(derivs, sizes, Zs, mus, strict=True)]
@@ -361,7 +586,7 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool
     H = L_ww + cross + cross.T + ca.mtimes([Dz.T, HB, Dz])
     if z_hess is not None:
         H = H + z_hess(W, ca.mtimes(JBh.T, mu))
-    if L_YY.nnz() > 0:
+    if L_YYv.nnz() > 0:
         H = H + ca.mtimes([JDh.T, L_YYv, JDh])
     fns["nlp_hess_l"] = ca.Function("nlp_hess_l", [W, P, S, Lam], [ca.triu(H)],
                                     ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])

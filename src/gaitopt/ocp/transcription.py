@@ -132,12 +132,7 @@ class Transcription:
                                    f"dynamics at single grid points (hermite-simpson-separated,"
                                    f" or trapezoidal without midpoint path constraints), not "
                                    f"{method!r}")
-            recorder = pointwise.PointRecorder()
-            outer = assemble_expressions(problem, METHODS[method], mesh, self.layout,
-                                         self.phase_functions, ends, d_w, sx, symbols=ca.SX,
-                                         point_calls=recorder, ends_call=recorder.ends,
-                                         fold_knot_states=True)
-            self._pointwise = pointwise.build_pointwise(outer, recorder.groups, compile_c=True)
+            self._pointwise = self.pointwise_nlp(d_w, sx)
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, False)
         else:
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
@@ -146,6 +141,25 @@ class Transcription:
         self._solvers: dict[str, tuple[ca.Function, bool]] = {}
         if build_solver:
             self.solver(self.options)
+
+    def pointwise_nlp(self, d_w: Array, state_scales: tuple[Array, ...], *,
+                      interval_templates: bool = True, compile_c: bool = True
+                      ) -> PointwiseNlp:
+        """The solver functions of ``compiled="points"`` (:mod:`gaitopt.ocp.pointwise`):
+        with ``interval_templates`` the terms of the intervals come from functions of one
+        interval derived once per process and mapped over the mesh, else they are derived
+        within the outer functions of this mesh (the same NLP; kept to check the first
+        against)."""
+        recorder = pointwise.PointRecorder()
+        ends = self.functions[1]
+        extra: dict[str, Any] = ({"interval_calls": recorder.intervals}
+                                 if interval_templates else {})
+        outer = assemble_expressions(self.problem, METHODS[self.method], self.mesh,
+                                     self.layout, self.phase_functions, ends, d_w,
+                                     state_scales, symbols=ca.SX, point_calls=recorder,
+                                     ends_call=recorder.ends, fold_knot_states=True, **extra)
+        return pointwise.build_pointwise(outer, recorder.groups, compile_c=compile_c,
+                                         intervals=recorder.interval_groups)
 
     # -- solvers ---------------------------------------------------------------------------
     def solver(self, options: Mapping[str, Any]) -> ca.Function:
