@@ -18,6 +18,7 @@ The NLP handed to the solver is ``min J / objective_scale`` over ``w_hat = w / d
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -263,13 +264,13 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
         t_of: Callable[[Any], Any]
         if spec.kind == "expression":
             T = durations_expr[i]
-            t_source, t_of = p, (lambda s, i=i: ends_fn.durations(s)[i])
+            t_source, t_of = p, functools.partial(_duration_of, ends_fn.durations, i)
         elif pl.duration_index is not None:
             T = w[pl.duration_index]
-            t_source, t_of = T, (lambda s: s)
+            t_source, t_of = T, _itself
         else:
             T = sym(spec.lower)
-            t_source, t_of = sym(0, 1), (lambda s, v=float(spec.lower): sym(v))
+            t_source, t_of = sym(0, 1), functools.partial(_constant, sym, float(spec.lower))
         durations.append(T)
         Z = ca.reshape(w[pl.knot_block()], pl.stride, K)
         X, U = Z[:n, :], Z[n:, :]
@@ -357,6 +358,19 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
     return Assembly(w_hat, f_scaled, g_scaled, g, rows, numerator, den,
                     ca.vertcat(*durations), np.asarray(dependent_index, dtype=np.int64),
                     ca.vertcat(*dependent_values) if dependent_values else sym(0, 1))
+
+
+def _duration_of(durations: ca.Function, i: int, p: Any) -> Any:
+    """Phase ``i``'s duration from the parameters ``p``."""
+    return durations(p)[i]
+
+
+def _itself(x: Any) -> Any:
+    return x
+
+
+def _constant(sym: Any, value: float, _: Any) -> Any:
+    return sym(value)
 
 
 def _folded_knots(i: int, pf: PhaseFunction, pl: PhaseLayout, X: Any, U: Any, p: Any,

@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import hashlib
 import warnings
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,6 +51,7 @@ import casadi as ca
 import numpy as np
 
 from gaitopt import codegen
+from gaitopt.ocp.functions import IdentityCache
 from gaitopt.ocp.method import Method
 from gaitopt.ocp.nlp import Assembly, IntervalInputs, interval_terms
 
@@ -133,14 +135,22 @@ class PointDerivatives:
                             ["J", "H"])]
 
 
+#: :func:`library_key` by the point function (the transcriptions of one problem on other
+#: meshes call the same point functions: they are serialized and hashed once).
+_KEYS = IdentityCache(256)
+
+
 def library_key(point: ca.Function, flags: tuple[str, ...] = POINT_FLAGS) -> str:
     """The cache key of the point library of ``point``: a hash of the serialized point
     function, CasADi's version, the compiler and its flags, and :data:`FORMAT` (the C is a
     deterministic function of these, so a cached library is found without deriving or
     generating anything)."""
-    text = "\0".join([FORMAT, point.serialize(), ca.CasadiMeta.version(), codegen.compiler(),
-                      *flags])
-    return hashlib.sha256(text.encode()).hexdigest()[:20]
+    def make() -> str:
+        text = "\0".join([FORMAT, point.serialize(), ca.CasadiMeta.version(),
+                          codegen.compiler(), *flags])
+        return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+    return _KEYS.get((point, codegen.compiler(), *flags), make)
 
 
 def point_derivatives(points: list[ca.Function], compile_c: bool
@@ -188,6 +198,10 @@ class _Group:
     y: ca.SX
 
 
+#: The constraint rows of an ends function (:meth:`PointRecorder.ends`), by the function.
+_ROWS = IdentityCache()
+
+
 @dataclass(frozen=True)
 class _IntervalGroup:
     """The N intervals of one phase: the function of one interval, its inputs v (nv, N) as
@@ -232,11 +246,15 @@ class PointRecorder:
         affine in the recorded outputs (a ratio of recorded outputs has a dense Hessian
         row)."""
         z = ca.vertcat(E, p)
-        E_sym = ca.SX.sym("E", fn.size1_in(0))
-        p_sym = ca.SX.sym("p", fn.size1_in(1))
-        rows = ca.Function(f"{fn.name()}_rows", [E_sym, p_sym], fn.call([E_sym, p_sym])[:2],
-                           ["E", "p"], ["linkages", "boundary"])
-        link, bnd = self._record(rows, z)
+
+        def make() -> ca.Function:
+            E_sym = ca.SX.sym("E", fn.size1_in(0))
+            p_sym = ca.SX.sym("p", fn.size1_in(1))
+            return ca.Function(f"{fn.name()}_rows", [E_sym, p_sym],
+                               fn.call([E_sym, p_sym])[:2], ["E", "p"],
+                               ["linkages", "boundary"])
+
+        link, bnd = self._record(_ROWS.get((fn,), make), z)
         return [link, bnd, *fn.call([E, p])[2:]]
 
 
@@ -292,7 +310,9 @@ class IntervalDerivatives:
 
 #: The derivatives of every interval template derived in this process, by a hash of the
 #: serialized template: a template is derived once, whatever the mesh.
-_INTERVAL_DERIVATIVES: dict[str, IntervalDerivatives] = {}
+_INTERVAL_DERIVATIVES: OrderedDict[str, IntervalDerivatives] = OrderedDict()
+#: How many derived templates :data:`_INTERVAL_DERIVATIVES` keeps (the newest).
+INTERVAL_CACHE_SIZE = 256
 #: How many interval templates this process has derived (a test checks that a second mesh
 #: of a problem derives none).
 interval_derivations = 0
@@ -315,6 +335,9 @@ def interval_derivatives(template: ca.Function) -> IntervalDerivatives:
             ca.Function("interval_hess", [v, dtau, mu], list(ca.cse([jac, grad, hess])),
                         ["v", "dtau", "mu"], ["J", "g", "H"]))
         interval_derivations += 1
+        while len(_INTERVAL_DERIVATIVES) > INTERVAL_CACHE_SIZE:
+            _INTERVAL_DERIVATIVES.popitem(last=False)
+    _INTERVAL_DERIVATIVES.move_to_end(key)
     return _INTERVAL_DERIVATIVES[key]
 
 
@@ -361,19 +384,49 @@ class PointwiseNlp:
     point_functions: tuple[ca.Function, ...] = ()
 
 
-def _selection(v: ca.SX, u: ca.SX) -> ca.DM:
-    """The constant matrix S with ``v = S u`` for ``v`` a selection of scaled entries of
-    ``u`` (each entry of v a constant times one entry of u), found from the sparsity and
-    one evaluation instead of by differentiation; any other linear ``v`` by its Jacobian."""
-    sp = ca.jacobian_sparsity(v, u)
-    rows, cols = (np.asarray(a, dtype=int) for a in sp.get_triplet())
+def _selections(v: ca.SX, u: ca.SX) -> tuple[ca.DM, list[int]]:
+    """The rows of ``v`` that are a constant times one entry of ``u`` as a constant matrix S
+    (``v[r] = S[r, :] u`` on those rows, zero rows elsewhere), found by evaluating ``v``
+    instead of differentiating it, and the other rows."""
     f = ca.Function("v", [u], [v])
     nv, nu = int(v.shape[0]), int(u.shape[0])
-    at_one = np.asarray(f(np.ones(nu)), dtype=float).ravel()
-    at_zero = np.asarray(f(np.zeros(nu)), dtype=float).ravel()
-    if np.bincount(rows, minlength=nv).max(initial=0) <= 1 and not at_zero.any():
-        return ca.DM.triplet(rows.tolist(), cols.tolist(), at_one[rows].tolist(), nv, nu)
-    return ca.evalf(ca.jacobian(v, u))
+    rng = np.random.default_rng(0)
+    probes = [np.zeros(nu), np.ones(nu), np.arange(1.0, nu + 1.0), rng.uniform(1, 2, nu),
+              rng.uniform(-2, -1, nu)]
+    zero, one, index, *checks = (np.asarray(f(x), dtype=float).ravel() for x in probes)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        col = index / one - 1.0
+    ok = (zero == 0.0) & (one != 0.0) & np.isfinite(col) & (np.abs(col - np.round(col)) < 1e-6)
+    col = np.where(ok, np.round(col), 0).astype(int)
+    ok &= (col >= 0) & (col < nu)
+    for x, value in zip(probes[3:], checks, strict=True):
+        ok &= np.abs(one * x[col] - value) <= 1e-12 * np.maximum(1.0, np.abs(value))
+    rows = np.flatnonzero(ok)
+    S = ca.DM.triplet(rows.tolist(), col[rows].tolist(), one[rows].tolist(), nv, nu)
+    return S, [int(r) for r in np.flatnonzero(~ok)]
+
+
+def _linear_jacobian(v: ca.SX, u: ca.SX) -> ca.SX:
+    """``jacobian(v, u)``, with the rows that select one entry of u (:func:`_selections`)
+    read off by evaluation and only the others differentiated."""
+    S, rest = _selections(v, u)
+    if not rest:
+        return ca.SX(S)
+    place = ca.DM.triplet(rest, list(range(len(rest))), [1.0] * len(rest), int(v.shape[0]),
+                          len(rest))
+    return ca.SX(S) + ca.mtimes(place, ca.jacobian(v[rest], u))
+
+
+def _selection(v: ca.SX, u: ca.SX) -> ca.DM:
+    """The constant matrix S with ``v = S u`` for ``v`` linear in ``u`` (each entry a
+    constant times one entry of u, else by the Jacobian of the other rows)."""
+    S, other = _selections(v, u)
+    if not other:
+        return S
+    rest = ca.evalf(ca.jacobian(v[other], u))
+    place = ca.DM.triplet(other, list(range(len(other))), [1.0] * len(other),
+                          int(v.shape[0]), len(other))
+    return S + ca.mtimes(place, rest)
 
 
 class _Outer:
@@ -406,21 +459,37 @@ class _Outer:
         self.derivs = [interval_derivatives(ig.template) for ig in self.intervals]
         F, G = assembly.f, assembly.g
         sigma, lam = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", ng)
-        lagrangian = sigma * F + ca.dot(lam, G)
-        G_Y, G_R = ca.jacobian(G, Y), ca.jacobian(G, R)
+        # Most rows of G are a scale times one entry of (w, Y, R) (the interval terms, path
+        # constraints, linkages, boundary conditions): their Jacobian is a constant matrix,
+        # read off by evaluation; only the other rows (durations, ...) are differentiated,
+        # and only they and F enter the second derivatives.
+        u = ca.vertcat(w, Y, R)
+        S_G, rest = _selections(G, u)
+        G_rest = G[rest]
+        J_rest = ca.jacobian(G_rest, u)
+        place = ca.DM.triplet(rest, list(range(len(rest))), [1.0] * len(rest), ng, len(rest))
+        G_u = ca.SX(S_G) + ca.mtimes(place, J_rest) if rest else ca.SX(S_G)
+        nw, ny = self.nw, self.ny
+        G_w, G_Y, G_R = G_u[:, :nw], G_u[:, nw:nw + ny], G_u[:, nw + ny:]
         self._g = ca.Function("outer_g", [w, Y, R], [G])
-        self._jac = ca.Function("outer_jac", [w, Y, R], [G, ca.jacobian(G, w), G_Y, G_R])
+        self._jac = ca.Function("outer_jac", [w, Y, R], [G, G_w, G_Y, G_R])
         # mu = L_Y from G_Y (sparse, G is affine in Y for collocation) rather than by reverse
         # AD of the whole Lagrangian, and L_wY as the transpose of d(mu)/dw: mu depends on few
         # entries of w (durations, parameters), where the Jacobian of the large gradient graph
         # L_w with respect to Y took 4x as long (60 + 15 knots, full coordinates: 0.014 s
         # against 0.061 s). The same for R.
-        L_Y = ca.mtimes(G_Y.T, lam) + sigma * ca.gradient(F, Y)
-        L_R = ca.mtimes(G_R.T, lam) + sigma * ca.gradient(F, R)
+        F_Y, F_R = ca.gradient(F, Y), ca.gradient(F, R)
+        L_Y = ca.mtimes(G_Y.T, lam) + sigma * F_Y
+        L_R = ca.mtimes(G_R.T, lam) + sigma * F_R
+        lam_rest = lam[rest]
+        curved = sigma * F + ca.dot(lam_rest, G_rest)
+        J_rest_Y, J_rest_R = J_rest[:, nw:nw + ny], J_rest[:, nw + ny:]
+        L_Y2 = ca.mtimes(J_rest_Y.T, lam_rest) + sigma * F_Y
+        L_R2 = ca.mtimes(J_rest_R.T, lam_rest) + sigma * F_R
         self._hess = ca.Function(
             "outer_hess", [w, Y, R, sigma, lam],
-            [ca.hessian(lagrangian, w)[0], ca.jacobian(L_Y, w).T, ca.jacobian(L_Y, Y), L_Y,
-             L_R, ca.jacobian(L_R, w).T, ca.jacobian(L_R, Y).T, ca.jacobian(L_R, R)])
+            [ca.hessian(curved, w)[0], ca.jacobian(L_Y2, w).T, ca.jacobian(L_Y2, Y), L_Y,
+             L_R, ca.jacobian(L_R2, w).T, ca.jacobian(L_R2, Y).T, ca.jacobian(L_R2, R)])
         if self.intervals:
             V = ca.vertcat(*[ca.vec(ig.v) for ig in self.intervals])
             S = _selection(V, ca.vertcat(w, Y))
@@ -520,13 +589,17 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool,
     Z = ca.vertcat(*[ca.vec(gr.z) for gr in groups])
     outer = _Outer(assembly, Y, intervals or [])
     nu = ca.SX.sym("nu", Z.shape[0])
-    Dz_sym = ca.jacobian(Z, w)
+    Dz_sym = _linear_jacobian(Z, w)
     z_of_w = ca.Function("z_of_w", [w], [Z, Dz_sym])
     # Hess_w (nu^T z(w)) vanishes where the point inputs are affine in w (fixed durations, or
-    # durations affine in the parameters): then it is not derived.
-    z_linear = not ca.depends_on(Dz_sym, w)
-    z_hess = (None if z_linear else
-              ca.Function("z_hess", [w, nu], [ca.hessian(ca.dot(nu, Z), w)[0]]))
+    # durations affine in the parameters): then it is not derived. Else only the inputs whose
+    # Jacobian depends on w enter it (the times, through the durations), not the mesh's
+    # states and controls.
+    curved = [int(i) for i in np.flatnonzero(ca.which_depends(Z, w, 2, True))]
+    z_hess = None
+    if curved:
+        hess = ca.hessian(ca.dot(nu[curved], Z[curved]), w)[0]
+        z_hess = ca.Function("z_hess", [w, nu], [hess])
 
     derivs = point_derivatives([gr.point for gr in groups], compile_c)
     W, P = ca.MX.sym("w", nw), ca.MX.sym("p", 0)

@@ -117,6 +117,7 @@ class Transcription:
         self.functions: tuple[tuple[PhaseFunction, ...], EndsFunction] = (
             self.phase_functions, ends)
         d_w = variable_scales(problem, self.layout, scaling)
+        self._state_scales = sx
         self.nlp: Nlp = assemble(problem, METHODS[method], mesh, self.layout,
                                  self.phase_functions, ends, d_w, sx)
         self.midpoint_bounds = midpoint_bounds
@@ -132,7 +133,7 @@ class Transcription:
                                    f"dynamics at single grid points (hermite-simpson-separated,"
                                    f" or trapezoidal without midpoint path constraints), not "
                                    f"{method!r}")
-            self._pointwise = self.pointwise_nlp(d_w, sx)
+            self._pointwise = self.pointwise_nlp()
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, False)
         else:
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
@@ -142,8 +143,7 @@ class Transcription:
         if build_solver:
             self.solver(self.options)
 
-    def pointwise_nlp(self, d_w: Array, state_scales: tuple[Array, ...], *,
-                      interval_templates: bool = True, compile_c: bool = True
+    def pointwise_nlp(self, *, interval_templates: bool = True, compile_c: bool = True
                       ) -> PointwiseNlp:
         """The solver functions of ``compiled="points"`` (:mod:`gaitopt.ocp.pointwise`):
         with ``interval_templates`` the terms of the intervals come from functions of one
@@ -155,8 +155,8 @@ class Transcription:
         extra: dict[str, Any] = ({"interval_calls": recorder.intervals}
                                  if interval_templates else {})
         outer = assemble_expressions(self.problem, METHODS[self.method], self.mesh,
-                                     self.layout, self.phase_functions, ends, d_w,
-                                     state_scales, symbols=ca.SX, point_calls=recorder,
+                                     self.layout, self.phase_functions, ends, self.nlp.d_w,
+                                     self._state_scales, symbols=ca.SX, point_calls=recorder,
                                      ends_call=recorder.ends, fold_knot_states=True, **extra)
         return pointwise.build_pointwise(outer, recorder.groups, compile_c=compile_c,
                                          intervals=recorder.interval_groups)
