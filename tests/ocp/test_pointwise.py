@@ -192,3 +192,80 @@ def test_large_point_functions_compile_with_the_fast_flags() -> None:
     assert small.n_instructions() <= LARGE_POINT < big.n_instructions()
     assert point_flags(small) == POINT_FLAGS and "-O1" in POINT_FLAGS
     assert point_flags(big) == LARGE_POINT_FLAGS and "-O0" in LARGE_POINT_FLAGS
+
+
+def _functions_values(nlp: object, w: np.ndarray, lam: np.ndarray
+                      ) -> dict[str, list[ca.DM]]:
+    """Every function of a :class:`~gaitopt.ocp.pointwise.PointwiseNlp` at scaled ``w``."""
+    out = {}
+    for kind, fn in nlp.functions.items():  # type: ignore[attr-defined]
+        args = [w, []] + ([0.7, lam] if kind == "nlp_hess_l" else [])
+        res = fn(*args)
+        out[kind] = [ca.DM(r) for r in (res if isinstance(res, list | tuple) else [res])]
+    return out
+
+
+def _knot_states_problem() -> Problem:
+    from test_knot_states import rest_to_rest
+
+    return rest_to_rest(given=True, ends_read_z=True)
+
+
+@pytest.mark.parametrize(("make", "method"), [
+    (nonlinear, SEPARATED), (lambda: P.periodic_ratio(intervals=4), SEPARATED),
+    (lambda: P.two_phase_jump(intervals=3), SEPARATED), (_knot_states_problem, SEPARATED),
+    # Trapezoidal (no midpoints) where it is point-wise: no path constraints at midpoints.
+    (lambda: P.periodic_ratio(intervals=4), "trapezoidal"),
+    (_knot_states_problem, "trapezoidal")],
+    ids=["nonlinear", "periodic_ratio", "two_phase_jump", "knot_states",
+         "trapezoidal-periodic_ratio", "trapezoidal-knot_states"])
+def test_interval_templates_give_the_outer_derivatives_of_the_mesh(make: object,
+                                                                   method: str) -> None:
+    # The terms of the intervals from one function of an interval, derived once and mapped
+    # (the default), against the same terms derived within the outer functions of this mesh:
+    # the same sparsity and values at a random point (one function's derivatives summed in
+    # another order: 1e-12 relative).
+    problem = make()  # type: ignore[operator]
+    tr = transcribe(problem, method=method, build_solver=False)
+    templates = tr.pointwise_nlp(compile_c=False)
+    whole = tr.pointwise_nlp(compile_c=False, interval_templates=False)
+    rng = np.random.default_rng(5)
+    w = tr.initial_guess() / tr.nlp.d_w * (1 + 0.1 * rng.standard_normal(tr.layout.size))
+    w += 0.05 * rng.standard_normal(w.size)
+    lam = rng.standard_normal(tr.nlp.lbg.size)
+    got, expected = _functions_values(templates, w, lam), _functions_values(whole, w, lam)
+    for kind in expected:
+        for e, g in zip(expected[kind], got[kind], strict=True):
+            assert g.sparsity() == e.sparsity(), kind
+            e_nz, g_nz = np.array(e.nonzeros()), np.array(g.nonzeros())
+            assert np.all(np.isfinite(e_nz)), kind
+            assert np.max(np.abs(g_nz - e_nz), initial=0.0) <= 1e-12 * max(
+                1.0, np.max(np.abs(e_nz), initial=0.0)), kind
+    assert np.count_nonzero(np.array(expected["nlp_hess_l"][0].nonzeros())) > 0
+
+
+def test_another_mesh_derives_no_interval_template() -> None:
+    # A new mesh of a problem costs an evaluation of the derived interval functions, not a
+    # derivation: the second transcription finds every template derived by the first (the
+    # same function objects), and derives none.
+    from gaitopt.ocp import pointwise
+
+    first = transcribe(nonlinear(intervals=4), method=SEPARATED, compiled="points",
+                       build_solver=False)
+    before = pointwise.interval_derivations
+    derived = dict(pointwise._INTERVAL_DERIVATIVES)
+    second = transcribe(nonlinear(intervals=11), method=SEPARATED, compiled="points",
+                        build_solver=False, functions=first.functions)
+    assert pointwise.interval_derivations == before
+    assert dict(pointwise._INTERVAL_DERIVATIVES) == derived
+    assert second.solve().success
+    # A template of another form (another duration) is derived once, then found again.
+    other = Problem([Phase("swing", ["q", "w"], ["tau"],
+                           lambda x, u, p, t: ca.vertcat(x[1], u[0]), 2.0,
+                           initial_state={"q": 0.0, "w": 0.0}, final_state={"q": 1.0},
+                           lagrange=lambda x, u, p, t: u[0] ** 2, intervals=3)])
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False)
+    assert pointwise.interval_derivations == before + 1
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False,
+               intervals=7)
+    assert pointwise.interval_derivations == before + 1

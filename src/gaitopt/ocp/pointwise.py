@@ -396,7 +396,8 @@ def _selections(v: ca.SX, u: ca.SX) -> tuple[ca.DM, list[int]]:
     zero, one, index, *checks = (np.asarray(f(x), dtype=float).ravel() for x in probes)
     with np.errstate(divide="ignore", invalid="ignore"):
         col = index / one - 1.0
-    ok = (zero == 0.0) & (one != 0.0) & np.isfinite(col) & (np.abs(col - np.round(col)) < 1e-6)
+        ok = (zero == 0.0) & (one != 0.0) & np.isfinite(col)
+        ok &= np.abs(np.where(ok, col - np.round(col), 1.0)) < 1e-6
     col = np.where(ok, np.round(col), 0).astype(int)
     ok &= (col >= 0) & (col < nu)
     for x, value in zip(probes[3:], checks, strict=True):
