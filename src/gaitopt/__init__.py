@@ -16,7 +16,10 @@ when a solver or ``verify_gait`` is needed).
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING, Any
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, cast
+
+from gaitopt import views as _views
 
 __version__ = "0.1.0"
 
@@ -47,6 +50,15 @@ if TYPE_CHECKING:
     from gaitopt.gait.gait_file import Gait, GaitFileError
     from gaitopt.gait.options import GaitOptions, GaitOptionsError
     from gaitopt.robot import ModelError, RobotModel, load_model
+
+
+def _notebook_views() -> _views.GaitViews:
+    """:mod:`gaitopt.viz.notebook`, imported on a gait's first view (:mod:`gaitopt.views`)."""
+    module: ModuleType = importlib.import_module("gaitopt.viz.notebook")
+    return cast(_views.GaitViews, module)
+
+
+_views.install_gait_views(_notebook_views)
 
 
 def __getattr__(name: str) -> Any:

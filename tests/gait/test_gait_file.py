@@ -270,3 +270,17 @@ def test_swap_names_follow_the_models_symmetry() -> None:
     assert names["ankle_1"] == "ankle_2" and names["knee_2"] == "knee_1"
     assert names["foot_1"] == "foot_2" and names["torso"] == "torso"
     assert all(names[names[n]] == n for n in names)  # an involution
+
+
+def test_the_record_interpolant_is_the_transcriptions_bit_for_bit() -> None:
+    """:func:`cubic_hermite` (NumPy, the gait file's rule) and the transcription's
+    ``HermiteSimpson.state_at`` do the same arithmetic: equal on identical inputs."""
+    from gaitopt.gait.interpolation import cubic_hermite
+    from gaitopt.ocp.hermite_simpson import HermiteSimpson
+
+    rng = np.random.default_rng(3)
+    s = rng.uniform(0.0, 1.0, (40, 1))
+    h = rng.uniform(0.01, 0.2, (40, 1))
+    x_k, x_k1, f_k, f_k1 = (rng.normal(size=(40, 7)) for _ in range(4))
+    np.testing.assert_array_equal(cubic_hermite(s, x_k, x_k1, f_k, f_k1, h),
+                                  HermiteSimpson().state_at(s, x_k, x_k1, f_k, f_k1, h))

@@ -15,6 +15,7 @@ from click.testing import CliRunner
 
 from gaitopt.cli import cli
 from gaitopt.cli.gait import multistart_default
+from gaitopt.gait.formulation import FORMULATIONS
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.solve import SAME_COST, SAME_STEP, distinct
 from tests.gait.conftest import SolveFn
@@ -40,7 +41,7 @@ def test_distinct_drops_repeated_optima_and_keeps_the_order() -> None:
 def test_gaitopt_solve_uses_multistart_far_from_12_m_min(
         speed_m_min: float | None, formulation: str, expected: bool) -> None:
     speed = None if speed_m_min is None else speed_m_min / 60.0
-    assert multistart_default(speed, formulation) is expected
+    assert multistart_default(speed, FORMULATIONS[formulation]) is expected
 
 
 class _Stop(Exception):

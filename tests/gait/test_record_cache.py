@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from gaitopt.gait import record, walking
+from gaitopt.gait import record_reduced as record
+from gaitopt.gait import walking
 from gaitopt.gait.walking import DOUBLE, SINGLE
 from gaitopt.robot import load_model
 

@@ -17,12 +17,15 @@ from click.testing import CliRunner
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.cli import cli
 from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.contact_sequence import ContactSequenceError, phase_knots
+from gaitopt.gait.formulation import contact_sequence
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.refinement import (
     MAX_ROUNDS,
     refine_to_accuracy,
     relative_estimates,
+    solved_shares,
     worst_estimate,
 )
 from gaitopt.gait.solution import WalkingSolution
@@ -50,6 +53,7 @@ class FakeSolution:
     result: Any = dataclasses.field(
         default_factory=lambda: SimpleNamespace(parameters={"speed": 0.2, "step_length": 0.1}))
     accuracy_extra: Any = None
+    model: Any = dataclasses.field(default_factory=lambda: load_model("five-link"))
 
 
 def _loop(errors: list[float], *, refines: bool = True,
@@ -68,6 +72,53 @@ def _loop(errors: list[float], *, refines: bool = True,
     sol, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,  # type: ignore[arg-type]
                                     accuracy_of=accuracy_of)
     return sol, extra, grids
+
+
+def test_with_free_shares_the_finer_grids_knots_follow_the_solved_shares() -> None:
+    model = load_model("seven-link")
+    options = GaitOptions(formulation="full", gait="heel-toe", free_phase_fractions=True,
+                          knots=(24, 16))
+    seq = contact_sequence(model, options)
+    assert [ph.fraction for ph in seq.phases] == pytest.approx([0.425, 0.2975, 0.15, 0.1275])
+    before = phase_knots(seq, options.knots)
+    # The solve moved the shares: double support grew to 0.28 of a 1.2 s step.
+    shares = (0.40, 0.20, 0.28, 0.12)
+    durations = [1.2 * s for s in shares]
+    solved = FakeSolution(options, model=model, result=SimpleNamespace(
+        parameters={"speed": 1.0, "step_length": 0.7},
+        phases=tuple(SimpleNamespace(duration=d) for d in durations)))
+    assert solved_shares(solved) == pytest.approx(shares)  # type: ignore[arg-type]
+    seen: list[GaitOptions] = []
+
+    def solve_on(finer: GaitOptions, _: Any) -> Any:
+        seen.append(finer)
+        return dataclasses.replace(solved, options=finer)
+
+    errors = iter([0.05, 0.001])
+    refine_to_accuracy(solved, refines=True, solve_on=solve_on,  # type: ignore[arg-type]
+                       accuracy_of=lambda _: {"cost_error_relative": next(errors)})
+    (finer,) = seen
+    assert finer.phase_shares == pytest.approx(shares)
+    after = phase_knots(contact_sequence(model, finer), finer.knots)
+    assert after[0] == 36 and before[0] == 24
+    # Double support: from 0.15 to 0.28 of the step, its knots from 16 to about 36 * 0.28 /
+    # 0.40 (the first phase's density), where a grid that did not follow would give 24.
+    assert after[2] == 1 + math.ceil(35 / 0.40 * 0.28 - 1e-9)
+    assert phase_knots(contact_sequence(model, finer.replace(phase_shares=None)),
+                       finer.knots)[2] == 24
+    # Fixed shares (the default): nothing to follow.
+    assert solved_shares(FakeSolution(options.replace(free_phase_fractions=False),  # type: ignore[arg-type]
+                                      model=model)) is None
+
+
+def test_phase_shares_are_checked() -> None:
+    model = load_model("seven-link")
+    options = GaitOptions(formulation="full", gait="heel-toe", free_phase_fractions=True)
+    with pytest.raises(GaitOptionsError, match=r"phase_shares = \(0.5, 1.2\): each must lie "
+                                               r"in \(0, 1\)"):
+        validate_options(options.replace(phase_shares=(0.5, 1.2)), None)
+    with pytest.raises(ContactSequenceError, match="phase_shares: 2 share"):
+        contact_sequence(model, options.replace(phase_shares=(0.5, 0.5)))
 
 
 def test_the_loop_refines_on_the_check_grid_until_within() -> None:

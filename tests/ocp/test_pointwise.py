@@ -29,11 +29,12 @@ from gaitopt.ocp.solver import EVAL_KINDS
 SEPARATED = "hermite-simpson-separated"
 
 
-def nonlinear(gain: float = 1.0, intervals: int = 5) -> Problem:
+def nonlinear(gain: float = 1.0, intervals: int = 5, rate: float = 0.0) -> Problem:
     """A pendulum-like phase whose dynamics, path constraint and integrand depend nonlinearly
     on the states, controls, time and parameters, with a duration that is a nonlinear
     expression of a free parameter (so the knot times are nonlinear in w): every term of the
-    chain rule (outer, cross, point and time Hessians) is nonzero."""
+    chain rule (outer, cross, point and time Hessians) is nonzero. ``rate``: the weight of a
+    control-rate term (``r int tau'^2 dt``, with 1 / h of the duration expression)."""
     def f(x: ca.SX, u: ca.SX, p: ca.SX, t: ca.SX) -> ca.SX:
         return ca.vertcat(x[1] * p[0], -gain * ca.sin(x[0]) * p[1] + u[0] * ca.cos(t * x[0]))
 
@@ -44,7 +45,8 @@ def nonlinear(gain: float = 1.0, intervals: int = 5) -> Problem:
                   path_constraints=[PathConstraint("reach", lambda x, u, p, t:
                                                    x[0] * x[1] + ca.exp(0.1 * u[0] * t),
                                                    lower=-5.0, upper=5.0)],
-                  intervals=intervals)
+                  intervals=intervals,
+                  control_rate_weights={"tau": rate} if rate else {})
     return Problem([swing], parameters=[Parameter("a", 0.5, 2.0, guess=1.0),
                                         Parameter("b", 1.0, 1.0)])
 
@@ -64,8 +66,9 @@ def solver_values(tr: Transcription, w: np.ndarray, lam: np.ndarray
 
 
 @pytest.mark.parametrize("make", [nonlinear, lambda: P.periodic_ratio(intervals=4),
-                                  lambda: P.brachistochrone(intervals=6)],
-                         ids=["nonlinear", "periodic_ratio", "brachistochrone"])
+                                  lambda: P.brachistochrone(intervals=6),
+                                  lambda: nonlinear(rate=0.3)],
+                         ids=["nonlinear", "periodic_ratio", "brachistochrone", "control_rate"])
 @pytest.mark.parametrize("compiled_points", [True, False], ids=["compiled", "vm"])
 def test_point_derivatives_equal_those_of_the_expanded_nlp(
         make: object, compiled_points: bool, tmp_path: Path,
@@ -212,12 +215,13 @@ def _knot_states_problem() -> Problem:
 
 
 @pytest.mark.parametrize(("make", "method"), [
-    (nonlinear, SEPARATED), (lambda: P.periodic_ratio(intervals=4), SEPARATED),
+    (nonlinear, SEPARATED), (lambda: nonlinear(rate=0.3), SEPARATED),
+    (lambda: P.periodic_ratio(intervals=4), SEPARATED),
     (lambda: P.two_phase_jump(intervals=3), SEPARATED), (_knot_states_problem, SEPARATED),
     # Trapezoidal (no midpoints) where it is point-wise: no path constraints at midpoints.
     (lambda: P.periodic_ratio(intervals=4), "trapezoidal"),
     (_knot_states_problem, "trapezoidal")],
-    ids=["nonlinear", "periodic_ratio", "two_phase_jump", "knot_states",
+    ids=["nonlinear", "control_rate", "periodic_ratio", "two_phase_jump", "knot_states",
          "trapezoidal-periodic_ratio", "trapezoidal-knot_states"])
 def test_interval_templates_give_the_outer_derivatives_of_the_mesh(make: object,
                                                                    method: str) -> None:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from gaitopt.analysis.checks.samples import phase_of_samples
 from gaitopt.gait.cost import impulse_events
 from gaitopt.gait.gait_file import Gait
 
@@ -55,7 +56,6 @@ def swing_heights(gait: Gait) -> NDArray[np.float64]:
     """Heights (m) of the swing foot at the samples where a leg has no point on the ground:
     the lowest of that leg's contact points (names ending ``_1`` / ``_2``; the swing tip of a
     point-foot walk in single support)."""
-    from gaitopt.analysis.checks.samples import phase_of_samples
 
     s = gait.samples
     contacts = [c.name for c in gait.model.contacts]

@@ -39,7 +39,10 @@ from gaitopt.analysis.checks.events import event_checks
 from gaitopt.analysis.checks.integration import integration_checks
 from gaitopt.analysis.checks.knots import UnknownStatesError, knot_checks
 from gaitopt.analysis.checks.samples import sample_checks
+from gaitopt.analysis.checks.swing import swing_checks
+from gaitopt.gait.cost import recompute_cost
 from gaitopt.gait.gait_file import Gait
+from gaitopt.gait.refinement import worst_estimate
 
 __all__ = ["CHECKS", "LIMITS", "Check", "CheckSpec", "UnknownStatesError", "VerifyReport",
            "verify_gait"]
@@ -90,14 +93,13 @@ def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
                          f"{tolerance_scale!r}")
     lim = {k: v * tolerance_scale for k, v in LIMITS.items()}
     checks = [*knot_checks(gait, lim), *integration_checks(gait, lim), *event_checks(gait, lim),
-              *sample_checks(gait, lim), _cost_check(gait, lim), _accuracy_check(gait, lim)]
+              *sample_checks(gait, lim), *swing_checks(gait, lim), _cost_check(gait, lim),
+              _accuracy_check(gait, lim)]
     order = list(CHECKS)
     return VerifyReport(tuple(sorted(checks, key=lambda c: order.index(c.id))))
 
 
 def _cost_check(gait: Gait, lim: dict[str, float]) -> Check:
-    from gaitopt.gait.cost import recompute_cost
-
     cost = recompute_cost(gait)
     saved = gait.cost_value
     rel = abs(cost - saved) / max(abs(saved), 1e-12)
@@ -112,7 +114,6 @@ def _accuracy_check(gait: Gait, lim: dict[str, float]) -> Check:
     (:func:`gaitopt.gait.refinement.worst_estimate`) against the accuracy it was asked to
     reach (``solver.accuracy.target``, scaled like every limit). A gait solved on a grid the
     caller chose has no target: the estimate is reported and the check passes."""
-    from gaitopt.gait.refinement import worst_estimate
 
     record = gait.solver.get("accuracy") or {}
     target = record.get("target")

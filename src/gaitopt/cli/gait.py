@@ -28,7 +28,7 @@ from gaitopt.cli.base import (
     parse_pair,
     resting_power_option,
 )
-from gaitopt.gait.formulation import biped_for, checked_sequence
+from gaitopt.gait.formulation import Formulation, biped_for, checked_sequence, formulation_of
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.model_defaults import MULTI_PHASE_KNOTS, options_for_model
 from gaitopt.gait.model_scale import model_scale
@@ -63,7 +63,7 @@ def _speed(text: str) -> float | None:
 FAR_FROM_REFERENCE = 0.25
 
 
-def multistart_default(speed: float | None, formulation: str | None,
+def multistart_default(speed: float | None, formulation: Formulation,
                        reference: float = REFERENCE_SPEED, far: float = FAR_FROM_REFERENCE
                        ) -> bool:
     """Whether ``gaitopt solve`` uses multistart when neither ``--multistart`` nor
@@ -71,7 +71,7 @@ def multistart_default(speed: float | None, formulation: str | None,
     measured) at a given speed at least ``far`` (:data:`FAR_FROM_REFERENCE` on the reference
     biped) from the ``reference`` speed (12 m/min on the reference biped: the speed-free
     optimal walk starts there; a model's: :func:`gaitopt.gait.solve.reference_speed`)."""
-    return (formulation == "reduced" and speed is not None
+    return (formulation.traits.multistart_by_default and speed is not None
             and abs(speed - reference) >= far - 1e-12)
 
 
@@ -166,6 +166,11 @@ def _step_time(text: str) -> float | None:
 @resting_power_option
 @click.option("--regularization", type=float, default=0.0, show_default=True,
               help="Weight of an added mean squared torque (u / u_max)^2 term.")
+@click.option("--torque-rate-time", type=click.FloatRange(min=0.0), default=0.0,
+              show_default=True,
+              help="Time tau in s of an added torque-rate term tau^2 int u'^2 dt in the cost "
+                   "(prices torque changes faster than about 1 / (2 pi tau) Hz; "
+                   "docs/feet.md).")
 @control_model_option(
               help="Controls continuous at the heel strike and periodic (paper), or free to "
                    "jump at both events (jumps).")
@@ -205,6 +210,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   free_fractions: bool, stride: bool,
                   gait_kind: str | None, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
+                  torque_rate_time: float,
                   control_model: str | None, mesh_tol: float | None, accuracy: float,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool | None,
@@ -238,7 +244,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
         periodic_controls=periodic_controls, friction=friction,
         unilateral_impulses=unilateral_impulses,
         cost=cost,  # type: ignore[arg-type]
-        cost_regularization=regularization,
+        cost_regularization=regularization, torque_rate_time=torque_rate_time,
         mesh_tol=mesh_tol, accuracy=accuracy, swing_clearance=clearance,
         clearance_profile=clearance_profile,  # type: ignore[arg-type]
         free_phase_fractions=free_fractions, stride=stride)
@@ -260,7 +266,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
         raise UserError(str(exc)) from None
     reference = reference_speed(model, options)
     if multistart is None:
-        multistart = multistart_default(options.speed, options.formulation, reference,
+        multistart = multistart_default(options.speed, formulation_of(options), reference,
                                         model_scale(model).speed(FAR_FROM_REFERENCE))
     options = options.replace(multistart=multistart)
     console.print(f"solving {options.variant} on model {model.name}: speed "
@@ -274,7 +280,7 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   + (", a stride (two steps, no leg swap)" if options.stride else ""))
 
     if (start is None and not options.multistart
-            and multistart_default(options.speed, options.formulation, reference,
+            and multistart_default(options.speed, formulation_of(options), reference,
                                    model_scale(model).speed(FAR_FROM_REFERENCE))):
         console.print(f"note: far from {format_speed(reference)} a cold solve can end in a "
                       "worse local optimum; "

@@ -24,7 +24,7 @@ from typing import Any
 
 from gaitopt.dynamics.backend import Scalar, Scalars, vector
 from gaitopt.dynamics.kinematics import body_velocities, coordinates, velocity_products
-from gaitopt.dynamics.rnea import gravity_acceleration
+from gaitopt.dynamics.rnea import add_damping, gravity_acceleration
 from gaitopt.dynamics.spatial import (
     ZERO3,
     ZERO_MAT3,
@@ -142,13 +142,16 @@ def velocity_terms(art: ArticulatedInertias, qd: Scalars) -> VelocityTerms:
 
 def free_accelerations(model: RobotModel, art: ArticulatedInertias, qd: Scalars,
                        tau: Scalars) -> Scalars:
-    """``qdd`` of the unconstrained system under ``tau`` and gravity (scalars)."""
+    """``qdd`` of the unconstrained system under ``tau``, gravity and the joints' damping
+    (scalars)."""
     terms = velocity_terms(art, qd)
-    return aba_sweep(art, tau, terms.bias, terms.c, gravity_acceleration(model))
+    return aba_sweep(art, add_damping(model, tau, qd, -1.0), terms.bias, terms.c,
+                     gravity_acceleration(model))
 
 
 def aba(model: RobotModel, q: Any, qd: Any, tau: Any) -> Any:
-    """Forward dynamics ``qdd = M^-1 (tau - C qd - G)`` ``(nq,)`` by the ABA.
+    """Forward dynamics ``qdd = M^-1 (tau - C qd - G - D qd)`` ``(nq,)`` by the ABA (``D``
+    the joints' damping, :func:`gaitopt.dynamics.rnea.add_damping`).
 
     ``tau`` ``(nq,)`` are generalized forces (see :func:`.actuation.generalized_forces` to get
     them from actuator torques).

@@ -5,7 +5,7 @@ the hold spec ``name:y`` its normal row only (:class:`gaitopt.dynamics.tree.Hold
 point of a flat foot). With ``J`` the stacked rows ``(m, nq)`` (``m = 2 nc`` for pins, rows
 ``x_1, y_1, x_2, y_2, ...``; a normal-only hold contributes its ``y`` row alone):
 
-* ``qdd_free = M^-1 (tau - C - G)`` (ABA),
+* ``qdd_free = M^-1 (tau - C - G - D qd)`` (ABA; ``D`` the joints' damping),
 * ``Lambda = (J M^-1 J^T)^-1`` ``(2 nc, 2 nc)``, the operational-space inertia,
 * ``forces = -Lambda (J qdd_free + Jdot qd)`` (eq. 9): the force of the ground on each tip,
   world frame, N, stacked ``[fx_1, fy_1, fx_2, fy_2, ...]``,
@@ -41,7 +41,7 @@ from gaitopt.dynamics.kinematics import (
     point_acceleration_world,
     point_jacobian_rows,
 )
-from gaitopt.dynamics.rnea import gravity_acceleration
+from gaitopt.dynamics.rnea import add_damping, gravity_acceleration
 from gaitopt.dynamics.tree import contact_point, hold_specs, holds
 from gaitopt.robot.model import RobotModel
 
@@ -126,7 +126,8 @@ def contact_dynamics_scalars(model: RobotModel, q: Scalars, qd: Scalars, tau: Sc
     """:func:`contact_dynamics` on scalar lists: ``(qdd, forces, Lambda rows)``."""
     art = articulated_inertias(model, q)
     terms = velocity_terms(art, qd)
-    qdd_free = aba_sweep(art, tau, terms.bias, terms.c, gravity_acceleration(model))
+    qdd_free = aba_sweep(art, add_damping(model, tau, qd, -1.0), terms.bias, terms.c,
+                         gravity_acceleration(model))
     if not names:
         return qdd_free, [], []
     system = constraint_system(model, q, names, art)

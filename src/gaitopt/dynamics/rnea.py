@@ -59,11 +59,25 @@ def rnea_scalars(model: RobotModel, q: Scalars, qd: Scalars, qdd: Scalars,
         tau[k] = f[k][body.axis]
         if body.parent >= 0:
             f[body.parent] = add3(f[body.parent], force_to_parent(x[k], f[k]))
-    return tau
+    return add_damping(model, tau, qd, +1.0)
+
+
+def add_damping(model: RobotModel, tau: Scalars, qd: Scalars, sign: float) -> Scalars:
+    """``tau + sign D qd`` with ``D = diag(b)`` the joints' damping
+    (:attr:`~gaitopt.robot.model.RobotModel.coordinate_damping`, N m s/rad): ``+1`` in the
+    RNEA (the generalized force that also overcomes the damping), ``-1`` where forces drive
+    the ABA (the damping's passive torque ``-D qd`` joins them). Coordinates without damping
+    are passed through untouched (the same expressions as without this term)."""
+    out = list(tau)
+    for i, b in enumerate(model.coordinate_damping):
+        if b:
+            out[i] = out[i] + sign * b * qd[i]
+    return out
 
 
 def rnea(model: RobotModel, q: Any, qd: Any, qdd: Any, tau_ext: Any = None) -> Any:
-    """Generalized forces ``tau (nq,)`` that produce ``qdd`` at state ``(q, qd)``.
+    """Generalized forces ``tau (nq,)`` that produce ``qdd`` at state ``(q, qd)``:
+    ``M qdd + C qd + G + D qd`` (``D`` the joints' damping, :func:`add_damping`).
 
     ``tau_ext`` (optional, ``(nq,)``) are generalized forces from outside the joints (for
     example ``J_c^T f_c`` of contact forces); the result is then ``M qdd + C + G - tau_ext``.
@@ -77,8 +91,8 @@ def rnea(model: RobotModel, q: Any, qd: Any, qdd: Any, tau_ext: Any = None) -> A
 
 
 def bias_forces(model: RobotModel, q: Any, qd: Any) -> Any:
-    """``C(q, qd) qd + G(q)`` ``(nq,)``: Coriolis, centrifugal and gravity generalized forces
-    (RNEA with ``qdd = 0``)."""
+    """``C(q, qd) qd + G(q) + D qd`` ``(nq,)``: Coriolis, centrifugal, gravity and joint
+    damping generalized forces (RNEA with ``qdd = 0``)."""
     q_s, qd_s = coordinates(model, q), coordinates(model, qd, "qd")
     return vector(rnea_scalars(model, q_s, qd_s, [0.0] * model.nq))
 

@@ -26,13 +26,15 @@ import os
 import numpy as np
 
 from gaitopt.gait.accuracy import accuracy_record
+from gaitopt.gait.diagnose import SolveFailedError, diagnose
+from gaitopt.gait.full_physics import actuator_names
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.model_defaults import default_speed, options_for_model
 from gaitopt.gait.options import GaitOptions, follows_model
 from gaitopt.gait.preflight import refuse_unwalkable
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
 from gaitopt.gait.refinement import refine_to_accuracy
-from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking
+from gaitopt.gait.solve import ProgressFn, WalkingSolution, solve_walking, transcription_for
 from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
@@ -45,7 +47,6 @@ def as_model(model: RobotModel | str | os.PathLike[str]) -> RobotModel:
 def guess_from_gait(gait: Gait) -> Guess:
     """An engine guess from a saved gait: its phase states (reduced or full, by name) and
     actuator torques at its knots (normalised times), and its parameters."""
-    from gaitopt.gait.full_physics import actuator_names
 
     model = gait.model
     phases = {}
@@ -156,7 +157,6 @@ def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
     data = gait.solver.get("warm_start")
     if not isinstance(data, dict) or options.mesh_tol is not None:
         return None
-    from gaitopt.gait.solve import transcription_for
 
     try:
         point = WarmStart(w=np.asarray(data["w"], dtype=float),
@@ -197,6 +197,5 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
     except MotionOutOfReachError:
         if solution.success:
             raise
-        from gaitopt.gait.diagnose import SolveFailedError, diagnose
 
         raise SolveFailedError(diagnose(solution).text()) from None

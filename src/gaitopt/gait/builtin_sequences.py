@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.gait.contact_sequence import (
     ContactSequence,
     ContactSequenceError,
@@ -57,7 +58,6 @@ def feet(model: RobotModel, contact_swap: Mapping[str, str]
     """``((heel_1, toe_1), (heel_2, toe_2))``: the two contact points on the link of the
     model's first contact (its foot), rear one first in the standing pose (all coordinates
     0), and their counterparts on the other foot by the leg swap."""
-    from gaitopt.dynamics.kinematics import contact_position
 
     link = model.contacts[0].link
     on_foot = [c.name for c in model.contacts if c.link == link]

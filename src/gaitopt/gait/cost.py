@@ -20,7 +20,10 @@ actuator power is ``p_a = u_a w_a`` (W). ``P`` is the liftoff impulse (N s) and
 ``pos(x) = (x + sqrt(x^2 + eps^2)) / 2`` is a smooth ``max(0, x)`` (IPOPT needs derivatives):
 ``0 <= pos(x) - max(0, x) <= eps / 2``, so with ``eps = cost_smoothing`` (W) the smoothed work
 cost exceeds the exact one by at most ``n_a eps T / (2 W L)`` (``n_a`` actuators). An optional
-regularisation adds ``r int sum_a (u_a / u_max_a)^2 dt / T`` (dimensionless) to any cost.
+regularisation adds ``r int sum_a (u_a / u_max_a)^2 dt / T`` (dimensionless) to any cost,
+and a torque-rate term with time ``tau`` (``torque_rate_time``) adds ``tau^2 int sum_a u_a'^2
+dt`` to the paper cost's numerator (``tau^2 W sqrt(g l) int sum_a (u_a' / u_max_a)^2 dt``,
+J, to a cost of transport's; ``l`` the leg length): :func:`torque_rate_weights`.
 Everything here runs on numbers and CasADi symbols alike.
 """
 
@@ -29,9 +32,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from gaitopt.dynamics.backend import Scalar, as_scalars, sqrt
+from gaitopt.dynamics.kinematics import contact_velocity
+from gaitopt.dynamics.reduced import double_support_state
+from gaitopt.gait import walking
 from gaitopt.gait.contact_sequence import sequence_from_dict
-from gaitopt.gait.model_scale import REFERENCE, ModelScale
+from gaitopt.gait.interpolation import phase_states_at
+from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.robot.model import RobotModel
 
@@ -63,7 +72,42 @@ def formula(options: GaitOptions) -> str:
     if options.cost_regularization > 0.0:
         text += (f"; plus {options.cost_regularization:g} x integral of sum (u / u_max)^2 dt "
                  "/ step time")
+    if options.torque_rate_time > 0.0:
+        tau = options.torque_rate_time
+        text += (f"; plus ({tau:g} s)^2 x integral of sum u'^2 dt in the numerator"
+                 if options.cost == "paper" else
+                 f"; plus ({tau:g} s)^2 x W sqrt(g l) x integral of sum (u' / u_max)^2 dt in "
+                 "the numerator")
     return text
+
+
+def torque_rate_weights(model: RobotModel, options: GaitOptions) -> dict[str, float]:
+    """The weight ``r_a`` of each actuator's ``int u_a'^2 dt`` in the cost's numerator
+    (:attr:`gaitopt.ocp.problem.Phase.control_rate_weights`): ``tau^2`` (s^2) for the paper
+    cost, ``tau^2 W sqrt(g l) / u_max_a^2`` (J s / (N m)^2) for the costs of transport, with
+    ``tau = options.torque_rate_time``, ``W`` the body weight, ``l`` the leg length
+    (:func:`gaitopt.gait.model_scale.model_scale`); empty when ``tau = 0``."""
+    tau = options.torque_rate_time
+    if tau <= 0.0:
+        return {}
+    if options.cost == "paper":
+        return {a.name: tau * tau for a in model.actuators}
+    scale = model_scale(model)
+    power = weight(model) * (scale.gravity * scale.leg_length) ** 0.5
+    return {a.name: tau * tau * power / (max(abs(a.limits[0]), abs(a.limits[1])) or 1.0) ** 2
+            for a in model.actuators}
+
+
+def torque_rate_cost(model: RobotModel, options: GaitOptions, t: Any, u: Any) -> float:
+    """``sum_a r_a sum_k (u[k+1, a] - u[k, a])^2 / (t[k+1] - t[k])``: the exact
+    :func:`torque_rate_weights` term of one phase's piecewise-linear torques ``u`` (K, n_a;
+    N m) at knot times ``t`` (K,; s); 0 without weights."""
+    weights = torque_rate_weights(model, options)
+    if not weights or len(t) < 2:
+        return 0.0
+    r = np.array([weights[a.name] for a in model.actuators])
+    du = np.diff(np.asarray(u, dtype=float), axis=0)
+    return float(np.sum((du * du) @ r / np.diff(np.asarray(t, dtype=float))))
 
 
 def smooth_positive(x: Scalar, eps: float) -> Scalar:
@@ -172,12 +216,6 @@ def recompute_cost(gait: Any) -> float:
     piecewise-linear torques. The impulse term of the costs of transport is the work of every
     event that applies the liftoff impulse (:func:`impulse_events`: by the file's contact
     sequence, not by the event's name; a heel-toe walk's impulse acts at ``toe_off``)."""
-    import numpy as np
-
-    from gaitopt.dynamics.kinematics import contact_velocity
-    from gaitopt.gait import walking
-    from gaitopt.gait.interpolation import phase_states_at
-
     model = gait.model
     options = GaitOptions.from_dict(dict(gait.options))
     nq = model.nq
@@ -196,8 +234,6 @@ def recompute_cost(gait: Any) -> float:
             elif ph.name == walking.SINGLE:
                 qd_mid = np.asarray(walking.single_support_to_full(model, x_mid[k])[1], float)
             else:
-                from gaitopt.dynamics.reduced import double_support_state
-
                 z, zd = walking.split_state(x_mid[k], len(ph.state_names) // 2)
                 qd_mid = np.asarray(double_support_state(model, 0, z, zd, walking.ORIGIN,
                                                          (step, 0.0))[1], float)
@@ -207,6 +243,7 @@ def recompute_cost(gait: Any) -> float:
                       running_cost(model, options, ph.qd[k + 1], list(ph.u[k + 1]), p)]
             h = ph.t[k + 1] - ph.t[k]
             total += h / 6.0 * (values[0] + 4.0 * values[1] + values[2])
+        total += torque_rate_cost(model, options, ph.t, ph.u)
     impulse = p[2]
     if options.cost == "paper":
         total += steps * impulse * impulse

@@ -82,7 +82,7 @@ from gaitopt.gait.full_physics import (
 from gaitopt.gait.model_scale import model_scale
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.phase_fractions import fraction_parameters, phase_share, remainder_bounds
-from gaitopt.gait.problem import LENGTH_SCALE
+from gaitopt.gait.problem import LENGTH_SCALE, clearance_profile, parameter_bounds, parameters_of
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
     BoundaryConstraint,
@@ -96,6 +96,7 @@ from gaitopt.ocp.problem import (
     Problem,
 )
 from gaitopt.ocp.transcription import Transcription
+from gaitopt.robot.biped import BipedStructureError, biped_of
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import LegSwap
 
@@ -144,7 +145,6 @@ def _limits(model: RobotModel) -> dict[str, tuple[float, float]]:
 
 def stance_knees(model: RobotModel) -> dict[str, str]:
     """Contact name -> the knee joint of its leg, for five-link-like models (else empty)."""
-    from gaitopt.robot.biped import BipedStructureError, biped_of
 
     try:
         legs = biped_of(model).legs
@@ -328,6 +328,8 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
             initial_control={n: 0.0 for n in proj}, path_constraints=path,
             lagrange=lagrange, state_scales=scales,
             control_scales={n: PROJECTION_SCALE for n in proj},
+            control_rate_weights={a: r for a, r in cost.torque_rate_weights(
+                model, options).items() if a in acts},
             intervals=counts[len(phases)] - 1,
             knot_states=None if placed is None else KnotStates(
                 BASE_STATES, _placed_base(model, seq, placed, i_ph))))
@@ -413,8 +415,6 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
         events.append(BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
                                          lower=-ca.inf, upper=ca.inf, scale=1.0))
 
-    from gaitopt.gait.problem import parameter_bounds, parameters_of
-
     bounds = parameter_bounds(options)
     if not any(ev.impulse for ev in seq.events):
         bounds[IMPULSE] = (0.0, 0.0)
@@ -479,7 +479,6 @@ def _clearance_profile(model: RobotModel, options: GaitOptions, points: Sequence
     """The swing clearance of the first phase (:func:`gaitopt.gait.problem.clearance_profile`):
     each point landing at its end stays above ``profile(s)``, ``s = t / T_0`` (``T_0 =
     duration(p)``, the phase's duration ``f steps L / v``)."""
-    from gaitopt.gait.problem import clearance_profile
 
     assert options.swing_clearance is not None
     height = options.swing_clearance

@@ -58,11 +58,11 @@ from gaitopt.gait.gait_parts import GaitEvent as GaitEvent
 from gaitopt.gait.gait_parts import GaitPhase as GaitPhase
 from gaitopt.gait.gait_parts import GaitSamples as GaitSamples
 from gaitopt.robot import ModelError, RobotModel
+from gaitopt.robot.symmetry import swap_matrices, swap_names
+from gaitopt.views import gait_views
 
-if TYPE_CHECKING:  # for annotations only: no viz import at run time
+if TYPE_CHECKING:  # for annotations only
     from matplotlib.figure import Figure
-
-    from gaitopt.viz.notebook import GifAnimation
 
 FORMAT = "gaitopt.gait"
 VERSION = 2
@@ -197,7 +197,6 @@ class Gait:
         if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
             raise ValueError(f"n_steps: expected an integer >= 1, got {n_steps!r}")
         s = self.samples
-        from gaitopt.robot.symmetry import swap_matrices, swap_names
 
         steps = self.period_steps
         if steps == 1:
@@ -295,29 +294,25 @@ class Gait:
                                 f"not valid JSON ({exc.msg})") from None
         return cls.from_dict(data, source=source)
 
-    # -- notebook use (gaitopt.viz.notebook, imported on first use) -------------------------
+    # -- notebook use: gaitopt.viz.notebook, found through gaitopt.views (gait/ is below viz/)
     def _repr_html_(self) -> str:
         """Jupyter's view: a table of speed, step length and time, cost, solver status, largest
         violation and the verify verdict (:func:`gaitopt.viz.notebook.summary_html`)."""
-        from gaitopt.viz.notebook import summary_html
-
-        return summary_html(self)
+        return gait_views().summary_html(self)
 
     def plot(self, kind: str = "overview") -> Figure:
         """A Matplotlib figure: ``overview`` (angles, hip, torques over the step), ``torques``,
         ``hip``, ``heights``, ``poses`` or ``costates``
         (:func:`gaitopt.viz.notebook.gait_figure`)."""
-        from gaitopt.viz.notebook import gait_figure
-
-        return gait_figure(self, kind)
+        figure: Figure = gait_views().gait_figure(self, kind)
+        return figure
 
     def animate(self, path: str | os.PathLike[str] | None = None, *, steps: int = 4,
-                fps: int = 30) -> Path | GifAnimation:
+                fps: int = 30) -> Any:
         """``steps`` steps of the walk in real time: written to ``path`` (.gif or .mp4; returns
-        the path) or, without a path, an animated GIF that Jupyter shows inline."""
-        from gaitopt.viz.notebook import animate
-
-        return animate(self, path, steps=steps, fps=fps)
+        the path) or, without a path, an animated GIF that Jupyter shows inline (a
+        :class:`gaitopt.viz.notebook.GifAnimation`)."""
+        return gait_views().animate(self, path, steps=steps, fps=fps)
 
 
 # -- validation helpers ------------------------------------------------------------------------

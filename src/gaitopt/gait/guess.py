@@ -83,11 +83,13 @@ def default_step_length(speed: float, scale: ModelScale = REFERENCE) -> float:
     return scale.length(float(np.clip(0.06 + 0.35 * v_ref, 0.05, 0.5)))
 
 
-def _smoothstep(s: Array) -> Array:
+def smoothstep(s: Array) -> Array:
+    """The cubic ``3 s^2 - 2 s^3``: 0 at ``s = 0``, 1 at ``s = 1``, flat at both ends."""
     return s * s * (3.0 - 2.0 * s)
 
 
-def _knots(t0: float, duration: float, count: int) -> Array:
+def knot_times(t0: float, duration: float, count: int) -> Array:
+    """``count`` uniform knot times (s) from ``t0`` over ``duration``, both ends included."""
     return t0 + duration * np.linspace(0.0, 1.0, count)
 
 
@@ -139,7 +141,7 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
     # Phase 1: single support on leg 1, swing leg 2 along an arc.
     t_fine = np.linspace(0.0, t1, _FINE)
     s = t_fine / t1
-    tip2 = np.stack([-step + 2.0 * step * _smoothstep(s), lift * np.sin(np.pi * s)], axis=1)
+    tip2 = np.stack([-step + 2.0 * step * smoothstep(s), lift * np.sin(np.pi * s)], axis=1)
     p_hip = hip(t_fine)
     q_fine = np.zeros((_FINE, model.nq))
     q_fine[:, BASE_POSITION] = p_hip
@@ -149,8 +151,8 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                                             0.0)
             q_fine[k, leg.hip_index] = float(joints.hip)
             q_fine[k, leg.knee_index] = float(joints.knee)
-    phases.append(_phase_guess(model, SINGLE, t_fine, q_fine, _knots(0.0, t1, knots[0]),
-                               ankle, use_ankles, [stance.contact], full))
+    phases.append(phase_guess(model, SINGLE, t_fine, q_fine, knot_times(0.0, t1, knots[0]),
+                              ankle, use_ankles, [stance.contact], full))
     if f < 1.0:
         t_fine = np.linspace(t1, t1 + t2, _FINE)
         p_hip = hip(t_fine)
@@ -162,9 +164,9 @@ def naive_guess(model: RobotModel, *, speed: float, step_length: float,
                                                 0.0, 0.0)
                 q_fine[k, leg.hip_index] = float(joints.hip)
                 q_fine[k, leg.knee_index] = float(joints.knee)
-        phases.append(_phase_guess(model, DOUBLE, t_fine, q_fine,
-                                   _knots(t1, t2, knots[1]), ankle, use_ankles,
-                                   [stance.contact, swing.contact], full))
+        phases.append(phase_guess(model, DOUBLE, t_fine, q_fine,
+                                  knot_times(t1, t2, knots[1]), ankle, use_ankles,
+                                  [stance.contact, swing.contact], full))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
@@ -201,13 +203,13 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
                                  ("flight", (t1, total), [])):
         t = np.linspace(ta, tb, _FINE)
         p_hip = np.stack([-s_hip / 2.0 + v * t, np.full_like(t, height)], axis=1)
-        sig2 = _smoothstep(t / total)
+        sig2 = smoothstep(t / total)
         tip2 = np.stack([xb + (step - xb) * sig2,
                          yb * (1.0 - sig2) + bump * np.sin(np.pi * t / total)], axis=1)
         if name == "stance":
             tip1 = np.zeros_like(tip2)
         else:
-            sig1 = _smoothstep((t - t1) / (total - t1))
+            sig1 = smoothstep((t - t1) / (total - t1))
             tip1 = np.stack([(step + xb) * sig1,
                              yb * sig1 + bump * np.sin(np.pi * (t - t1) / (total - t1))],
                             axis=1)
@@ -220,14 +222,18 @@ def naive_running_guess(model: RobotModel, *, speed: float, step_length: float,
                 q_fine[k, leg.hip_index] = float(joints.hip)
                 q_fine[k, leg.knee_index] = float(joints.knee)
         count = knots[0] if name == "stance" else knots[1]
-        phases.append(_phase_guess(model, name, t, q_fine, _knots(ta, tb - ta, count), ankle,
-                                   use_ankles, held, True))
+        phases.append(phase_guess(model, name, t, q_fine, knot_times(ta, tb - ta, count), ankle,
+                                  use_ankles, held, True))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})
 
 
-def _phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_knots: Array,
-                 ankle: bool, use_ankles: bool, held: list[str], full: bool) -> PhaseGuess:
+def phase_guess(model: RobotModel, phase: str, t_fine: Array, q_fine: Array, t_knots: Array,
+                ankle: bool, use_ankles: bool, held: list[str], full: bool) -> PhaseGuess:
+    """The guess of one phase from a motion ``q_fine`` (rows at the times ``t_fine``): its
+    states at ``t_knots`` (full ``[q, qd]`` if ``full``, else the phase's reduced states) and
+    the least-squares torques that realise it with the ``held`` contact points on the ground
+    (ankle torques only if ``use_ankles``; ``ankle`` says whether the phase has them)."""
     qd_fine = np.gradient(q_fine, t_fine, axis=0)
     qdd_fine = np.gradient(qd_fine, t_fine, axis=0)
     controls = actuator_names(model, held, ankle=ankle)

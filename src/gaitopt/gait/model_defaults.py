@@ -26,6 +26,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
+from gaitopt.gait.formulation import default_formulation
 from gaitopt.gait.model_scale import model_scale
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, follows_model
 from gaitopt.robot.model import RobotModel
@@ -109,8 +111,6 @@ def default_speed(model: RobotModel, gait: str) -> float:
 
 def _phase_count(options: GaitOptions, gait: str) -> int:
     if options.contact_sequence is not None:
-        from gaitopt.gait.contact_sequence import ContactSequenceError, sequence_from_dict
-
         try:
             return len(sequence_from_dict(options.contact_sequence).phases)
         except ContactSequenceError as exc:
@@ -127,7 +127,6 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
             (When no built-in gait fits and none was given, the gait is the walk, and the
             walk's own checks name what the model lacks.)
     """
-    from gaitopt.gait.formulation import default_formulation
 
     o, changes = options, dict[str, Any]()
     custom = o.contact_sequence is not None

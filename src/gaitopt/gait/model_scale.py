@@ -35,6 +35,7 @@ import functools
 import math
 from dataclasses import dataclass
 
+from gaitopt.dynamics.kinematics import contact_position, point_position
 from gaitopt.robot.model import RobotModel
 
 #: The reference biped's characteristic leg length (m): the five-link biped's hip height
@@ -126,7 +127,6 @@ def leg_length(model: RobotModel) -> float:
     Raises:
         ValueError: the model has no contact point, or no contact point below the hip.
     """
-    from gaitopt.dynamics.kinematics import contact_position, point_position
 
     if not model.contacts:
         raise ValueError(f"model {model.name!r} has no contact point: no leg length")

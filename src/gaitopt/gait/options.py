@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Literal, TypeVar, cast
 
+from gaitopt.gait.formulation_traits import FORMULATION_TRAITS
 from gaitopt.robot.biped import Biped
 from gaitopt.units import format_speed
 
@@ -34,7 +35,7 @@ GaitKind = Literal["walk", "run", "heel-toe"]
 #: The built-in gaits (``GaitOptions.gait``).
 GAITS = ("walk", "run", "heel-toe")
 CostName = Literal["paper", "work", "metabolic"]
-FORMULATIONS: tuple[str, ...] = ("reduced", "full")
+FORMULATIONS: tuple[str, ...] = tuple(FORMULATION_TRAITS)
 ControlModel = Literal["paper", "jumps"]
 #: The control models (see ``docs/walking.md``, "Control model").
 CONTROL_MODELS = ("paper", "jumps")
@@ -189,6 +190,12 @@ class GaitOptions:
             min(2 s, 0.95)]`` around its share ``s`` (which is its first guess); full
             formulation, two phases or more. Not with ``single_support_fraction_bounds``.
             See :func:`gaitopt.gait.phase_fractions.fraction_parameters`.
+        phase_shares: ``None``, or each phase's share of the step (one per phase of the
+            contact sequence, in (0, 1)): the first guess of the free fractions instead of the
+            sequence's own, and what the knots per phase follow
+            (:func:`gaitopt.gait.contact_sequence.phase_knots`). A refinement round of a
+            solve with free fractions sets it to the shares it solved for
+            (:mod:`gaitopt.gait.refinement`), so a phase that grew gets more knots.
         gait: ``"walk"`` (single support on leg 1, then double support, or the single-support
             walk when ``single_support_fraction = 1``) or ``"run"`` (stance on leg 1 for
             ``single_support_fraction`` of the step, then flight; full formulation only, no
@@ -212,6 +219,12 @@ class GaitOptions:
         cost_smoothing: ``eps`` (W, > 0) of the smooth positive part in the work costs
             (default 0.01 W for 42 kg on 1 m legs, carried over as a power).
         cost_regularization: weight (>= 0) of an added ``int sum (u / u_max)^2 dt / T``.
+        torque_rate_time: ``tau`` (s, >= 0) of an added torque-rate term ``tau^2 int sum
+            u'(t)^2 dt`` in the numerator of the paper's cost (the costs of transport: ``tau^2
+            W sqrt(g l) int sum (u' / u_max)^2 dt``; :func:`gaitopt.gait.cost.torque_rate_weights`).
+            It prices torque changes faster than about ``1 / (2 pi tau)`` Hz, as a muscle's
+            activation time or a motor's bandwidth does (default 0: none; docs/feet.md,
+            "Flapping feet", measures it against the seven-link model's flapping feet).
         multistart: solve the coarse problem from every naive guess and, away from 12 m/min,
             by continuation in speed, take every distinct coarse optimum through the
             remaining stages and keep the lowest final one (3-4x the time; a cold solve
@@ -280,12 +293,14 @@ class GaitOptions:
     contact_sequence: dict[str, Any] | None = None
     single_support_fraction_bounds: tuple[float, float] | None = None
     free_phase_fractions: bool = False
+    phase_shares: tuple[float, ...] | None = None
     cost: CostName = "paper"
     efficiency_positive: float = 0.25
     efficiency_negative: float = 1.2
     resting_power: float = 1.2
     cost_smoothing: float = from_model(0.01)
     cost_regularization: float = 0.0
+    torque_rate_time: float = 0.0
     mesh_tol: float | None = None
     accuracy: float | None = 0.01
     control_model: ControlModel = "jumps"
@@ -383,19 +398,21 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
     if o.formulation not in FORMULATIONS:
         raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
                                f"{', '.join(FORMULATIONS)}")
+    traits = FORMULATION_TRAITS[o.formulation]
     if o.cost not in ("paper", "work", "metabolic"):
         raise GaitOptionsError(f"cost = {o.cost!r}: must be one of paper, work, metabolic")
     for name, value, lo, strict in (("efficiency_positive", o.efficiency_positive, 0.0, True),
                                     ("efficiency_negative", o.efficiency_negative, 0.0, True),
                                     ("resting_power", o.resting_power, 0.0, False),
                                     ("cost_smoothing", o.cost_smoothing, 0.0, True),
-                                    ("cost_regularization", o.cost_regularization, 0.0, False)):
+                                    ("cost_regularization", o.cost_regularization, 0.0, False),
+                                    ("torque_rate_time", o.torque_rate_time, 0.0, False)):
         v = _finite(name, value)
         if v < lo or (strict and v == lo):
             raise GaitOptionsError(f"{name} = {v:g}: must be {'>' if strict else '>='} {lo:g}")
     if o.single_support_fraction_bounds is not None:
         f_lo, f_hi = _bounds("single_support_fraction_bounds", o.single_support_fraction_bounds)
-        if o.formulation != "full":
+        if not traits.contact_sequences:
             raise GaitOptionsError("single_support_fraction_bounds: a free single-support "
                                    "fraction needs formulation 'full'")
         if f_lo < 0.05 or f_hi >= 1.0:
@@ -406,14 +423,18 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
                                    f"must lie in single_support_fraction_bounds "
                                    f"[{f_lo:g}, {f_hi:g}] (it is the first guess)")
     if o.free_phase_fractions:
-        if o.formulation != "full":
+        if not traits.contact_sequences:
             raise GaitOptionsError("free_phase_fractions: free phase fractions need "
                                    "formulation 'full'")
         if o.single_support_fraction_bounds is not None:
             raise GaitOptionsError("free_phase_fractions and single_support_fraction_bounds: "
                                    "give one of them (free_phase_fractions frees every phase)")
+    if o.phase_shares is not None and not all(
+            isinstance(v, int | float) and 0.0 < float(v) < 1.0 for v in o.phase_shares):
+        raise GaitOptionsError(f"phase_shares = {tuple(o.phase_shares)!r}: each must lie in "
+                               "(0, 1)")
     if o.stride:
-        if o.formulation != "full":
+        if not traits.contact_sequences:
             raise GaitOptionsError("stride: a two-step stride needs formulation 'full' (the "
                                    "reduced coordinates describe one step of the five-link "
                                    "biped, periodic through the leg swap)")
@@ -423,7 +444,7 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
                                    "both steps)")
     if o.gait not in GAITS:
         raise GaitOptionsError(f"gait = {o.gait!r}: must be one of {', '.join(GAITS)}")
-    if (o.gait == "heel-toe" or o.contact_sequence is not None) and o.formulation != "full":
+    if (o.gait == "heel-toe" or o.contact_sequence is not None) and not traits.contact_sequences:
         raise GaitOptionsError("gait = 'heel-toe' and contact_sequence need formulation "
                                "'full'")
     if o.contact_sequence is not None:
@@ -433,16 +454,16 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
             sequence_from_dict(o.contact_sequence)
         except ContactSequenceError as exc:
             raise GaitOptionsError(str(exc)) from None
-    if o.gait == "run" and (o.formulation != "full" or o.single_support_fraction >= 1.0
+    if o.gait == "run" and (not traits.contact_sequences or o.single_support_fraction >= 1.0
                             or o.impulse):
         raise GaitOptionsError(
             "gait = 'run': needs formulation 'full', single_support_fraction < 1 (the stance "
             "share of the step) and impulse off (no liftoff impulse in a run)")
     flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
-    if o.formulation == "full" and not 0.0 <= flex < 1.5:
+    if traits.straight_stance_knee and not 0.0 <= flex < 1.5:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in [0, 1.5) "
                                "(full formulation)")
-    if o.formulation == "reduced" and not 0.0 < flex < 1.5:
+    if not traits.straight_stance_knee and not 0.0 < flex < 1.5:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in (0, 1.5) "
                                "in the reduced formulation (its leg inverse kinematics is "
                                "singular at a straight knee; formulation 'full' allows 0)")

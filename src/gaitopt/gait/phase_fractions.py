@@ -116,6 +116,24 @@ def with_free_fractions(seq: ContactSequence, factor: float = FREE_FRACTION_FACT
     return dataclasses.replace(seq, phases=phases)
 
 
+def with_shares(seq: ContactSequence, shares: Sequence[float]) -> ContactSequence:
+    """``seq`` with each free phase's first guess set to its share in ``shares`` (one per
+    phase, clipped to the phase's bounds; fixed phases keep theirs): the shares a solve found,
+    which the knots per phase then follow (``GaitOptions.phase_shares``).
+
+    Raises:
+        ContactSequenceError: not one share per phase.
+    """
+    if len(shares) != len(seq.phases):
+        raise ContactSequenceError(f"phase_shares: {len(shares)} share(s) for the "
+                                   f"{len(seq.phases)} phases of sequence {seq.name!r}")
+    phases = tuple(dataclasses.replace(ph, fraction=min(max(float(s), ph.bounds[0]),
+                                                          ph.bounds[1]))
+                   if ph.bounds is not None else ph
+                   for ph, s in zip(seq.phases, shares, strict=True))
+    return dataclasses.replace(seq, phases=phases)
+
+
 def with_first_fraction_bounds(seq: ContactSequence, bounds: tuple[float, float]
                                ) -> ContactSequence:
     """A two-phase ``seq`` with phase 0's fraction ``f`` free within ``bounds`` (phase 1

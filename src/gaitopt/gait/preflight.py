@@ -37,7 +37,9 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from gaitopt.dynamics.kinematics import contact_position, point_position
 from gaitopt.gait.model_defaults import legs_contacts
+from gaitopt.gait.model_scale import leg_length
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 
@@ -117,8 +119,6 @@ class _Points:
 
     def __init__(self, model: RobotModel) -> None:
         import casadi as ca
-
-        from gaitopt.dynamics.kinematics import contact_position, point_position
 
         q = ca.SX.sym("q", model.nq)
         rows = [contact_position(model, q, c.name) for c in model.contacts]
@@ -282,8 +282,6 @@ def unplaceable_step(model: RobotModel, torso: tuple[float, float],
 
 @functools.lru_cache(maxsize=32)
 def _preflight(model: RobotModel, torso: tuple[float, float]) -> tuple[str, ...]:
-    from gaitopt.gait.model_scale import leg_length
-
     problems = unactuated_joints(model) + unreachable_ground(model, torso)
     if problems:
         return tuple(problems)

@@ -29,6 +29,7 @@ import casadi as ca
 import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
+from gaitopt.dynamics.kinematics import contact_velocity, point_position
 from gaitopt.gait import cost, walking
 from gaitopt.gait.model_scale import ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions
@@ -226,6 +227,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         return {n: bounds[n] for n in names}
 
     paper_cost = options.cost == "paper" and options.cost_regularization == 0.0
+    rate_weights = cost.torque_rate_weights(model, options)
 
     def running(point: Callable[[Any, Any, Any], walking.PhasePoint],
                 controls: Sequence[str]) -> Callable[[Any, Any, Any, Any], Any]:
@@ -272,6 +274,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
         duration=Duration.of_parameters(lambda p: f * p[_L] / p[_V]),
         state_bounds=state_bounds(ss_states), control_bounds=control_bounds(ss_controls),
         path_constraints=ss_path, lagrange=running(ss, ss_controls),
+        control_rate_weights={n: r for n, r in rate_weights.items() if n in ss_controls},
         intervals=options.knots[0] - 1)
 
     phases = [phase1]
@@ -281,7 +284,6 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
     def landing(ends: Mapping[str, Any], p: Any) -> Any:
         q, _ = walking.single_support_to_full(model, ends[SINGLE].xf)
         c = model.contact(swing.contact)
-        from gaitopt.dynamics.kinematics import point_position
 
         tip = as_scalars(point_position(model, q, c.link, model.link(c.link).local_point(*c.at)),
                          2, "tip")
@@ -352,6 +354,7 @@ def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
             duration=Duration.of_parameters(lambda p: (1.0 - f) * p[_L] / p[_V]),
             state_bounds=state_bounds(ds_states), control_bounds=control_bounds(ds_controls),
             path_constraints=ds_path, lagrange=running(ds, ds_controls),
+            control_rate_weights={n: r for n, r in rate_weights.items() if n in ds_controls},
             intervals=options.knots[1] - 1)
         phases.append(phase2)
 
@@ -413,7 +416,6 @@ def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition
                  magnitude: Any) -> Any:
     """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
     lifting = reduced_biped(model).stance.contact
-    from gaitopt.dynamics.kinematics import contact_velocity
 
     v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
     return cost.impulse_cost(model, options, tr.impulses[lifting], v_after, magnitude)

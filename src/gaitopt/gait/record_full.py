@@ -22,8 +22,10 @@ from gaitopt.dynamics.backend import as_scalars
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait import full_physics as full
 from gaitopt.gait.contact_sequence import ContactSequence
+from gaitopt.gait.function_cache import disk_cached, function_file
 from gaitopt.gait.gait_file import GaitEvent, GaitPhase, GaitSamples
-from gaitopt.gait.transcriptions import disk_cached, function_file
+from gaitopt.gait.record_points import SAMPLE_RATE, RecordParts, point_names, points_function
+from gaitopt.gait.solution import WalkingSolution
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -133,3 +135,17 @@ def full_samples(model: RobotModel, res: Any, count: int,
     pts = pts.T.reshape(count, len(point_names), 2)
     points = {name: pts[:, j, :] for j, name in enumerate(point_names)}
     return GaitSamples(t=t, q=q, qd=qd, u=u, points=points)
+
+
+def full_record(solution: WalkingSolution, seq: ContactSequence) -> RecordParts:
+    """The phases, events and samples of a full-coordinate solution on its contact sequence
+    ``seq``."""
+    model, res = solution.model, solution.result
+    step = res.parameters["step_length"]
+    # IPOPT may end a hair outside a bound (its bound_relax_factor): the impulse is >= 0.
+    impulse = max(res.parameters["impulse"], 0.0)
+    total = sum(ph.duration for ph in res.phases)
+    count = max(101, int(np.ceil(total * SAMPLE_RATE)) + 1)
+    phases, events = full_phases_and_events(model, seq, res, step, impulse)
+    samples = full_samples(model, res, count, points_function(model), point_names(model))
+    return RecordParts(phases, events, samples)

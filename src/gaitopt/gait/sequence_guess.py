@@ -30,13 +30,19 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.dynamics.reduced import ReachError
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.contact_sequence import ContactSequence
-from gaitopt.gait.guess import Array, PhaseGuess, WalkingGuess, _knots, _phase_guess, _smoothstep
+from gaitopt.gait.guess import (
+    Array,
+    PhaseGuess,
+    WalkingGuess,
+    knot_times,
+    phase_guess,
+    smoothstep,
+)
 from gaitopt.gait.model_scale import model_scale
 from gaitopt.robot.model import BASE_ANGLE, BASE_X, BASE_Y, RobotModel
 
@@ -106,7 +112,7 @@ def _target(rows: list[tuple[float, float, float | None]], t: float, lift: float
         return None
     (_, ta, xa), (tb, _, xb) = before[-1], after[0]
     s = (t - ta) / (tb - ta)
-    x = None if xa is None or xb is None else xa + (xb - xa) * float(_smoothstep(np.array(s)))
+    x = None if xa is None or xb is None else xa + (xb - xa) * float(smoothstep(np.array(s)))
     return x, lift * float(np.sin(np.pi * s)), W_SWING
 
 
@@ -135,6 +141,10 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     knots of phase ``i`` are ``knots[min(i, 1)]``, as in the full-coordinate problem) over
     its period ``seq.steps L / v``; ``swap``: the contact renaming from the end of the period
     to its start (:meth:`ContactSequence.period_contacts` applies: none for a stride)."""
+    # Imported here: SciPy's optimizer takes 0.8 s to import, and the paper's walk, which
+    # imports this module with the staged solve, never calls it.
+    from scipy.optimize import least_squares
+
     use_ankles = ankle if ankle_torques is None else ankle_torques and ankle
     v, step = speed, step_length
     swap = seq.period_contacts(swap)
@@ -187,8 +197,8 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
             q_fine[k] = q
             _check_placed(model, ph.name, float(t), q, targets, step)
         count = knots[min(i, 1)]
-        phases.append(_phase_guess(model, ph.name, t_fine, q_fine,
-                                   _knots(float(ends[i]), float(ends[i + 1] - ends[i]), count),
-                                   ankle, use_ankles, list(ph.held), True))
+        phases.append(phase_guess(model, ph.name, t_fine, q_fine,
+                                  knot_times(float(ends[i]), float(ends[i + 1] - ends[i]), count),
+                                  ankle, use_ankles, list(ph.held), True))
     return WalkingGuess(phases=tuple(phases),
                         parameters={"step_length": step, "speed": v, "impulse": 0.0})

@@ -67,18 +67,19 @@ import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
 from gaitopt.gait.check_grid import check_knots
-from gaitopt.gait.formulation import biped_for, checked_sequence, contact_sequence, stage_bounds
-from gaitopt.gait.full_physics import period_map
+from gaitopt.gait.formulation import (
+    biped_for,
+    checked_sequence,
+    formulation_of,
+    stage_bounds,
+)
 from gaitopt.gait.guess import (
     default_running_step,
     default_step_length,
-    naive_guess,
-    naive_running_guess,
 )
 from gaitopt.gait.model_defaults import default_gait, default_speed, options_for_model
 from gaitopt.gait.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
-from gaitopt.gait.phase_fractions import fraction_parameters
 from gaitopt.gait.problem import (
     FRACTION,
     IMPULSE,
@@ -198,9 +199,7 @@ class _Run:
         #: Naive starts no leg could reach: (step length m, longest leg reach m, why).
         self.unplaced: list[tuple[float, float, str]] = []
         #: The free phase fractions' parameters -> first guesses (held by the cold stages).
-        self.fractions = ({fp.name: fp.guess for fp in
-                           fraction_parameters(contact_sequence(model, options))}
-                          if options.formulation == "full" else {})
+        self.fractions = formulation_of(options).fraction_guesses(model, options)
 
     def stage(self, name: str, knots: Grid, relax: Relaxation,
               guess: Guess | Result | WarmStart, bounds: dict[str, Any], *,
@@ -258,9 +257,8 @@ class _Run:
         """The converged results of :meth:`cold`'s naive guesses: the first one, or with
         ``every_start`` all of them."""
         o, coarse = self.options, coarse_knots(self.options)
-        biped = biped_for(self.model, o)
-        generic = (biped is None or o.gait == "heel-toe" or o.contact_sequence is not None
-                   or o.stride)
+        formulation = formulation_of(o)
+        biped = formulation.biped(self.model)
         r_max = (0.0 if biped is None else
                  min(leg.reach(-o.min_stance_knee_flexion) for leg in biped.legs))
         held = {spec.frees for spec in RELEASES if spec.frees and spec.runs(o)}
@@ -276,26 +274,8 @@ class _Run:
         found: list[Result] = []
         for step0 in steps:
             try:
-                if generic:
-                    # Imported here: it needs SciPy's optimizer (0.8 s to import), which the
-                    # paper's walk never uses.
-                    from gaitopt.gait.sequence_guess import sequence_guess
-
-                    seq = contact_sequence(self.model, o)
-                    guess = sequence_guess(self.model, seq,
-                                           period_map(self.model, seq).contacts, speed=speed,
-                                           step_length=step0, knots=coarse, ankle=o.ankle,
-                                           ankle_torques=False)
-                elif o.gait == "run":
-                    guess = naive_running_guess(
-                        self.model, speed=speed, step_length=step0,
-                        stance_fraction=o.single_support_fraction, knots=coarse,
-                        ankle=o.ankle, r_max=r_max, ankle_torques=False)
-                else:
-                    guess = naive_guess(self.model, speed=speed, step_length=step0,
-                                        single_support_fraction=o.single_support_fraction,
-                                        knots=coarse, ankle=o.ankle, r_max=r_max,
-                                        ankle_torques=False, full=o.formulation == "full")
+                guess = formulation.cold_guess(self.model, o, speed=speed, step_length=step0,
+                                               knots=coarse, r_max=r_max)
             except ReachError as exc:  # this start puts a leg beyond its reach: the next
                 self.unplaced.append((step0, r_max, str(exc)))
                 continue

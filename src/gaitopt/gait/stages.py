@@ -15,7 +15,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from gaitopt.gait.contact_sequence import sequence_from_dict
+from gaitopt.gait.formulation import formulation_of
 from gaitopt.gait.options import GaitOptions
+from gaitopt.gait.phase_fractions import free_phases
 from gaitopt.gait.problem import FRACTION, IMPULSE, SPEED, Relaxation, parameter_bounds
 from gaitopt.ocp import Bounds, Result, Transcription
 from gaitopt.robot.model import RobotModel
@@ -97,7 +100,8 @@ def fine_stage_options(options: GaitOptions) -> dict[str, Any]:
     the separated form, whose derivatives are assembled from compiled point functions
     (:func:`gaitopt.gait.transcriptions.evaluation_mode`): its exact Hessian costs no
     derivation of the whole NLP (at 40 + 10: 38 + 18 iterations against 99 + 25)."""
-    if options.formulation != "reduced" or options.transcription == "hermite-simpson-separated":
+    if (not formulation_of(options).traits.quasi_newton_fine_stages
+            or options.transcription == "hermite-simpson-separated"):
         return {}
     return dict(FINE_STAGE_OPTIONS)
 
@@ -134,7 +138,7 @@ def fine_grid_options(options: GaitOptions) -> dict[str, Any]:
     :data:`FULL_WALK_FINE_GRID_OPTIONS`; none for other contact sequences."""
     if sequence_kind(options) != "walk":
         return {}
-    if options.formulation == "full":
+    if formulation_of(options).traits.unscaled_mumps_fine_walk:
         return {**WALK_FINE_GRID_OPTIONS, **FULL_WALK_FINE_GRID_OPTIONS}
     return dict(WALK_FINE_GRID_OPTIONS)
 
@@ -207,7 +211,7 @@ class StageSpec:
 CONTACT_STAGES: tuple[StageSpec, ...] = (
     StageSpec("relaxed contact", relax=RELAXED, solver_options=COLD_START_OPTIONS),
     StageSpec("enforced contact", warm_start_options=lambda o: (
-        ENFORCED_CONTACT_OPTIONS if o.formulation == "full" else None)),
+        ENFORCED_CONTACT_OPTIONS if formulation_of(o).traits.warm_enforced_contact else None)),
 )
 #: Stage 3: what the contact stages held, freed one at a time in this order (the impulse
 #: from the no-impulse gait keeps the impulse variants out of worse local minima).
@@ -238,9 +242,6 @@ def frees_fractions(options: GaitOptions) -> bool:
         return True
     if options.contact_sequence is None:
         return False
-    from gaitopt.gait.contact_sequence import sequence_from_dict
-    from gaitopt.gait.phase_fractions import free_phases
-
     return bool(free_phases(sequence_from_dict(options.contact_sequence)))
 
 

@@ -12,22 +12,19 @@ normalised knot times in [0, 1] per phase of the problem (a refined mesh).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import functools
-import hashlib
-import pickle
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import casadi as ca
 import numpy as np
 
-from gaitopt import codegen
-from gaitopt.fileio import write_bytes_atomic
 from gaitopt.gait.formulation import problem_for
+from gaitopt.gait.function_cache import cached_functions as cached_functions
+from gaitopt.gait.function_cache import disk_cached as disk_cached
+from gaitopt.gait.function_cache import function_file as function_file
+from gaitopt.gait.function_cache import save_functions as save_functions
+from gaitopt.gait.function_cache import source_hash as source_hash
 from gaitopt.gait.options import GaitOptions, GaitOptionsError
 from gaitopt.ocp import Guess, Result, Transcription, WarmStart, transcribe
 from gaitopt.process_memory import memory_budget_bytes, release_freed_memory, resident_bytes
@@ -127,62 +124,12 @@ def evaluation_mode(options: GaitOptions, compiled: str | None) -> str | None:
 FUNCTIONS_FORMAT = "gaitopt-walking-functions-1"
 
 
-@functools.cache
-def source_hash() -> str:
-    """A hash of every Python file of the installed gaitopt package: the symbolic functions
-    cached on disk are those this code builds."""
-    root = Path(__file__).resolve().parents[1]
-    digest = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
-    return digest.hexdigest()[:20]
-
-
 def functions_file(key: NlpStructure) -> Path:
     """Where the symbolic functions (``Transcription.functions``) of the problem of the
     structure ``key`` are cached on disk: keyed by the model, every shaping option, the
     gaitopt sources and CasADi's version, not the grid or the evaluation mode."""
     return function_file("walking-functions",
                          (FUNCTIONS_FORMAT, key.model_hash, key.step_time_row, key.options))
-
-
-def cached_functions(path: Path) -> Any:
-    """The functions pickled at ``path``, or None (missing, unreadable or stale: rebuilt)."""
-    try:
-        functions = pickle.loads(path.read_bytes())
-    except Exception:  # noqa: BLE001 - any unreadable cache file is rebuilt and replaced
-        return None
-    codegen.mark_used(path)
-    return functions
-
-
-def save_functions(path: Path, functions: Any) -> None:
-    """Pickle ``functions`` to the cache file ``path`` atomically, then bound the cache's
-    size (:func:`gaitopt.codegen.prune_cache`); a read-only or full disk only costs the
-    build next time."""
-    with contextlib.suppress(OSError):
-        write_bytes_atomic(path, pickle.dumps(functions))
-        codegen.prune_cache()
-
-
-def function_file(kind: str, key: tuple[Any, ...]) -> Path:
-    """Where a symbolic function of ``kind`` (a file-name prefix) built from ``key`` is cached
-    on disk: keyed by ``kind``, ``key`` (its repr: model hashes, names), the gaitopt sources
-    and CasADi's version, as the walking problem's functions (:func:`functions_file`)."""
-    text = repr((kind, source_hash(), ca.CasadiMeta.version(), key))
-    name = hashlib.sha256(text.encode()).hexdigest()[:24]
-    return codegen.cache_dir() / f"{kind}-{name}.pickle"
-
-
-def disk_cached(path: Path, build: Callable[[], ca.Function]) -> ca.Function:
-    """The CasADi function pickled at ``path`` (:func:`function_file`), or ``build()``
-    saved there atomically (a read-only or full cache only costs the build next time)."""
-    cached = cached_functions(path)
-    if isinstance(cached, ca.Function):
-        return cached
-    fn = build()
-    save_functions(path, fn)
-    return fn
 
 
 def transcription_for(model: RobotModel, options: GaitOptions, knots: Grid, *,

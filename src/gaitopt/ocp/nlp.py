@@ -38,7 +38,7 @@ from gaitopt.ocp.functions import (
 from gaitopt.ocp.layout import ConstraintBlock, ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.mesh import Mesh
 from gaitopt.ocp.method import Method, midpoint_control
-from gaitopt.ocp.problem import Problem
+from gaitopt.ocp.problem import Phase, Problem
 
 Array = NDArray[np.float64]
 
@@ -139,6 +139,10 @@ class IntervalInputs:
     (``f_m``, ``l_m`` None where the method has no midpoints), the phase duration ``T``, and
     ``dtau`` (1, N), the normalised interval lengths (constants: h = T dtau).
 
+    ``u_k, u_k1`` (m, N) are the knot controls and ``rates`` the weights of the control-rate
+    term (:attr:`~gaitopt.ocp.problem.Phase.control_rate_weights`, a constant (m, 1); None
+    without the term, and then the controls are not read).
+
     ``t_source`` (s, 1) and ``t_of`` give the duration as a function of a few entries of w:
     ``t_of(t_source)`` is ``T`` (the duration variable itself, the parameters of a duration
     expression, or nothing for a fixed duration), so that the terms of one interval are a
@@ -159,19 +163,26 @@ class IntervalInputs:
     dtau: ca.DM
     t_source: Any
     t_of: Callable[[Any], Any]
+    u_k: Any = None
+    u_k1: Any = None
+    rates: ca.DM | None = None
 
 
 def interval_terms(inp: IntervalInputs, T: Any, dtau: Any) -> tuple[Any, Any, Any]:
     """The defects (n, N), the midpoint defects (n, N; None without midpoint variables) and
-    the quadrature of the integrand (1, N) of the intervals of ``inp``, with duration ``T``
-    and normalised interval lengths ``dtau`` (1, N)."""
+    the cost of each interval (1, N): the quadrature of the integrand plus the control-rate
+    term, for the intervals of ``inp`` with duration ``T`` and normalised interval lengths
+    ``dtau`` (1, N)."""
     h = T * dtau
     Hn = ca.repmat(h, int(inp.x_k.shape[0]), 1)
     method = inp.method
     mid_defects = (None if inp.xm is None else
                    inp.xm - method.midpoint_state(inp.x_k, inp.x_k1, inp.f_k, inp.f_k1, Hn))
     defects = method.defects(inp.x_k, inp.x_k1, inp.f_k, inp.f_k1, inp.f_m, Hn)
-    return defects, mid_defects, method.quadrature(inp.l_k, inp.l_k1, inp.l_m, h)
+    cost = method.quadrature(inp.l_k, inp.l_k1, inp.l_m, h)
+    if inp.rates is not None:
+        cost = cost + control_rates(inp.rates, inp.u_k, inp.u_k1, h)
+    return defects, mid_defects, cost
 
 
 #: How the terms of a phase's intervals are evaluated: ``(i, inputs) -> (defects,
@@ -308,7 +319,7 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
             f_m, Cm, L_m = point_calls(i, pf.point, Xm, Um, p, tm)
         defects, mid_defects, quadrature = interval_calls(i, IntervalInputs(
             method, x_k, x_k1, x_mid, f_k, f_k1, f_m, L[:, :-1], L[:, 1:], L_m, T, dtau,
-            t_source, t_of))
+            t_source, t_of, U[:, :-1], U[:, 1:], rate_weights(ph)))
         dx = state_scales[i]
         rows.add(f"{ph.name}/defects", ph.name, "defects", flat(defects), (N, n),
                  np.zeros(N * n), np.zeros(N * n), np.tile(dx, N))
@@ -371,6 +382,30 @@ def _itself(x: Any) -> Any:
 
 def _constant(sym: Any, value: float, _: Any) -> Any:
     return sym(value)
+
+
+def control_rate_term(phase: Phase, U: Any, h: Any) -> Any:
+    """``sum_j r_j sum_k (U[j, k+1] - U[j, k])^2 / h_k``: the exact ``sum_j r_j int u_j'^2 dt``
+    of the piecewise-linear controls ``U`` (m, K) on intervals ``h`` (1, K - 1)
+    (:attr:`~gaitopt.ocp.problem.Phase.control_rate_weights`); 0 without weights."""
+    r = rate_weights(phase)
+    if r is None or U.shape[1] < 2:
+        return 0.0
+    return ca.sum2(control_rates(r, U[:, :-1], U[:, 1:], h))
+
+
+def rate_weights(phase: Phase) -> ca.DM | None:
+    """The weights of the control-rate term by control (m, 1), None without weights."""
+    weights = phase.control_rate_weights
+    if not weights:
+        return None
+    return ca.DM([float(weights.get(name, 0.0)) for name in phase.controls])
+
+
+def control_rates(r: ca.DM, u_k: Any, u_k1: Any, h: Any) -> Any:
+    """The control-rate term of each interval, ``r^T (u_k1 - u_k)^2 / h`` (1, N)."""
+    dU = u_k1 - u_k
+    return ca.mtimes(r.T, dU * dU) / h
 
 
 def _folded_knots(i: int, pf: PhaseFunction, pl: PhaseLayout, X: Any, U: Any, p: Any,

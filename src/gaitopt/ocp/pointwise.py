@@ -265,8 +265,9 @@ class PointRecorder:
         one interval is :func:`interval_template`."""
         n, N = int(inp.x_k.shape[0]), int(inp.x_k.shape[1])
         template = interval_template(inp)
+        controls = (inp.u_k, inp.u_k1) if inp.rates is not None else (None, None)
         v = ca.vertcat(*[c for c in (inp.x_k, inp.x_k1, inp.xm, inp.f_k, inp.f_k1, inp.f_m,
-                                     inp.l_k, inp.l_k1, inp.l_m) if c is not None],
+                                     inp.l_k, inp.l_k1, inp.l_m, *controls) if c is not None],
                        ca.repmat(inp.t_source, 1, N))
         assert v.shape == (template.size1_in(0), N), (v.shape, template.size_in(0))
         nr = template.size1_out(0)
@@ -277,20 +278,25 @@ class PointRecorder:
 
 def interval_template(inp: IntervalInputs) -> ca.Function:
     """The terms of one interval of ``inp`` (:func:`gaitopt.ocp.nlp.interval_terms`) as a
-    function ``(v, dtau) -> [defects; midpoint defects; quadrature]`` of one column ``v =
-    [x_k; x_k1; xm; f_k; f_k1; f_m; l_k; l_k1; l_m; t_source]`` (the parts the method has)
-    and the normalised interval length: a function of the phase's sizes, the method and the
-    duration's form only, the same on every mesh."""
+    function ``(v, dtau) -> [defects; midpoint defects; cost]`` of one column ``v = [x_k;
+    x_k1; xm; f_k; f_k1; f_m; l_k; l_k1; l_m; u_k; u_k1; t_source]`` (the parts the method
+    and the cost have; the control-rate weights are constants of the template) and the
+    normalised interval length: a function of the phase's sizes, the method, the cost's
+    form and the duration's form only, the same on every mesh."""
     n, s = int(inp.x_k.shape[0]), int(inp.t_source.shape[0])
     mid = inp.f_m is not None
     names = ["x_k", "x_k1", *(["xm"] if inp.xm is not None else []), "f_k", "f_k1",
              *(["f_m"] if mid else [])]
     parts = {name: ca.SX.sym(name, n) for name in names}
     parts |= {name: ca.SX.sym(name) for name in ("l_k", "l_k1", *(["l_m"] if mid else []))}
+    if inp.rates is not None:
+        m = int(inp.rates.shape[0])
+        parts |= {name: ca.SX.sym(name, m) for name in ("u_k", "u_k1")}
     t_source, dtau = ca.SX.sym("t", s), ca.SX.sym("dtau")
     local = IntervalInputs(inp.method, parts["x_k"], parts["x_k1"], parts.get("xm"),
                            parts["f_k"], parts["f_k1"], parts.get("f_m"), parts["l_k"],
-                           parts["l_k1"], parts.get("l_m"), None, ca.DM(), t_source, inp.t_of)
+                           parts["l_k1"], parts.get("l_m"), None, ca.DM(), t_source, inp.t_of,
+                           parts.get("u_k"), parts.get("u_k1"), inp.rates)
     defects, mid_defects, quadrature = interval_terms(local, inp.t_of(t_source), dtau)
     out = ca.vertcat(defects, *([] if mid_defects is None else [mid_defects]), quadrature)
     v = ca.vertcat(*parts.values(), t_source)

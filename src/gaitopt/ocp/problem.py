@@ -3,7 +3,8 @@
 A problem is a sequence of phases run one after the other in time, static parameters ``p``
 shared by all phases, linkages between phase ends, boundary (event) constraints and costs::
 
-    minimise   J = (sum_i int_{phase i} L_i(x, u, p, t) dt + M(ends, p) + P(p)) / D(ends, p)
+    minimise   J = (sum_i int_{phase i} [L_i(x, u, p, t) + sum_j r_ij u_j'(t)^2] dt
+                    + M(ends, p) + P(p)) / D(ends, p)
     subject to x_i' = f_i(x_i, u_i, p, t)                  in every phase i
                c_lo <= c_i(x_i, u_i, p, t) <= c_hi          path constraints
                b_lo <= b(ends, p) <= b_hi                   boundary/event constraints
@@ -222,6 +223,11 @@ class Phase:
         initial_control / final_control: the same for controls.
         path_constraints: :class:`PathConstraint` list.
         lagrange: integrand ``L(x, u, p, t) -> SX scalar`` of the running cost.
+        control_rate_weights: weights ``r_j >= 0`` by control name of the control-rate term
+            ``r_j int u_j'(t)^2 dt`` of the cost's numerator (units of the numerator per
+            (control unit / s)^2 s). The controls are piecewise linear between knots, so the
+            term is exactly ``r_j sum_k (u_j[k+1] - u_j[k])^2 / h_k`` over the phase's
+            intervals; a jump between phases is not counted.
         state_scales / control_scales: variable scales by name (default from bounds).
         intervals: default number of mesh intervals (a transcription may override it).
         knot_states: states given by the others at every knot after the first
@@ -241,6 +247,7 @@ class Phase:
     final_control: Mapping[str, Bound | float] = field(default_factory=dict)
     path_constraints: Sequence[PathConstraint] = ()
     lagrange: PointFn | None = None
+    control_rate_weights: Mapping[str, float] = field(default_factory=dict)
     state_scales: Mapping[str, float] = field(default_factory=dict)
     control_scales: Mapping[str, float] = field(default_factory=dict)
     intervals: int = 20

@@ -66,6 +66,11 @@ def check_phase(phase: Phase) -> None:
     _check_bounds(phase.final_state, phase.states, f"{where} final_state")
     _check_bounds(phase.initial_control, phase.controls, f"{where} initial_control")
     _check_bounds(phase.final_control, phase.controls, f"{where} final_control")
+    _check_names(phase.control_rate_weights, phase.controls, f"{where} control_rate_weights")
+    for name, r in phase.control_rate_weights.items():
+        if not (r >= 0 and math.isfinite(r)):
+            raise ProblemError(f"{where}: control_rate_weights[{name!r}] = {r!r}: must be "
+                               "finite and >= 0")
     _check_names(phase.state_scales, phase.states, f"{where} state_scales")
     _check_names(phase.control_scales, phase.controls, f"{where} control_scales")
     for name, s in {**phase.state_scales, **phase.control_scales}.items():

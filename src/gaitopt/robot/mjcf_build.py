@@ -17,16 +17,23 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.robot.errors import ModelError
-from gaitopt.robot.mjcf import UNLIMITED, CoordinateMap, MjcfImport
+from gaitopt.robot.mjcf_contacts import contact_points
+from gaitopt.robot.mjcf_result import UNLIMITED, CoordinateMap, MjcfImport
 from gaitopt.robot.model import BASE_ANGLE, BASE_COORDINATES
 from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf import ContactSpec
 from gaitopt.robot.urdf_assumptions import declare_foot_symmetry, symmetry_note
-from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP, direction_and_length, link_point
+from gaitopt.robot.urdf_plane import (
+    AXIS_TOL,
+    IN_PLANE_ROWS,
+    NORMAL,
+    SNAP,
+    direction_and_length,
+    link_point,
+)
 
 Vec = NDArray[np.float64]
 #: Rows of a plane matrix: gaitopt x and y (the plane) and z (its normal), as MuJoCo vectors.
-IN_PLANE_ROWS, NORMAL = slice(0, 2), 2
 #: The number of base coordinates (x, y, angle) at the start of q.
 N_BASE = len(BASE_COORDINATES)
 #: For each common hinge axis, the MuJoCo axes of gaitopt x and y: the base slides' axes.
@@ -244,8 +251,6 @@ class Builder:
         if len(coords) != m.nv:
             raise self.fail("", m.nv, f"{len(coords)} degrees of freedom (those of the robot)",
                             problem=f"{m.nv - len(coords)} degrees of freedom outside it")
-        from gaitopt.robot.mjcf_contacts import contact_points
-
         contacts = contact_points(self, links, link_of, specs, name)
         data = self.to_dict(links, contacts, name)
         data["actuators"] = self.actuators(links, cmap)

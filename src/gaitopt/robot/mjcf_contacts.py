@@ -25,10 +25,9 @@ import numpy as np
 
 from gaitopt.robot.contact_inference import Capsule, Circle, Rectangle, Shape, infer_contacts
 from gaitopt.robot.errors import ModelError
-from gaitopt.robot.mjcf_build import IN_PLANE_ROWS, NORMAL
 from gaitopt.robot.schema import model_from_dict
 from gaitopt.robot.urdf import ContactSpec
-from gaitopt.robot.urdf_plane import AXIS_TOL, SNAP
+from gaitopt.robot.urdf_plane import AXIS_TOL, IN_PLANE_ROWS, NORMAL, SNAP
 
 #: A capsule's or cylinder's axis is its frame's z axis (MuJoCo's convention).
 GEOM_AXIS = 2

@@ -160,7 +160,7 @@ def mjcf_from_model(model: RobotModel, *, contact: MjcfContact | None = None) ->
                                  pos=_xyz(parent.local_point(*link.joint.at)))
             ET.SubElement(body, "joint", name=link.joint.name, type="hinge", axis="0 -1 0",
                           range=_nums(link.joint.limits), limited="true", armature="0",
-                          damping="0")
+                          damping=_num(link.joint.damping))
         bodies[link.name] = body
         ixx, izz = _out_of_plane(link)
         ET.SubElement(body, "inertial", pos=_xyz(link.com_local), mass=_num(link.mass),

@@ -55,12 +55,15 @@ class Joint:
     ``at`` is the joint position on the parent as ``(along, across)`` in metres (see the module
     docstring); ``limits`` are the joint angle bounds in radians, ``lower <= upper``; ``-inf``
     (lower) or ``inf`` (upper) is no bound (a continuous joint has both; a model file writes
-    them ``null``).
+    them ``null``). ``damping`` ``b >= 0`` (N m s/rad) is a passive viscous torque ``-b qd``
+    at the joint, which the dynamics include (:func:`gaitopt.dynamics.rnea.rnea`, the ABA, the
+    contact dynamics); the actuators' torques, and so the costs, do not.
     """
 
     name: str
     at: tuple[float, float]
     limits: tuple[float, float]
+    damping: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -224,6 +227,13 @@ class RobotModel:
         parent = self.links[i].parent
         return -1 if parent is None else self.link_index(parent)
 
+    @property
+    def coordinate_damping(self) -> tuple[float, ...]:
+        """``(nq,)``: each coordinate's joint damping ``b`` (N m s/rad; 0 on the base
+        coordinates), :attr:`Joint.damping`."""
+        return (0.0, 0.0, 0.0) + tuple(link.joint.damping if link.joint is not None else 0.0
+                                       for link in self.links[1:])
+
     def coordinate_of_link(self, i: int) -> int:
         """Index in ``q`` of the joint coordinate of link ``i >= 1`` (the base uses 0, 1, 2)."""
         return 2 if i == 0 else 2 + i
@@ -282,6 +292,8 @@ def model_to_dict(model: RobotModel) -> dict[str, Any]:
             entry["joint"] = {"name": link.joint.name, "at": list(link.joint.at),
                               "limits": [x if math.isfinite(x) else None
                                          for x in link.joint.limits]}
+            if link.joint.damping:  # written only where set: older models keep their hash
+                entry["joint"]["damping"] = link.joint.damping
         entry.update({"direction": link.direction, "length": link.length, "mass": link.mass,
                       "com": list(link.com), "inertia": link.inertia})
         if link.shape is not None:

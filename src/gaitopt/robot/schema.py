@@ -14,7 +14,8 @@ rad, torques in N m, gravity in m/s^2. Points on a link are ``[along, across]`` 
     links:                    # the floating base first (parent: null), parents before children
       - {name, parent, direction: up|down, length, mass, com (default [length/2, 0]),
          inertia and/or shape: {type: ellipsoid, radius} | {type: rod},
-         joint: {name, at: [along, across] on the parent, limits: [lower, upper]}}  # not base
+         joint: {name, at: [along, across] on the parent, limits: [lower, upper],
+                 damping: b}}  # not base; damping optional (N m s/rad, default 0)
     contacts:                 # optional
       - {name, link, at (default [length, 0]: the link's far end)}
     actuators:                # optional; the controls u, in this order
@@ -50,6 +51,7 @@ from gaitopt.robot.model import (
     Shape,
     SymmetrySpec,
 )
+from gaitopt.robot.symmetry import SymmetryError, swap_matrices
 
 DEFAULT_GRAVITY: tuple[float, float] = (0.0, -9.81)
 
@@ -57,7 +59,8 @@ TOP_KEYS = ("format", "version", "name", "description", "gravity", "links", "con
             "actuators", "symmetry")
 SYMMETRY_KEYS = ("links", "contacts")
 LINK_KEYS = ("name", "parent", "joint", "direction", "length", "mass", "com", "inertia", "shape")
-JOINT_KEYS = ("name", "at", "limits")
+JOINT_KEYS = ("name", "at", "limits", "damping")
+JOINT_REQUIRED = ("name", "at", "limits")
 CONTACT_KEYS = ("name", "link", "at")
 ACTUATOR_KEYS = ("name", "joint", "contact", "limits")
 SHAPE_TYPES = ("ellipsoid", "rod")
@@ -114,8 +117,6 @@ class _Validator(FieldReader):
                            gravity=gravity, description=description, symmetry=symmetry)
         check_positive_definite(model, source=self.source)
         if symmetry is not None:
-            from gaitopt.robot.symmetry import SymmetryError, swap_matrices
-
             try:
                 swap_matrices(model)
             except SymmetryError as exc:
@@ -260,7 +261,7 @@ class _Validator(FieldReader):
         if raw is MISSING:
             raise self.fail(path, MISSING, "a joint {name, at, limits} on every link but the "
                             "floating base")
-        j = self.mapping(path, raw, JOINT_KEYS, JOINT_KEYS, "a joint")
+        j = self.mapping(path, raw, JOINT_KEYS, JOINT_REQUIRED, "a joint")
         name = self.name(f"{path}.name", j["name"])
         reserved = {"x", "y", base_name}
         if name in reserved:
@@ -269,8 +270,10 @@ class _Validator(FieldReader):
                             "coordinates of q)")
         self.unique(f"{path}.name", name, joint_names, "joint")
         at = self.pair(f"{path}.at", j["at"], "[along, across] in m on the parent link")
+        damping = (self.number(f"{path}.damping", j["damping"], "a number >= 0 (N m s/rad)",
+                               nonnegative=True) if "damping" in j else 0.0)
         return Joint(name=name, at=at, limits=self.bounds(f"{path}.limits", j["limits"], "rad",
-                                                          unbounded=True))
+                                                          unbounded=True), damping=damping)
 
     def shape(self, path: str, raw: Any) -> Shape:
         if not isinstance(raw, Mapping) or "type" not in raw:

@@ -312,8 +312,10 @@ class _Importer:
                 lo, hi = (j.limits if sign > 0 else (-j.limits[1] + 0.0, -j.limits[0] + 0.0))
                 at = self.in_plane(pos, exact_p)
                 bodies[k].points.append(at)
-                bodies.append(Body(j.child, k, {"name": j.name, "at": at, "limits": [lo, hi]},
-                                    effort=j.effort or 0.0))
+                joint: dict[str, Any] = {"name": j.name, "at": at, "limits": [lo, hi]}
+                if j.damping:
+                    joint["damping"] = j.damping
+                bodies.append(Body(j.child, k, joint, effort=j.effort or 0.0))
                 frame[j.child] = (len(bodies) - 1, rot, np.zeros(3), is_identity(rot))
             else:
                 raise self.r.fail(where, j.type, "revolute, continuous or fixed joints below "

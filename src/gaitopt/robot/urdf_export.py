@@ -77,6 +77,8 @@ def urdf_from_model(model: RobotModel) -> str:
         attrs = {} if continuous else {"lower": _num(lower), "upper": _num(upper)}  # or inf
         attrs.update(effort=_num(effort.get(link.joint.name, 0.0)), velocity="0.0")
         ET.SubElement(j, "limit", attrs)
+        if link.joint.damping:
+            ET.SubElement(j, "dynamics", damping=_num(link.joint.damping), friction="0.0")
     for c in model.contacts:
         robot.append(ET.Comment(f" gaitopt contact point {c.name!r} on {c.link!r} "))
         ET.SubElement(robot, "link", name=c.name)

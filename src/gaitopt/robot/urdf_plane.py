@@ -21,6 +21,8 @@ PLANE = {"y": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
          "x": np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])}
 #: Which URDF coordinates of a link frame a ``--contact`` point gives, for each common axis.
 IN_PLANE = {"y": (0, 2), "x": (1, 2)}
+#: The rows of a :data:`PLANE` matrix: the plane's x and y, and its normal (gaitopt z).
+IN_PLANE_ROWS, NORMAL = slice(0, 2), 2
 
 
 def is_identity(rot: np.ndarray) -> bool:

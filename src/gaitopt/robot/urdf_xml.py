@@ -68,6 +68,7 @@ class UJoint:
     axis: np.ndarray      # unit vector in the child frame
     limits: tuple[float, float] | None
     effort: float | None
+    damping: float = 0.0  # <dynamics damping>, N m s/rad
 
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
@@ -232,7 +233,15 @@ class Reader:
                             "on a revolute joint (or type continuous)", problem="missing")
         if kind == "continuous":
             limits = CONTINUOUS_LIMITS
-        return UJoint(name, kind, ends[0], ends[1], rot, pos, axis / norm, limits, effort)
+        damping = 0.0
+        dyn = elem.find("dynamics")
+        if dyn is not None:
+            damping = self.number(f"{where} dynamics damping", dyn.get("damping"), 0.0)
+            if damping < 0.0:
+                raise self.fail(f"{where} dynamics damping", damping,
+                                "a damping >= 0 (N m s/rad)")
+        return UJoint(name, kind, ends[0], ends[1], rot, pos, axis / norm, limits, effort,
+                      damping)
 
 
 

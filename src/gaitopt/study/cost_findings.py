@@ -31,6 +31,7 @@ from gaitopt.study.findings import (
     HUMAN_OPTIMAL_SPEED_M_MIN,
     HUMAN_STEP_LENGTH,
     SLOW_LIMIT_M_MIN,
+    VERDICT_WORDS,
     Finding,
     Findings,
 )
@@ -163,7 +164,6 @@ def ranked(rows: Sequence[CostRow]) -> list[CostRow]:
 
 def cost_findings_text(findings: Mapping[str, Findings]) -> str:
     """Plain text: per model, one paragraph per finding (verdict, claim, id; evidence)."""
-    from gaitopt.study.findings import VERDICT_WORDS
 
     lines = []
     for model, items in findings.items():

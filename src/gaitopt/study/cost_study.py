@@ -51,7 +51,7 @@ from typing import Any, Literal
 from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
 from gaitopt.gait.gait_file import Gait, GaitFileError
-from gaitopt.gait.options import KNOT_SPACINGS, Formulation, GaitOptions, KnotSpacing
+from gaitopt.gait.options import FORMULATIONS, KNOT_SPACINGS, Formulation, GaitOptions, KnotSpacing
 from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.cost_start import AUTO_START, StartChoice, auto_start_speed, given_start
@@ -217,9 +217,9 @@ class CostStudySpec:
         if self.swing_clearance is not None and not (math.isfinite(self.swing_clearance)
                                                      and self.swing_clearance >= 0.0):
             raise CostStudyError(f"swing clearance: {self.swing_clearance!r} m; allowed: >= 0")
-        if self.formulation not in ("auto", "reduced", "full"):
-            raise CostStudyError(f"formulation: {self.formulation!r}; allowed: auto, reduced, "
-                                 "full")
+        if self.formulation not in ("auto", *FORMULATIONS):
+            raise CostStudyError(f"formulation: {self.formulation!r}; allowed: "
+                                 f"{', '.join(('auto', *FORMULATIONS))}")
         if self.gait not in ("auto", "walk", "heel-toe"):
             raise CostStudyError(f"gait: {self.gait!r}; allowed: auto, walk, heel-toe")
         if self.variant not in VARIANTS:

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from gaitopt.gait.api import guess_from_gait
 from gaitopt.gait.gait_file import Gait, GaitFileError
 from gaitopt.gait.options import GaitOptions
 from gaitopt.gait.record import MotionOutOfReachError, gait_from_solution
@@ -127,8 +128,6 @@ def _warm_start(task: PointTask) -> tuple[Guess | Result | None, str]:
     if isinstance(task.warm, Result):
         return task.warm, "result"
     if isinstance(task.warm, SavedGait):
-        from gaitopt.gait.api import guess_from_gait
-
         try:
             gait = Gait.from_dict(json.loads(task.warm.text), source=task.warm.source)
             return guess_from_gait(gait), "file"

@@ -21,7 +21,7 @@ from PIL import Image
 
 from gaitopt.analysis.checks.samples import points_function
 from gaitopt.fileio import write_bytes_atomic
-from gaitopt.gait.record import point_names
+from gaitopt.gait.record_points import point_names
 from gaitopt.robot.model import RobotModel
 from gaitopt.viz.stick import draw_pose
 from gaitopt.viz.style import new_figure

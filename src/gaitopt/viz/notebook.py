@@ -2,8 +2,10 @@
 
 :class:`~gaitopt.gait.gait_file.Gait` calls these from ``_repr_html_`` (Jupyter shows the
 summary table when a gait is the value of a cell), :meth:`~gaitopt.gait.gait_file.Gait.plot`
-and :meth:`~gaitopt.gait.gait_file.Gait.animate`; the gait file module imports nothing from
-here until one of them is called.
+and :meth:`~gaitopt.gait.gait_file.Gait.animate`. The gait record sits below ``viz/`` and
+never imports this module: it finds it through :mod:`gaitopt.views` (this module is a
+:class:`~gaitopt.views.GaitViews`), where the front door installs its loader; nothing here is
+imported until a view is first asked for.
 """
 
 from __future__ import annotations

@@ -66,6 +66,8 @@ _SPECS = (
     CheckSpec("bounds.joints_knots", "joint limits at knots (excess)", "rad", 1e-6),
     CheckSpec("bounds.joints_samples", "joint limits between knots (excess)", "rad", 5e-2),
     CheckSpec("swing.clearance", "swing tip above ground (penetration)", "m", 5e-3),
+    CheckSpec("swing.reversals", "turns of the swing leg's distal joint (ankle) in one swing "
+              "(flapping)", "turns", 3.0),
     # The objective.
     CheckSpec("cost.recomputed", "cost recomputed from the file (relative)", "", 1e-6),
     # The solve's own accuracy.

@@ -37,7 +37,7 @@ from gaitopt.gait.contact_sequence import phase_holds
 from gaitopt.gait.full_physics import hold_axes
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.interpolation import phase_controls_at, phase_states_at
-from gaitopt.gait.record import point_names, sample_points
+from gaitopt.gait.record_points import point_names, sample_points
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
