@@ -32,11 +32,20 @@ mesh. They are generated as C once per point function and compiled into the disk
 :mod:`gaitopt.codegen` (keyed by a hash of the serialized point function, which determines
 the C, see :func:`library_key`: a changed model or problem compiles anew; an unchanged one
 loads in milliseconds) and mapped over the grid. Without a C compiler the same functions run
-in CasADi's virtual machine. The outer functions are SX functions, always interpreted; their
-derivatives are derived for every mesh, and keeping the dynamics, the event maps and the
-knot states out of them is what keeps that cheap (the five-link biped at 60 + 15 knots, full
-coordinates: 0.19-0.28 s per transcription against 0.49-0.57 s with the ends function and the
-knot states in them; ``docs/results/benchmarks-gait.md``).
+in CasADi's virtual machine.
+
+The outer functions are SX functions, always interpreted, and they are not derived for every
+mesh either: the terms of each interval (defects, midpoint defects, the quadrature of the
+integrand and the control-rate term) are recorded like the point outputs, as symbols ``R =
+r(v)`` of one interval's inputs ``v`` (a selection of w and of the point outputs, one column
+per interval), and the function ``r`` of one interval (:func:`interval_template`: a function
+of the phase's sizes, the method and the forms of the cost and the duration, not of the mesh)
+is derived once per process (:func:`interval_derivatives`) and mapped over the intervals.
+What remains of ``F, G`` is affine in ``Y`` and ``R`` apart from the ends' objective terms
+and the duration rows: its rows that select one entry (the interval terms, the path
+constraints, the linkages and boundary conditions, scaled) have a constant Jacobian, read off
+by evaluating them, and only the few others are differentiated for each mesh (see
+``_Outer``; ``docs/results/benchmarks-gait.md``, "Build time independent of the mesh").
 """
 
 from __future__ import annotations
@@ -414,7 +423,7 @@ def _selections(v: ca.SX, u: ca.SX) -> tuple[ca.DM, list[int]]:
 
 
 def _linear_jacobian(v: ca.SX, u: ca.SX) -> ca.SX:
-    """``jacobian(v, u)``, with the rows that select one entry of u (:func:`_selections`)
+    """``jacobian(v, u)``, with the rows that select one entry of u (``_selections``)
     read off by evaluation and only the others differentiated."""
     S, rest = _selections(v, u)
     if not rest:
@@ -447,12 +456,17 @@ class _Outer:
     templates, derived once per template (:func:`interval_derivatives`) and mapped over the
     intervals; what remains, ``F(w, Y, R)`` and ``G(w, Y, R)``, is affine in Y and R apart
     from the ends' objective terms (Mayer, parameter cost, denominator) and the duration
-    rows, and is derived for every mesh (cheap: no products of the mesh's variables). With
-    ``A = blockdiag(dr/dv) S`` and the residual Lagrangian ``L0(u, R)``, ``u = [w; Y]``::
+    rows: its rows that select one entry of ``(w, Y, R)`` have a constant Jacobian, read off by
+    evaluation (``_selections``), and only the other rows and ``F`` are differentiated
+    for each mesh (a few expressions of the ends and the parameters). With ``A =
+    blockdiag(dr/dv) S`` and the residual Lagrangian ``L0(u, R)``, ``u = [w; Y]``::
 
         G_u  = G0_u + G0_R A
         L_u  = L0_u + S^T (dr/dv)^T L0_R
         L_uu = L0_uu + L0_uR A + (L0_uR A)^T + A^T L0_RR A + S^T blockdiag(Hess_v(mu_R^T r)) S
+
+    The products are SX functions of the nonzeros of the mapped interval derivatives
+    (sparse products of constant selections: built for each mesh, not derived).
     """
 
     def __init__(self, assembly: Assembly, Y: ca.SX, intervals: list[_IntervalGroup]
@@ -479,7 +493,6 @@ class _Outer:
         nw, ny = self.nw, self.ny
         G_w, G_Y, G_R = G_u[:, :nw], G_u[:, nw:nw + ny], G_u[:, nw + ny:]
         self._g = ca.Function("outer_g", [w, Y, R], [G])
-        self._jac = ca.Function("outer_jac", [w, Y, R], [G, G_w, G_Y, G_R])
         # mu = L_Y from G_Y (sparse, G is affine in Y for collocation) rather than by reverse
         # AD of the whole Lagrangian, and L_wY as the transpose of d(mu)/dw: mu depends on few
         # entries of w (durations, parameters), where the Jacobian of the large gradient graph
@@ -493,14 +506,52 @@ class _Outer:
         J_rest_Y, J_rest_R = J_rest[:, nw:nw + ny], J_rest[:, nw + ny:]
         L_Y2 = ca.mtimes(J_rest_Y.T, lam_rest) + sigma * F_Y
         L_R2 = ca.mtimes(J_rest_R.T, lam_rest) + sigma * F_R
-        self._hess = ca.Function(
-            "outer_hess", [w, Y, R, sigma, lam],
-            [ca.hessian(curved, w)[0], ca.jacobian(L_Y2, w).T, ca.jacobian(L_Y2, Y), L_Y,
-             L_R, ca.jacobian(L_R2, w).T, ca.jacobian(L_R2, Y).T, ca.jacobian(L_R2, R)])
-        if self.intervals:
-            V = ca.vertcat(*[ca.vec(ig.v) for ig in self.intervals])
-            S = _selection(V, ca.vertcat(w, Y))
-            self.S, self.S_w, self.S_Y = S, S[:, :self.nw], S[:, self.nw:]
+        L_ww = ca.hessian(curved, w)[0]
+        L_wY, L_YY = ca.jacobian(L_Y2, w).T, ca.jacobian(L_Y2, Y)
+        L_wR, L_YR, L_RR = ca.jacobian(L_R2, w).T, ca.jacobian(L_R2, Y).T, ca.jacobian(L_R2, R)
+        if not self.intervals:
+            self._jac = ca.Function("outer_jac", [w, Y, R], [G, G_w, G_Y])
+            self._hess = ca.Function("outer_hess", [w, Y, R, sigma, lam],
+                                     [L_ww, L_wY, L_YY, L_Y])
+            return
+        self._mu = ca.Function("outer_mu", [w, Y, R, sigma, lam], [L_R])
+        V = ca.vertcat(*[ca.vec(ig.v) for ig in self.intervals])
+        S = _selection(V, ca.vertcat(w, Y))
+        self.S = S
+        S_w, S_Y = S[:, :nw], S[:, nw:]
+        # The chain rule through the interval templates as SX functions of the nonzeros of
+        # their mapped derivatives (sparse products, built, not derived: evaluated in one
+        # pass of the VM, as cheap as the outer functions of the whole mesh were).
+        BJ, bj = self._block_symbols("J", [d.jacobian.sparsity_out(1) for d in self.derivs])
+        self._jac = ca.Function("outer_jac", [w, Y, R, bj],
+                                [G, G_w + ca.mtimes([G_R, BJ, S_w]),
+                                 G_Y + ca.mtimes([G_R, BJ, S_Y])])
+        BJ, bj = self._block_symbols("J", [d.hessian.sparsity_out(0) for d in self.derivs])
+        BH, bh = self._block_symbols("H", [d.hessian.sparsity_out(2) for d in self.derivs])
+        grads = ca.SX.sym("g", int(V.shape[0]))
+        A_w, A_Y = ca.mtimes(BJ, S_w), ca.mtimes(BJ, S_Y)
+        cross_w = ca.mtimes(L_wR, A_w)
+        L_ww = L_ww + cross_w + cross_w.T + ca.mtimes([S_w.T, BH, S_w])
+        L_wY = (L_wY + ca.mtimes(L_wR, A_Y) + ca.mtimes(A_w.T, L_YR.T)
+                + ca.mtimes([S_w.T, BH, S_Y]))
+        cross_Y = ca.mtimes(L_YR, A_Y)
+        L_YY = L_YY + cross_Y + cross_Y.T + ca.mtimes([S_Y.T, BH, S_Y])
+        if L_RR.nnz() > 0:
+            L_ww = L_ww + ca.mtimes([A_w.T, L_RR, A_w])
+            L_wY = L_wY + ca.mtimes([A_w.T, L_RR, A_Y])
+            L_YY = L_YY + ca.mtimes([A_Y.T, L_RR, A_Y])
+        self._hess = ca.Function("outer_hess", [w, Y, R, sigma, lam, bj, bh, grads],
+                                 [L_ww, L_wY, L_YY, L_Y + ca.mtimes(S_Y.T, grads)])
+
+    def _block_symbols(self, name: str, blocks: list[ca.Sparsity]) -> tuple[ca.SX, ca.SX]:
+        """The block-diagonal matrix of the interval groups' blocks (N copies of each
+        group's block) as an SX matrix of symbols for its nonzeros, and those symbols (in
+        the order of the mapped outputs' nonzeros)."""
+        mats = [ca.diagcat(*[ca.DM(b, 1.0)] * int(ig.r.shape[1])).sparsity()
+                for b, ig in zip(blocks, self.intervals, strict=True)]
+        sp = ca.diagcat(*[ca.DM(m, 1.0) for m in mats]).sparsity()
+        nz = ca.SX.sym(name, sp.nnz())
+        return ca.SX(sp, nz), nz
 
     def _inputs(self, W: ca.MX, Yv: ca.MX) -> list[ca.MX]:
         """The inputs v (nv, N) of each interval group."""
@@ -526,49 +577,33 @@ class _Outer:
     def jacobian(self, W: ca.MX, Yv: ca.MX) -> tuple[ca.MX, ca.MX, ca.MX]:
         """(G, G_w, G_Y) at (W, Y)."""
         if not self.intervals:
-            G, G_w, G_Y, _ = self._jac(W, Yv, ca.MX(0, 1))
+            G, G_w, G_Y = self._jac(W, Yv, ca.MX(0, 1))
             return G, G_w, G_Y
         calls = [d.jacobian.map(int(ig.r.shape[1]))(v, ig.dtau)
                  for d, ig, v in zip(self.derivs, self.intervals, self._inputs(W, Yv),
                                      strict=True)]
         Rv = ca.vertcat(*[ca.vec(c[0]) for c in calls])
-        BJ = ca.diagcat(*[_block_diagonal(c[1], d.jacobian.sparsity_out(1), int(ig.r.shape[1]))
-                          for c, d, ig in zip(calls, self.derivs, self.intervals, strict=True)])
-        G, G_w, G_Y, G_R = self._jac(W, Yv, Rv)
-        return (G, G_w + ca.mtimes([G_R, BJ, self.S_w]), G_Y + ca.mtimes([G_R, BJ, self.S_Y]))
+        G, G_w, G_Y = self._jac(W, Yv, Rv, ca.vertcat(*[c[1].nz[:] for c in calls]))
+        return G, G_w, G_Y
 
     def hessian(self, W: ca.MX, Yv: ca.MX, S: ca.MX, Lam: ca.MX
                 ) -> tuple[ca.MX, ca.MX, ca.MX, ca.MX]:
         """(L_ww, L_wY, L_YY, L_Y) at (W, Y, sigma, lambda)."""
         if not self.intervals:
-            L_ww, L_wY, L_YY, L_Y, *_ = self._hess(W, Yv, ca.MX(0, 1), S, Lam)
+            L_ww, L_wY, L_YY, L_Y = self._hess(W, Yv, ca.MX(0, 1), S, Lam)
             return L_ww, L_wY, L_YY, L_Y
         Vs = self._inputs(W, Yv)
-        L_ww, L_wY, L_YY, L_Y, L_R, L_wR, L_YR, L_RR = self._hess(W, Yv, self._values(Vs), S,
-                                                                 Lam)
+        Rv = self._values(Vs)
+        L_R = self._mu(W, Yv, Rv, S, Lam)
         calls, pos = [], 0
         for d, ig, v in zip(self.derivs, self.intervals, Vs, strict=True):
             nr, N = int(ig.r.shape[0]), int(ig.r.shape[1])
             calls.append(d.hessian.map(N)(v, ig.dtau, ca.reshape(L_R[pos:pos + nr * N], nr, N)))
             pos += nr * N
-        BJ = ca.diagcat(*[_block_diagonal(c[0], d.hessian.sparsity_out(0), int(ig.r.shape[1]))
-                          for c, d, ig in zip(calls, self.derivs, self.intervals, strict=True)])
-        BH = ca.diagcat(*[_block_diagonal(c[2], d.hessian.sparsity_out(2), int(ig.r.shape[1]))
-                          for c, d, ig in zip(calls, self.derivs, self.intervals, strict=True)])
-        grads = ca.vertcat(*[ca.vec(c[1]) for c in calls])
-        A_w, A_Y = ca.mtimes(BJ, self.S_w), ca.mtimes(BJ, self.S_Y)
-        S_w, S_Y = self.S_w, self.S_Y
-        cross_w = ca.mtimes(L_wR, A_w)
-        L_ww = L_ww + cross_w + cross_w.T + ca.mtimes([S_w.T, BH, S_w])
-        L_wY = (L_wY + ca.mtimes(L_wR, A_Y) + ca.mtimes(A_w.T, L_YR.T)
-                + ca.mtimes([S_w.T, BH, S_Y]))
-        cross_Y = ca.mtimes(L_YR, A_Y)
-        L_YY = L_YY + cross_Y + cross_Y.T + ca.mtimes([S_Y.T, BH, S_Y])
-        if L_RR.nnz() > 0:
-            L_ww = L_ww + ca.mtimes([A_w.T, L_RR, A_w])
-            L_wY = L_wY + ca.mtimes([A_w.T, L_RR, A_Y])
-            L_YY = L_YY + ca.mtimes([A_Y.T, L_RR, A_Y])
-        return L_ww, L_wY, L_YY, L_Y + ca.mtimes(S_Y.T, grads)
+        L_ww, L_wY, L_YY, L_Y = self._hess(
+            W, Yv, Rv, S, Lam, ca.vertcat(*[c[0].nz[:] for c in calls]),
+            ca.vertcat(*[c[2].nz[:] for c in calls]), ca.vertcat(*[ca.vec(c[1]) for c in calls]))
+        return L_ww, L_wY, L_YY, L_Y
 
     def objective(self, F: ca.SX) -> ca.SX:
         """``F`` with the interval terms it reads (the quadrature) as SX expressions of w
@@ -588,7 +623,7 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool,
                     intervals: list[_IntervalGroup] | None = None) -> PointwiseNlp:
     """The exact derivative functions of the SX ``assembly`` whose point outputs are the
     recorded ``groups`` and whose interval terms are the recorded ``intervals`` (see the
-    module docstring and :class:`_Outer`)."""
+    module docstring and ``_Outer``)."""
     w = assembly.w_hat
     nw = int(w.shape[0])
     ng = int(assembly.g.shape[0])
