@@ -10,6 +10,8 @@ for this branch's sources and one for the reference revision's (``--reference``,
   same problem (the symbolic functions and the compiled point libraries loaded, as in a
   staged solve or a refinement round); best of ``--repeat``;
 * the peak resident memory of each measuring process (``process_memory``);
+* the solver functions' evaluation times on the finest mesh (ms per call at the naive
+  guess), since a cheaper build must not cost the iterations more;
 * with ``--solves``: whole ``gaitopt solve`` processes, new against reference: wall time,
   peak RSS, the cost and the iterations of every stage (the same NLP: the costs agree to the
   solver's accuracy and the iterations to rounding).
@@ -23,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -72,6 +75,24 @@ def child(model_name: str, meshes: list[tuple[int, int]], repeat: int) -> dict[s
             transcriptions._CACHE.clear()
             times.append(build(knots))
         out[f"{knots[0]}+{knots[1]}"] = min(times)
+    # The solver functions of the last mesh at its naive guess (ms per call, best of 5
+    # batches of 20): the evaluations an IPOPT iteration pays.
+    import numpy as np
+
+    tr = transcriptions.transcription_for(model, options, meshes[-1])
+    solver = tr.solver(tr.options)
+    w = tr.initial_guess() / tr.nlp.d_w
+    lam = np.ones(tr.nlp.lbg.size)
+    for kind in ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l"):
+        fn = solver.get_function(kind)
+        args = [w, []] + ([0.7, lam] if kind == "nlp_hess_l" else [])
+        best = math.inf
+        for _ in range(5):
+            start = time.perf_counter()
+            for _ in range(20):
+                fn(*args)
+            best = min(best, (time.perf_counter() - start) / 20)
+        out[kind] = 1e3 * best
     out["peak_rss_mb"] = peak_resident_bytes() / 2**20
     return out
 
@@ -113,6 +134,7 @@ def builds(variants: dict[str, Path], repeat: int) -> None:
     print("| model | mesh | reference build s | this branch build s | this / reference |")
     print("| --- | --- | --- | --- | --- |")
     peaks: dict[tuple[str, str], float] = {}
+    evaluations: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
     for model, meshes in MESHES.items():
         results = {}
         for name, src in variants.items():
@@ -123,6 +145,7 @@ def builds(variants: dict[str, Path], repeat: int) -> None:
             results[name] = json.loads(proc.stdout.strip().splitlines()[-1])
             peaks[(model, name)] = results[name]["peak_rss_mb"]
         ref, new = results["reference"], results["this branch"]
+        evaluations[model] = (ref, new)
         for key in ["warm-up", *[f"{a}+{b}" for a, b in meshes[1:]]]:
             label = f"{key} (first grid)" if key == "warm-up" else key
             print(f"| {model} | {label} | {ref[key]:.3f} | {new[key]:.3f} | "
@@ -133,6 +156,14 @@ def builds(variants: dict[str, Path], repeat: int) -> None:
     for model in MESHES:
         print(f"| {model} | {peaks[(model, 'reference')]:.0f} | "
               f"{peaks[(model, 'this branch')]:.0f} |")
+    print()
+    print("| model, mesh | function | reference ms | this branch ms | this / reference |")
+    print("| --- | --- | --- | --- | --- |")
+    for model, meshes in MESHES.items():
+        ref, new = evaluations[model]
+        for kind in ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l"):
+            print(f"| {model} {meshes[-1][0]}+{meshes[-1][1]} | `{kind}` | {ref[kind]:.3f} | "
+                  f"{new[kind]:.3f} | {new[kind] / ref[kind]:.2f} |")
 
 
 def solves(variants: dict[str, Path], repeat: int) -> None:

@@ -492,7 +492,8 @@ class _Outer:
         G_u = ca.SX(S_G) + ca.mtimes(place, J_rest) if rest else ca.SX(S_G)
         nw, ny = self.nw, self.ny
         G_w, G_Y, G_R = G_u[:, :nw], G_u[:, nw:nw + ny], G_u[:, nw + ny:]
-        self._g = ca.Function("outer_g", [w, Y, R], [G])
+        # g with the interval terms inlined (their values are small functions): one VM pass.
+        self._g = ca.Function("outer_g", [w, Y], [self._inlined(G, R)])
         # mu = L_Y from G_Y (sparse, G is affine in Y for collocation) rather than by reverse
         # AD of the whole Lagrangian, and L_wY as the transpose of d(mu)/dw: mu depends on few
         # entries of w (durations, parameters), where the Jacobian of the large gradient graph
@@ -571,8 +572,19 @@ class _Outer:
 
     def g(self, W: ca.MX, Yv: ca.MX) -> ca.MX:
         """G at (W, Y)."""
-        return self._g(W, Yv, self._values(self._inputs(W, Yv)) if self.intervals
-                       else ca.MX(0, 1))
+        return self._g(W, Yv)
+
+    def _inlined(self, expr: ca.SX, R: ca.SX) -> ca.SX:
+        """``expr`` with the interval terms it reads as SX expressions of w and the point
+        outputs (the interval templates inlined)."""
+        if not self.intervals:
+            return expr
+        read = sorted(set(ca.jacobian_sparsity(expr, R).get_col()))
+        if not read:
+            return expr
+        values = ca.vertcat(*[ca.vec(ig.template.map(int(ig.r.shape[1]))(ig.v, ig.dtau))
+                              for ig in self.intervals])
+        return ca.substitute(expr, R[read], values[read])
 
     def jacobian(self, W: ca.MX, Yv: ca.MX) -> tuple[ca.MX, ca.MX, ca.MX]:
         """(G, G_w, G_Y) at (W, Y)."""
@@ -606,17 +618,11 @@ class _Outer:
         return L_ww, L_wY, L_YY, L_Y
 
     def objective(self, F: ca.SX) -> ca.SX:
-        """``F`` with the interval terms it reads (the quadrature) as SX expressions of w
+        """``F`` with the interval terms it reads (the interval costs) as SX expressions of w
         and the point outputs (the interval templates inlined)."""
         if not self.intervals:
             return F
-        R = ca.vertcat(*[ca.vec(ig.r) for ig in self.intervals])
-        read = sorted(set(ca.jacobian_sparsity(F, R).get_col()))
-        if not read:
-            return F
-        values = ca.vertcat(*[ca.vec(ig.template.map(int(ig.r.shape[1]))(ig.v, ig.dtau))
-                              for ig in self.intervals])
-        return ca.substitute(F, R[read], values[read])
+        return self._inlined(F, ca.vertcat(*[ca.vec(ig.r) for ig in self.intervals]))
 
 
 def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool,
