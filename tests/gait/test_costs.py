@@ -101,3 +101,27 @@ def test_smoothing_ladder_divides_by_ten_down_to_the_request() -> None:
     assert smoothing_ladder(0.05) == pytest.approx([1.0, 0.1])
     assert smoothing_ladder(0.1) == pytest.approx([1.0])
     assert smoothing_ladder(1.0) == [] and smoothing_ladder(2.0) == []
+
+
+def test_the_torque_rate_term_is_in_the_saved_cost_and_recomputes(solved: SolveFn) -> None:
+    """With ``torque_rate_time`` the saved cost holds the term ``r sum (du)^2 / h`` of every
+    phase's knot torques (independently recomputed here), and verify recomputes it."""
+    tau = 0.05
+    plain = solved(GaitOptions(knots=(16, 6))).gait
+    rated = solved(GaitOptions(knots=(16, 6), torque_rate_time=tau)).gait
+    assert rated.success and f"({tau:g} s)^2" in rated.cost["formula"]
+    model = rated.model
+    weights = cost.torque_rate_weights(model, GaitOptions.from_dict(dict(rated.options)))
+    r = np.array([weights[a.name] for a in model.actuators])
+    term = sum(float(np.sum((np.diff(ph.u, axis=0) ** 2) @ r / np.diff(ph.t)))
+               for ph in rated.phases)
+    without = cost.recompute_cost(rated) - term / cost.denominator(
+        model, GaitOptions.from_dict(dict(rated.options)),
+        [rated.step_length, rated.speed, rated.parameters["liftoff_impulse"]])
+    assert term > 0.0
+    assert cost.recompute_cost(rated) == pytest.approx(rated.cost_value, rel=1e-6)
+    # The term prices the torques' changes: the optimum without it is cheaper in the plain
+    # cost, and smooths less.
+    assert without >= plain.cost_value * (1.0 - 1e-5)
+    report = verify_gait(rated)
+    assert report.passed, report.failed_ids

@@ -18,7 +18,7 @@ from gaitopt.analysis.verify import verify_gait
 from gaitopt.cli import cli
 from gaitopt.gait.api import solve_gait_solution
 from gaitopt.gait.contact_sequence import ContactSequenceError, phase_knots
-from gaitopt.gait.formulation import contact_sequence
+from gaitopt.gait.formulation import checked_sequence, contact_sequence
 from gaitopt.gait.gait_file import Gait
 from gaitopt.gait.options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.refinement import (
@@ -119,6 +119,16 @@ def test_phase_shares_are_checked() -> None:
         validate_options(options.replace(phase_shares=(0.5, 1.2)), None)
     with pytest.raises(ContactSequenceError, match="phase_shares: 2 share"):
         contact_sequence(model, options.replace(phase_shares=(0.5, 0.5)))
+    # Shares a solve returns: a bound's relaxation outside a bound, a rounding off 1. The
+    # guesses stay within the bounds and sum to 1 (the sequence check passes).
+    bounds = [ph.bounds for ph in contact_sequence(model, options).phases]
+    lo = bounds[1][0]  # type: ignore[index]
+    shares = (0.45 + 3e-8, lo - 2e-8, 0.3, 1.0 - 0.45 - lo - 0.3 + 1e-12)
+    seq = contact_sequence(model, options.replace(phase_shares=shares))
+    checked_sequence(model, options.replace(phase_shares=shares))
+    assert math.fsum(ph.fraction for ph in seq.phases) == pytest.approx(1.0, abs=1e-12)
+    assert seq.phases[1].fraction == lo
+    assert [ph.fraction for ph in seq.phases] == pytest.approx(shares, abs=1e-7)
 
 
 def test_the_loop_refines_on_the_check_grid_until_within() -> None:

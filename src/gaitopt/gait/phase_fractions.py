@@ -20,6 +20,7 @@ the remainder is exactly the single fraction ``f, 1 - f``.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -127,10 +128,19 @@ def with_shares(seq: ContactSequence, shares: Sequence[float]) -> ContactSequenc
     if len(shares) != len(seq.phases):
         raise ContactSequenceError(f"phase_shares: {len(shares)} share(s) for the "
                                    f"{len(seq.phases)} phases of sequence {seq.name!r}")
-    phases = tuple(dataclasses.replace(ph, fraction=min(max(float(s), ph.bounds[0]),
-                                                          ph.bounds[1]))
-                   if ph.bounds is not None else ph
-                   for ph, s in zip(seq.phases, shares, strict=True))
+    fractions = [min(max(float(s), ph.bounds[0]), ph.bounds[1]) if ph.bounds is not None
+                 else ph.fraction for ph, s in zip(seq.phases, shares, strict=True)]
+    free = free_phases(seq)
+    if free:
+        # The shares a solve found sum to 1 within rounding, and may sit a bound's
+        # relaxation (about 1e-8) outside a bound: what clipping took away goes to the free
+        # phase with the most room for it, so that the guesses sum to 1.
+        rest = 1.0 - math.fsum(fractions)
+        room = [(seq.phases[i].bounds[1] - fractions[i]) if rest > 0.0  # type: ignore[index]
+                else (fractions[i] - seq.phases[i].bounds[0]) for i in free]  # type: ignore[index]
+        fractions[free[room.index(max(room))]] += rest
+    phases = tuple(dataclasses.replace(ph, fraction=f)
+                   for ph, f in zip(seq.phases, fractions, strict=True))
     return dataclasses.replace(seq, phases=phases)
 
 
