@@ -273,3 +273,24 @@ def test_another_mesh_derives_no_interval_template() -> None:
     transcribe(other, method=SEPARATED, compiled="points", build_solver=False,
                intervals=7)
     assert pointwise.interval_derivations == before + 1
+
+
+@pytest.mark.parametrize("selections", [True, False], ids=["selections", "general"])
+def test_scatter_is_the_product_with_constant_matrices(selections: bool) -> None:
+    # C1 B C2 as a constant map of B's nonzeros (repeated columns of C2: entries that add up).
+    from gaitopt.ocp.pointwise import _Scatter
+
+    rng = np.random.default_rng(2)
+    block = ca.Sparsity.triplet(4, 5, [0, 1, 3, 2, 0, 3], [0, 1, 1, 3, 4, 4])
+    if selections:
+        C1 = ca.DM.triplet([0, 2, 1], [0, 1, 3], [2.0, -1.0, 0.5], 3, 4)
+        C2 = ca.DM.triplet([0, 1, 3, 4], [2, 0, 2, 1], [1.0, 3.0, -2.0, 1.5], 5, 3)
+    else:
+        C1 = ca.DM(rng.standard_normal((3, 4)))
+        C2 = ca.DM(rng.standard_normal((5, 3)))
+    values = rng.standard_normal(block.nnz())
+    scatter = _Scatter(C1, block, C2)
+    got = ca.Function("f", [x := ca.MX.sym("x", block.nnz())], [scatter(x)])(values)
+    expected = ca.mtimes([C1, ca.DM(block, values), C2])
+    assert np.allclose(np.array(ca.densify(got)), np.array(ca.densify(expected)),
+                       rtol=1e-14, atol=1e-14)

@@ -445,6 +445,50 @@ def _selection(v: ca.SX, u: ca.SX) -> ca.DM:
     return S + ca.mtimes(place, rest)
 
 
+class _Scatter:
+    """``C1 B C2`` for constant selections C1, C2 (at most one entry per column of C1 and
+    per row of C2) and a matrix B of a given sparsity, as a constant sparse matrix M taking
+    B's nonzeros to the product's (a nonzero of B at (r, c) contributes ``C1[i, r] C2[c, j]``
+    to entry (i, j); contributions to one entry add up), built with numpy from the sparsity
+    patterns: evaluating it is one sparse matrix-vector product, nothing is derived."""
+
+    def __init__(self, C1: ca.DM, block: ca.Sparsity, C2: ca.DM) -> None:
+        C1, C2 = ca.DM(C1), ca.DM(C2)
+        rows, cols = (np.asarray(a, dtype=int) for a in block.get_triplet())
+        c1_rows, c1_cols = (np.asarray(a, dtype=int) for a in C1.sparsity().get_triplet())
+        c2_rows, c2_cols = (np.asarray(a, dtype=int) for a in C2.sparsity().get_triplet())
+        c1_vals = np.asarray(C1.nonzeros(), dtype=float)
+        c2_vals = np.asarray(C2.nonzeros(), dtype=float)
+        if (np.bincount(c1_cols, minlength=1).max(initial=0) > 1
+                or np.bincount(c2_rows, minlength=1).max(initial=0) > 1):
+            # Not selections: C1 B C2 of a symbolic B, and the map read off its Jacobian.
+            b = ca.SX.sym("b", block.nnz())
+            prod = ca.mtimes([ca.SX(C1), ca.SX(block, b), ca.SX(C2)])
+            self.sparsity = prod.sparsity()
+            values = ca.reshape(prod[prod.sparsity()], prod.nnz(), 1)
+            self.matrix = ca.evalf(ca.jacobian(values, b))
+            return
+        # Selections: each nonzero of B goes to at most one entry of the product.
+        to_i = np.full(int(C1.shape[1]), -1)
+        to_a = np.zeros(int(C1.shape[1]))
+        to_i[c1_cols], to_a[c1_cols] = c1_rows, c1_vals
+        to_j = np.full(int(C2.shape[0]), -1)
+        to_b = np.zeros(int(C2.shape[0]))
+        to_j[c2_rows], to_b[c2_rows] = c2_cols, c2_vals
+        out_i, out_j = to_i[rows], to_j[cols]
+        keep = np.flatnonzero((out_i >= 0) & (out_j >= 0))
+        coef = to_a[rows[keep]] * to_b[cols[keep]]
+        self.sparsity, mapping = ca.Sparsity.triplet(
+            int(C1.shape[0]), int(C2.shape[1]), out_i[keep].tolist(), out_j[keep].tolist(),
+            True)
+        self.matrix = ca.DM.triplet(list(mapping), keep.tolist(), coef.tolist(),
+                                    self.sparsity.nnz(), block.nnz())
+
+    def __call__(self, nz: ca.MX) -> ca.MX:
+        """The product for B with nonzeros ``nz``."""
+        return ca.MX(self.sparsity, ca.mtimes(self.matrix, nz))
+
+
 class _Outer:
     """The outer functions of the SX ``assembly`` (defects, quadrature, linkages, scaling)
     and their derivatives with respect to w and the point outputs Y, as MX functions of
@@ -520,39 +564,40 @@ class _Outer:
         S = _selection(V, ca.vertcat(w, Y))
         self.S = S
         S_w, S_Y = S[:, :nw], S[:, nw:]
-        # The chain rule through the interval templates as SX functions of the nonzeros of
-        # their mapped derivatives (sparse products, built, not derived: evaluated in one
-        # pass of the VM, as cheap as the outer functions of the whole mesh were).
-        BJ, bj = self._block_symbols("J", [d.jacobian.sparsity_out(1) for d in self.derivs])
-        self._jac = ca.Function("outer_jac", [w, Y, R, bj],
-                                [G, G_w + ca.mtimes([G_R, BJ, S_w]),
-                                 G_Y + ca.mtimes([G_R, BJ, S_Y])])
-        BJ, bj = self._block_symbols("J", [d.hessian.sparsity_out(0) for d in self.derivs])
-        BH, bh = self._block_symbols("H", [d.hessian.sparsity_out(2) for d in self.derivs])
-        grads = ca.SX.sym("g", int(V.shape[0]))
-        A_w, A_Y = ca.mtimes(BJ, S_w), ca.mtimes(BJ, S_Y)
-        cross_w = ca.mtimes(L_wR, A_w)
-        L_ww = L_ww + cross_w + cross_w.T + ca.mtimes([S_w.T, BH, S_w])
-        L_wY = (L_wY + ca.mtimes(L_wR, A_Y) + ca.mtimes(A_w.T, L_YR.T)
-                + ca.mtimes([S_w.T, BH, S_Y]))
-        cross_Y = ca.mtimes(L_YR, A_Y)
-        L_YY = L_YY + cross_Y + cross_Y.T + ca.mtimes([S_Y.T, BH, S_Y])
-        if L_RR.nnz() > 0:
-            L_ww = L_ww + ca.mtimes([A_w.T, L_RR, A_w])
-            L_wY = L_wY + ca.mtimes([A_w.T, L_RR, A_Y])
-            L_YY = L_YY + ca.mtimes([A_Y.T, L_RR, A_Y])
-        self._hess = ca.Function("outer_hess", [w, Y, R, sigma, lam, bj, bh, grads],
-                                 [L_ww, L_wY, L_YY, L_Y + ca.mtimes(S_Y.T, grads)])
+        nR = int(R.shape[0])
+        # The chain rule through the interval templates: every product of a block of their
+        # mapped derivatives with constant selections is a constant linear map of the block's
+        # nonzeros (_Scatter: one sparse matrix-vector product per evaluation, nothing
+        # derived); only the products with the few non-constant rows of the ratio objective
+        # (L_wR, L_YR) stay MX products.
+        G_R_const = not ca.depends_on(G_R, ca.vertcat(w, Y, R))
+        self._jac = ca.Function("outer_jac", [w, Y, R], [G, G_w, G_Y] +
+                                ([] if G_R_const else [G_R]))
+        jac_block = self._block_sparsity([d.jacobian.sparsity_out(1) for d in self.derivs])
+        hess_J = self._block_sparsity([d.hessian.sparsity_out(0) for d in self.derivs])
+        hess_H = self._block_sparsity([d.hessian.sparsity_out(2) for d in self.derivs])
+        self._jac_block = jac_block
+        if G_R_const:
+            C = ca.evalf(G_R)
+            self._G_R = None
+            self._jac_w, self._jac_Y = _Scatter(C, jac_block, S_w), _Scatter(C, jac_block, S_Y)
+        else:
+            self._G_R = True
+        I_R = ca.DM.eye(nR)
+        self._A_w, self._A_Y = _Scatter(I_R, hess_J, S_w), _Scatter(I_R, hess_J, S_Y)
+        self._H_ww = _Scatter(S_w.T, hess_H, S_w)
+        self._H_wY = _Scatter(S_w.T, hess_H, S_Y)
+        self._H_YY = _Scatter(S_Y.T, hess_H, S_Y)
+        self._S_Y_T = S_Y.T
+        self._hess = ca.Function("outer_hess", [w, Y, R, sigma, lam],
+                                 [L_ww, L_wY, L_YY, L_Y, L_wR, L_YR, L_RR])
 
-    def _block_symbols(self, name: str, blocks: list[ca.Sparsity]) -> tuple[ca.SX, ca.SX]:
-        """The block-diagonal matrix of the interval groups' blocks (N copies of each
-        group's block) as an SX matrix of symbols for its nonzeros, and those symbols (in
-        the order of the mapped outputs' nonzeros)."""
+    def _block_sparsity(self, blocks: list[ca.Sparsity]) -> ca.Sparsity:
+        """The block-diagonal sparsity of the interval groups' blocks (N copies of each
+        group's block), whose nonzeros are in the order of the mapped outputs'."""
         mats = [ca.diagcat(*[ca.DM(b, 1.0)] * int(ig.r.shape[1])).sparsity()
                 for b, ig in zip(blocks, self.intervals, strict=True)]
-        sp = ca.diagcat(*[ca.DM(m, 1.0) for m in mats]).sparsity()
-        nz = ca.SX.sym(name, sp.nnz())
-        return ca.SX(sp, nz), nz
+        return ca.diagcat(*[ca.DM(m, 1.0) for m in mats]).sparsity()
 
     def _inputs(self, W: ca.MX, Yv: ca.MX) -> list[ca.MX]:
         """The inputs v (nv, N) of each interval group."""
@@ -595,8 +640,14 @@ class _Outer:
                  for d, ig, v in zip(self.derivs, self.intervals, self._inputs(W, Yv),
                                      strict=True)]
         Rv = ca.vertcat(*[ca.vec(c[0]) for c in calls])
-        G, G_w, G_Y = self._jac(W, Yv, Rv, ca.vertcat(*[c[1].nz[:] for c in calls]))
-        return G, G_w, G_Y
+        nz = ca.vertcat(*[c[1].nz[:] for c in calls])
+        if self._G_R is None:
+            G, G_w, G_Y = self._jac(W, Yv, Rv)
+            return G, G_w + self._jac_w(nz), G_Y + self._jac_Y(nz)
+        G, G_w, G_Y, G_R = self._jac(W, Yv, Rv)
+        BJ = ca.MX(self._jac_block, nz)
+        return (G, G_w + ca.mtimes([G_R, BJ, self.S[:, :self.nw]]),
+                G_Y + ca.mtimes([G_R, BJ, self.S[:, self.nw:]]))
 
     def hessian(self, W: ca.MX, Yv: ca.MX, S: ca.MX, Lam: ca.MX
                 ) -> tuple[ca.MX, ca.MX, ca.MX, ca.MX]:
@@ -612,10 +663,25 @@ class _Outer:
             nr, N = int(ig.r.shape[0]), int(ig.r.shape[1])
             calls.append(d.hessian.map(N)(v, ig.dtau, ca.reshape(L_R[pos:pos + nr * N], nr, N)))
             pos += nr * N
-        L_ww, L_wY, L_YY, L_Y = self._hess(
-            W, Yv, Rv, S, Lam, ca.vertcat(*[c[0].nz[:] for c in calls]),
-            ca.vertcat(*[c[2].nz[:] for c in calls]), ca.vertcat(*[ca.vec(c[1]) for c in calls]))
-        return L_ww, L_wY, L_YY, L_Y
+        bj = ca.vertcat(*[c[0].nz[:] for c in calls])
+        bh = ca.vertcat(*[c[2].nz[:] for c in calls])
+        grads = ca.vertcat(*[ca.vec(c[1]) for c in calls])
+        L_ww, L_wY, L_YY, L_Y, L_wR, L_YR, L_RR = self._hess(W, Yv, Rv, S, Lam)
+        L_ww = L_ww + self._H_ww(bh)
+        L_wY = L_wY + self._H_wY(bh)
+        L_YY = L_YY + self._H_YY(bh)
+        if L_wR.nnz() or L_YR.nnz() or L_RR.nnz():
+            A_w, A_Y = self._A_w(bj), self._A_Y(bj)
+            cross_w = ca.mtimes(L_wR, A_w)
+            cross_Y = ca.mtimes(L_YR, A_Y)
+            L_ww = L_ww + cross_w + cross_w.T
+            L_wY = L_wY + ca.mtimes(L_wR, A_Y) + ca.mtimes(A_w.T, L_YR.T)
+            L_YY = L_YY + cross_Y + cross_Y.T
+            if L_RR.nnz() > 0:
+                L_ww = L_ww + ca.mtimes([A_w.T, L_RR, A_w])
+                L_wY = L_wY + ca.mtimes([A_w.T, L_RR, A_Y])
+                L_YY = L_YY + ca.mtimes([A_Y.T, L_RR, A_Y])
+        return L_ww, L_wY, L_YY, L_Y + ca.mtimes(self._S_Y_T, grads)
 
     def objective(self, F: ca.SX) -> ca.SX:
         """``F`` with the interval terms it reads (the interval costs) as SX expressions of w
