@@ -342,8 +342,11 @@ def test_single_support_walk_monodromies_agree(single_support_gait: Gait) -> Non
 def run_gait() -> Gait:
     """A run (stance on tip 1, then flight), full coordinates, 60 m/min, 8 + 5 knots: about
     2 s."""
+    # the stance share fixed at 0.85 and the walk's step bounds (a run's defaults free the
+    # share and allow longer steps: docs/running.md)
     return solve_gait("five-link", GaitOptions.paper(speed=1.0, formulation="full", gait="run",
-                                                     impulse=False))
+                                                     impulse=False, single_support_fraction=0.85,
+                                                     step_length_bounds=(0.02, 0.8)))
 
 
 def test_run_step_follows_its_contact_sequence(run_gait: Gait) -> None:

@@ -91,6 +91,26 @@ def read_sequence(path: Path) -> dict[str, Any]:
     return dict(data)
 
 
+def speed_bounds(text: str) -> tuple[float, float]:
+    """The ``--speed-bounds`` text ``LO,HI`` (each a speed with a unit, as ``--speed``) in m/s.
+
+    Raises:
+        UserError: not two speeds, or not ``0 < LO <= HI``.
+    """
+    parts = text.split(",")
+    if len(parts) != 2:
+        raise UserError(f"--speed-bounds: {text!r} must be two speeds LO,HI with units, e.g. "
+                        "60m/min,400m/min")
+    try:
+        lo, hi = (parse_speed(p.strip()) for p in parts)
+    except ValueError as exc:
+        raise UserError(f"--speed-bounds: {exc}") from None
+    if not 0.0 < lo <= hi:
+        raise UserError(f"--speed-bounds: {text!r} must satisfy 0 < LO <= HI (the bounds of a "
+                        "free speed)")
+    return lo, hi
+
+
 def _step(text: str) -> float | None:
     return parse_free_or_value(text, "--step-length", "m", "length")
 
@@ -106,16 +126,24 @@ def _step_time(text: str) -> float | None:
                    "[default: the model's, at equal Froude number v^2/(g l): 12 m/min for the "
                    "five-link walk, 72.2 m/min for the seven-link heel-toe walk; "
                    "docs/walking.md].")
+@click.option("--speed-bounds", "speed_bounds_text", default=None,
+              help="LO,HI: the bounds of a free speed (--speed free), with units as --speed, "
+                   "e.g. 60m/min,400m/min [default: the model's, 1.2-90 m/min on the "
+                   "five-link biped]. A given --speed is never checked against them.")
 @click.option("--step-length", default="free", show_default=True,
               help="Step length in m, or 'free'.")
 @click.option("--step-time", default="free", show_default=True,
               help="Step time in s (step length / speed), or 'free'; not with --step-length.")
 @click.option("--ankle/--no-ankle", default=True, show_default=True,
               help="Ankle torques at the tips on the ground.")
-@click.option("--impulse/--no-impulse", default=True, show_default=True,
-              help="Liftoff impulse along the lifting leg.")
-@click.option("--single-support", type=float, default=0.85, show_default=True,
-              help="Single-support fraction of the step time; 1 = no double support.")
+@click.option("--impulse/--no-impulse", default=None,
+              help="Liftoff impulse along the lifting leg [default: on; off for --gait run, "
+                   "which has no double support to push off from, and --impulse with it is "
+                   "an error].")
+@click.option("--single-support", type=float, default=None,
+              help="Single-support fraction of the step time; 1 = no double support; a run's "
+                   "stance share, fixed when given [default: 0.85; a run's is free in "
+                   "0.2-0.95, docs/running.md].")
 @click.option("--single-support-bounds", default=None,
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
@@ -151,7 +179,8 @@ def _step_time(text: str) -> float | None:
                    "and the walk, else full].", default=None)
 @min_knee_flexion_option
 @click.option("--gait", "gait_kind", type=click.Choice(list(GAITS)), default=None,
-              help="The contact sequence: walk, run (stance then flight; needs --no-impulse) "
+              help="The contact sequence: walk, run (stance then flight, no liftoff impulse, "
+                   "the stance share free; docs/running.md) "
                    "or heel-toe (feet with heel and toe points, e.g. --model seven-link) "
                    "[default: what the model's feet allow: walk with one contact point per "
                    "leg, heel-toe with two].")
@@ -199,9 +228,10 @@ def _step_time(text: str) -> float | None:
                                  "gait); the cold path is the fallback.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
-def solve_command(model_name: str, speed: str | None, step_length: str, step_time: str, ankle: bool,
-                  impulse: bool,
-                  single_support: float, knots: str | None, knot_spacing: str | None,
+def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | None,
+                  step_length: str, step_time: str, ankle: bool,
+                  impulse: bool | None,
+                  single_support: float | None, knots: str | None, knot_spacing: str | None,
                   paper_grid: bool,
                   transcription: str | None,
                   periodic_controls: bool, friction: float | None,
@@ -233,11 +263,19 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
     given: dict[str, Any] = {"speed": _speed(speed)} if speed is not None else {}
     given |= {"formulation": formulation} if formulation is not None else {}
     given |= {"gait": gait_kind} if gait_kind is not None else {}
+    if speed_bounds_text is not None:
+        given["speed_bounds"] = speed_bounds(speed_bounds_text)
+    if single_support is not None:
+        given["single_support_fraction"] = single_support
+    run = gait_kind == "run" and sequence is None
+    if impulse and run:
+        raise UserError("--impulse with --gait run: a run leaves the ground from single "
+                        "support into a flight, with no double support for a liftoff impulse "
+                        "to act from; leave --impulse out (a run has none by default)")
     options = GaitOptions(
         contact_sequence=sequence,
         step_length=_step(step_length), step_time=_step_time(step_time),
-        ankle=ankle, impulse=impulse,
-        single_support_fraction=single_support,
+        ankle=ankle, impulse=(not run) if impulse is None else impulse,
         **{**grid_choice(knots, control_model, paper_grid, knot_spacing),
            **({"transcription": transcription} if transcription else {}),
            **given},
@@ -279,6 +317,9 @@ def solve_command(model_name: str, speed: str | None, step_length: str, step_tim
                   + f", {options.formulation} coordinates"
                   + (", a stride (two steps, no leg swap)" if options.stride else ""))
 
+    if speed_bounds_text is not None and options.speed is not None:
+        console.print("note: --speed-bounds bound a free speed (--speed free); the speed "
+                      f"{format_speed(options.speed)} is fixed, so they play no part")
     if (start is None and not options.multistart
             and multistart_default(options.speed, formulation_of(options), reference,
                                    model_scale(model).speed(FAR_FROM_REFERENCE))):

@@ -43,14 +43,39 @@ def walking_sequence(model: RobotModel, single_support_fraction: float, *,
 
 def running_sequence(model: RobotModel, stance_fraction: float) -> ContactSequence:
     """A run: stance on leg 1 for ``stance_fraction`` of the step, then flight; leg 2 lands
-    one step length ahead."""
-    c1, c2 = _two_contacts(model)
+    one step length ahead. On feet with a heel and a toe point (:func:`run_points`) the run
+    is on the toes (a forefoot run: the toe pinned, the heel above the ground)."""
+    c1, c2 = run_points(model)
     f = stance_fraction
     return ContactSequence(
         "run",
         (PhaseSpec("stance", (c1,), f), PhaseSpec("flight", (), 1.0 - f)),
         (EventSpec("toe_off", release=(c1,)), EventSpec("touchdown", touchdown=(c2,))),
         ((c1, 0.0), (c2, 1.0)))
+
+
+def legs_contacts(model: RobotModel) -> tuple[tuple[str, ...], ...]:
+    """The contact points of each leg: grouped by the first link below the base on the chain
+    from the base to each contact (a contact on the base is a group of its own), legs in the
+    order of their first contact point."""
+    groups: dict[str, list[str]] = {}
+    for c in model.contacts:
+        chain = model.chain(model.link_index(c.link))
+        root = model.links[chain[1]].name if len(chain) > 1 else model.base.name
+        groups.setdefault(root, []).append(c.name)
+    return tuple(tuple(g) for g in groups.values())
+
+
+def run_points(model: RobotModel) -> tuple[str, str]:
+    """The points a run stands on: the model's first two contact points, or, on two feet with
+    two points each (heel and toe), the front one of each foot in the standing pose (all
+    coordinates 0)."""
+    legs = legs_contacts(model)
+    if len(legs) != 2 or [len(g) for g in legs] != [2, 2]:
+        return _two_contacts(model)
+    zero = [0.0] * model.nq
+    return tuple(max(g, key=lambda c: float(contact_position(model, zero, c)[0]))  # type: ignore[return-value]
+                 for g in legs)
 
 
 def feet(model: RobotModel, contact_swap: Mapping[str, str]

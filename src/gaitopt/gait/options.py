@@ -134,10 +134,12 @@ class GaitOptions:
             the gait's at equal Froude number (0.2 m/s for the five-link walk;
             :data:`gaitopt.gait.model_defaults.DEFAULT_SPEEDS`).
         speed_bounds: bounds (m/s) when the speed is free (default 0.02-1.5 m/s on 1 m legs,
-            times ``sqrt(g l / (9.81 * 1 m))``).
+            times ``sqrt(g l / (9.81 * 1 m))``). A given ``speed`` is not checked against
+            them: they bound a free speed only (docs/running.md).
         step_length: step length (m), or ``None`` for free.
         step_length_bounds: bounds (m) when the step length is free (default 0.02-0.8 m on
-            1 m legs, times ``l / 1 m``).
+            1 m legs, times ``l / 1 m``; a run's 0.02-3 m,
+            :data:`gaitopt.gait.model_defaults.RUN_STEP_LENGTH_BOUNDS`).
         step_time: step time ``L / v`` (s), or ``None`` for free. With a given speed it
             fixes the step length; with the speed free, the optimal walk of that step time.
             Give at most one of ``step_length`` and ``step_time``.
@@ -145,6 +147,9 @@ class GaitOptions:
         impulse: liftoff impulse on.
         single_support_fraction: phase-1 share of the step time, in (0, 1]; 1 gives the
             single-support gait (no double support, the trailing leg leaves at heel strike).
+            Default 0.85; a run's stance share is free by default
+            (:data:`gaitopt.gait.model_defaults.RUN_STANCE_BOUNDS`, from a guess that falls
+            with the speed, :func:`~gaitopt.gait.model_defaults.run_stance_guess`).
         knots: grid points per phase (single support, double support): 16 + 6 by default
             (the cost within 0.1 % of the fine-grid limit with ``control_model="jumps"``);
             the paper's 8 + 5 with :meth:`paper`; 24 + 16 for steps of more than two phases
@@ -274,7 +279,7 @@ class GaitOptions:
     step_time: float | None = None
     ankle: bool = True
     impulse: bool = True
-    single_support_fraction: float = 0.85
+    single_support_fraction: float = from_model(0.85)
     knots: tuple[int, int] = from_model((16, 6))
     transcription: Transcription = "hermite-simpson-separated"
     periodic_controls: bool = True
@@ -391,9 +396,8 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
         speed = _finite("speed", o.speed)
         if speed <= 0.0:
             raise GaitOptionsError(f"speed = {format_speed(speed)}: must be > 0 (or free)")
-        if not v_lo <= speed <= v_hi:
-            raise GaitOptionsError(f"speed = {format_speed(speed)}: must lie in speed_bounds "
-                                   f"[{format_speed(v_lo)}, {format_speed(v_hi)}]")
+        # A given speed is not checked against speed_bounds, which bound a free speed only
+        # (a run at 240 m/min is asked for directly; docs/running.md).
     l_lo, l_hi = _bounds("step_length_bounds", o.step_length_bounds, positive=True)
     if o.formulation not in FORMULATIONS:
         raise GaitOptionsError(f"formulation = {o.formulation!r}: must be one of "
@@ -454,11 +458,15 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
             sequence_from_dict(o.contact_sequence)
         except ContactSequenceError as exc:
             raise GaitOptionsError(str(exc)) from None
-    if o.gait == "run" and (not traits.contact_sequences or o.single_support_fraction >= 1.0
-                            or o.impulse):
+    if o.gait == "run" and o.impulse:
         raise GaitOptionsError(
-            "gait = 'run': needs formulation 'full', single_support_fraction < 1 (the stance "
-            "share of the step) and impulse off (no liftoff impulse in a run)")
+            "gait = 'run' with impulse on: a run leaves the ground from single support into "
+            "a flight, with no double support for a liftoff impulse to act from; turn it off "
+            "(impulse=False; gaitopt solve --gait run has it off unless --impulse is given)")
+    if o.gait == "run" and (not traits.contact_sequences or o.single_support_fraction >= 1.0):
+        raise GaitOptionsError(
+            "gait = 'run': needs formulation 'full' and single_support_fraction < 1 (the "
+            "stance share of the step)")
     flex = _finite("min_stance_knee_flexion", o.min_stance_knee_flexion)
     if traits.straight_stance_knee and not 0.0 <= flex < 1.5:
         raise GaitOptionsError(f"min_stance_knee_flexion = {flex:g} rad: must lie in [0, 1.5) "

@@ -562,7 +562,11 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         outcome = run.other_cost()
         result = outcome if outcome is not None and outcome.success else None
     elif result is None:
-        speed = options.speed if options.speed is not None else run.reference_speed
+        # A free speed starts from the reference speed moved into its bounds (a run's
+        # --speed-bounds 150m/min,400m/min start at 150 m/min, by continuation if need be).
+        lo, hi = options.speed_bounds
+        speed = (options.speed if options.speed is not None
+                 else min(max(run.reference_speed, lo), hi))
         far = options.continuation and abs(speed - run.reference_speed) > 1e-9
         if options.multistart:
             starts = run.cold_starts(speed, every_start=True)
