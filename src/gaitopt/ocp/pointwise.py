@@ -315,8 +315,9 @@ def interval_template(inp: IntervalInputs) -> ca.Function:
 @dataclass(frozen=True)
 class IntervalDerivatives:
     """The derivatives of an :func:`interval_template` ``r(v, dtau)``: ``jacobian(v, dtau)
-    -> (r, dr/dv)`` and ``hessian(v, dtau, mu) -> (dr/dv, (dr/dv)^T mu, Hess_v (mu^T r))``
-    (SX functions, evaluated in CasADi's VM)."""
+    -> (r, dr/dv)`` and ``hessian(v, dtau, mu) -> (dc/dv, (dr/dv)^T mu, Hess_v (mu^T r))``
+    with ``c`` the interval's cost (the last row of r: the objective's second derivatives
+    couple it to the ends' terms) (SX functions, evaluated in CasADi's VM)."""
 
     value: ca.Function
     jacobian: ca.Function
@@ -347,7 +348,8 @@ def interval_derivatives(template: ca.Function) -> IntervalDerivatives:
             template,
             ca.Function("interval_jac", [v, dtau], list(ca.cse([r, jac])), ["v", "dtau"],
                         ["r", "J"]),
-            ca.Function("interval_hess", [v, dtau, mu], list(ca.cse([jac, grad, hess])),
+            ca.Function("interval_hess", [v, dtau, mu],
+                        list(ca.cse([jac[jac.shape[0] - 1, :], grad, hess])),
                         ["v", "dtau", "mu"], ["J", "g", "H"]))
         interval_derivations += 1
         while len(_INTERVAL_DERIVATIVES) > INTERVAL_CACHE_SIZE:
@@ -576,6 +578,23 @@ class _Outer:
         jac_block = self._block_sparsity([d.jacobian.sparsity_out(1) for d in self.derivs])
         hess_J = self._block_sparsity([d.hessian.sparsity_out(0) for d in self.derivs])
         hess_H = self._block_sparsity([d.hessian.sparsity_out(2) for d in self.derivs])
+        # The second derivatives of the residual Lagrangian couple R to (w, Y) through the
+        # objective's ratio: through the interval costs only, unless a differentiated row of
+        # G reads other interval terms (then the whole Jacobian of r is needed).
+        costs, pos = [], 0
+        for ig in self.intervals:
+            nr, N = int(ig.r.shape[0]), int(ig.r.shape[1])
+            costs.append(pos + nr * np.arange(N) + nr - 1)
+            pos += nr * N
+        cost_rows = np.concatenate(costs)
+        used = {int(c) for m in (L_wR, L_YR) for c in m.sparsity().get_col()}
+        used |= {int(c) for c in L_RR.sparsity().get_col()}
+        self._costs_only = used <= set(cost_rows.tolist())
+        if self._costs_only:
+            place = ca.DM.triplet(cost_rows.tolist(), list(range(cost_rows.size)),
+                                  [1.0] * cost_rows.size, nR, cost_rows.size)
+        else:
+            place, hess_J = ca.DM.eye(nR), jac_block
         self._jac_block = jac_block
         if G_R_const:
             C = ca.evalf(G_R)
@@ -583,8 +602,7 @@ class _Outer:
             self._jac_w, self._jac_Y = _Scatter(C, jac_block, S_w), _Scatter(C, jac_block, S_Y)
         else:
             self._G_R = True
-        I_R = ca.DM.eye(nR)
-        self._A_w, self._A_Y = _Scatter(I_R, hess_J, S_w), _Scatter(I_R, hess_J, S_Y)
+        self._A_w, self._A_Y = _Scatter(place, hess_J, S_w), _Scatter(place, hess_J, S_Y)
         self._H_ww = _Scatter(S_w.T, hess_H, S_w)
         self._H_wY = _Scatter(S_w.T, hess_H, S_Y)
         self._H_YY = _Scatter(S_Y.T, hess_H, S_Y)
@@ -640,7 +658,7 @@ class _Outer:
                  for d, ig, v in zip(self.derivs, self.intervals, self._inputs(W, Yv),
                                      strict=True)]
         Rv = ca.vertcat(*[ca.vec(c[0]) for c in calls])
-        nz = ca.vertcat(*[c[1].nz[:] for c in calls])
+        nz = ca.vertcat(*[ca.vec(c[1].nz[:]) for c in calls])
         if self._G_R is None:
             G, G_w, G_Y = self._jac(W, Yv, Rv)
             return G, G_w + self._jac_w(nz), G_Y + self._jac_Y(nz)
@@ -663,8 +681,13 @@ class _Outer:
             nr, N = int(ig.r.shape[0]), int(ig.r.shape[1])
             calls.append(d.hessian.map(N)(v, ig.dtau, ca.reshape(L_R[pos:pos + nr * N], nr, N)))
             pos += nr * N
-        bj = ca.vertcat(*[c[0].nz[:] for c in calls])
-        bh = ca.vertcat(*[c[2].nz[:] for c in calls])
+        if self._costs_only:
+            bj = ca.vertcat(*[ca.vec(c[0].nz[:]) for c in calls])
+        else:
+            bj = ca.vertcat(*[ca.vec(d.jacobian.map(int(ig.r.shape[1]))(v, ig.dtau)[1].nz[:])
+                              for d, ig, v in zip(self.derivs, self.intervals, Vs,
+                                                  strict=True)])
+        bh = ca.vertcat(*[ca.vec(c[2].nz[:]) for c in calls])
         grads = ca.vertcat(*[ca.vec(c[1]) for c in calls])
         L_ww, L_wY, L_YY, L_Y, L_wR, L_YR, L_RR = self._hess(W, Yv, Rv, S, Lam)
         L_ww = L_ww + self._H_ww(bh)
