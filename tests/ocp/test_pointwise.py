@@ -294,3 +294,21 @@ def test_scatter_is_the_product_with_constant_matrices(selections: bool) -> None
     expected = ca.mtimes([C1, ca.DM(block, values), C2])
     assert np.allclose(np.array(ca.densify(got)), np.array(ca.densify(expected)),
                        rtol=1e-14, atol=1e-14)
+
+
+def test_identity_cache_finds_the_same_objects_and_keeps_the_newest() -> None:
+    from gaitopt.ocp.functions import IdentityCache
+
+    cache = IdentityCache(2)
+    made: list[int] = []
+
+    def make(value: int) -> object:
+        return lambda: made.append(value) or value
+
+    a, b = object(), object()
+    assert cache.get(("x", a), make(1)) == 1
+    assert cache.get(("x", a), make(2)) == 1          # the same object: found
+    assert cache.get(("y", a), make(3)) == 3          # another key
+    assert cache.get(("x", b), make(4)) == 4          # another object: made (evicts x, a)
+    assert cache.get(("x", a), make(5)) == 5
+    assert made == [1, 3, 4, 5]

@@ -223,7 +223,7 @@ class IdentityCache:
     entries. The transcriptions of one problem on other meshes share its functions, so the
     functions made from them are made, and hashed, once."""
 
-    def __init__(self, size: int = 64) -> None:
+    def __init__(self, size: int = 16) -> None:
         self.size = size
         self._items: OrderedDict[tuple[Any, ...], tuple[tuple[Any, ...], Any]] = OrderedDict()
 
@@ -243,7 +243,9 @@ class IdentityCache:
         return value
 
 
-_MADE = IdentityCache()
+#: The knot-state point functions made from a problem's functions: a few problems' worth
+#: (an entry keeps the problem's phase functions alive).
+_MADE = IdentityCache(16)
 
 
 def knot_point(pf: PhaseFunction) -> ca.Function:

@@ -146,7 +146,7 @@ class PointDerivatives:
 
 #: :func:`library_key` by the point function (the transcriptions of one problem on other
 #: meshes call the same point functions: they are serialized and hashed once).
-_KEYS = IdentityCache(256)
+_KEYS = IdentityCache(32)
 
 
 def library_key(point: ca.Function, flags: tuple[str, ...] = POINT_FLAGS) -> str:
@@ -208,7 +208,7 @@ class _Group:
 
 
 #: The constraint rows of an ends function (:meth:`PointRecorder.ends`), by the function.
-_ROWS = IdentityCache()
+_ROWS = IdentityCache(8)
 
 
 @dataclass(frozen=True)
@@ -328,7 +328,7 @@ class IntervalDerivatives:
 #: serialized template: a template is derived once, whatever the mesh.
 _INTERVAL_DERIVATIVES: OrderedDict[str, IntervalDerivatives] = OrderedDict()
 #: How many derived templates :data:`_INTERVAL_DERIVATIVES` keeps (the newest).
-INTERVAL_CACHE_SIZE = 256
+INTERVAL_CACHE_SIZE = 64
 #: How many interval templates this process has derived (a test checks that a second mesh
 #: of a problem derives none).
 interval_derivations = 0
