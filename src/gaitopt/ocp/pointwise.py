@@ -565,6 +565,12 @@ class _Outer:
         V = ca.vertcat(*[ca.vec(ig.v) for ig in self.intervals])
         S = _selection(V, ca.vertcat(w, Y))
         self.S = S
+        rows, cols = (np.asarray(a, dtype=int) for a in S.sparsity().get_triplet())
+        self._pick: tuple[list[int], ca.DM] | None = None
+        if rows.size == S.shape[0] and np.array_equal(np.sort(rows), np.arange(rows.size)):
+            order = np.argsort(rows)
+            self._pick = (cols[order].tolist(),
+                          ca.DM(np.asarray(S.nonzeros(), dtype=float)[order]))
         S_w, S_Y = S[:, :nw], S[:, nw:]
         nR = int(R.shape[0])
         # The chain rule through the interval templates: every product of a block of their
@@ -619,7 +625,12 @@ class _Outer:
 
     def _inputs(self, W: ca.MX, Yv: ca.MX) -> list[ca.MX]:
         """The inputs v (nv, N) of each interval group."""
-        V = ca.mtimes(self.S, ca.vertcat(W, Yv))
+        U = ca.vertcat(W, Yv)
+        if self._pick is not None:  # a selection: indexing and scaling, not a product
+            cols, scale = self._pick
+            V = U[cols] * scale
+        else:
+            V = ca.mtimes(self.S, U)
         out, pos = [], 0
         for ig in self.intervals:
             nv, N = int(ig.v.shape[0]), int(ig.v.shape[1])
