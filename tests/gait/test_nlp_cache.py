@@ -113,9 +113,9 @@ def test_walking_interval_templates_give_the_derivatives_of_the_mesh(
     tr = transcribe(problem, method="hermite-simpson-separated", build_solver=False)
     before = pointwise.interval_derivations
     # The point functions compiled (once per model, shared with the other walking tests).
-    templates = tr.pointwise_nlp()
+    templates = tr.pointwise_nlp(interval_templates=True)
     whole = tr.pointwise_nlp(interval_templates=False)
-    tr.pointwise_nlp()  # a second build derives nothing
+    tr.pointwise_nlp(interval_templates=True)  # a second build derives nothing
     assert pointwise.interval_derivations - before <= len(problem.phases)
     rng = np.random.default_rng(7)
     w = tr.initial_guess() / tr.nlp.d_w * (1 + 0.01 * rng.standard_normal(tr.layout.size))

@@ -73,7 +73,10 @@ def solver_values(tr: Transcription, w: np.ndarray, lam: np.ndarray
 def test_point_derivatives_equal_those_of_the_expanded_nlp(
         make: object, compiled_points: bool, tmp_path: Path,
         monkeypatch: pytest.MonkeyPatch) -> None:
+    from gaitopt.ocp import pointwise
+
     monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    monkeypatch.setattr(pointwise, "TEMPLATE_MIN_INTERVALS", 0)  # the interval templates too
     if not compiled_points:
         monkeypatch.setattr(codegen, "has_compiler", lambda: False)
     problem = make()  # type: ignore[operator]
@@ -231,7 +234,7 @@ def test_interval_templates_give_the_outer_derivatives_of_the_mesh(make: object,
     # another order: 1e-12 relative).
     problem = make()  # type: ignore[operator]
     tr = transcribe(problem, method=method, build_solver=False)
-    templates = tr.pointwise_nlp(compile_c=False)
+    templates = tr.pointwise_nlp(compile_c=False, interval_templates=True)
     whole = tr.pointwise_nlp(compile_c=False, interval_templates=False)
     rng = np.random.default_rng(5)
     w = tr.initial_guess() / tr.nlp.d_w * (1 + 0.1 * rng.standard_normal(tr.layout.size))
@@ -248,11 +251,13 @@ def test_interval_templates_give_the_outer_derivatives_of_the_mesh(make: object,
     assert np.count_nonzero(np.array(expected["nlp_hess_l"][0].nonzeros())) > 0
 
 
-def test_another_mesh_derives_no_interval_template() -> None:
+def test_another_mesh_derives_no_interval_template(monkeypatch: pytest.MonkeyPatch) -> None:
     # A new mesh of a problem costs an evaluation of the derived interval functions, not a
     # derivation: the second transcription finds every template derived by the first (the
     # same function objects), and derives none.
     from gaitopt.ocp import pointwise
+
+    monkeypatch.setattr(pointwise, "TEMPLATE_MIN_INTERVALS", 0)  # templates on small meshes
 
     first = transcribe(nonlinear(intervals=4), method=SEPARATED, compiled="points",
                        build_solver=False)
@@ -273,6 +278,16 @@ def test_another_mesh_derives_no_interval_template() -> None:
     transcribe(other, method=SEPARATED, compiled="points", build_solver=False,
                intervals=7)
     assert pointwise.interval_derivations == before + 1
+    # Below the threshold the mesh's outer functions are derived: no template.
+    monkeypatch.setattr(pointwise, "TEMPLATE_MIN_INTERVALS", 8)
+    other = Problem([Phase("swing", ["q", "w"], ["tau"],
+                           lambda x, u, p, t: ca.vertcat(x[1], u[0]), 3.0,
+                           initial_state={"q": 0.0, "w": 0.0}, final_state={"q": 1.0},
+                           lagrange=lambda x, u, p, t: u[0] ** 2, intervals=3)])
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False)
+    assert pointwise.interval_derivations == before + 1
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False, intervals=8)
+    assert pointwise.interval_derivations == before + 2
 
 
 @pytest.mark.parametrize("selections", [True, False], ids=["selections", "general"])

@@ -81,6 +81,13 @@ LARGE_POINT = 1300
 def point_flags(point: ca.Function) -> tuple[str, ...]:
     """The compiler flags of ``point``'s library (by its number of instructions)."""
     return POINT_FLAGS if point.n_instructions() <= LARGE_POINT else LARGE_POINT_FLAGS
+#: The interval templates serve meshes of at least this many intervals (all phases): below,
+#: deriving the outer functions of the mesh is as cheap as building from the templates, and
+#: the templates' fixed cost per evaluation (more nodes and calls) outweighs it over a coarse
+#: stage's iterations (the five-link walk at 8 + 5 knots: the same build, ``nlp_hess_l``
+#: 0.71 against 0.43 ms; at 16 + 6: the same evaluations; at 40 + 10 and beyond builds 0.6-0.8
+#: of the derived ones; ``docs/results/benchmarks-gait.md``).
+TEMPLATE_MIN_INTERVALS = 24
 #: Version of the generated point libraries (part of their cache key): change it when the
 #: functions a library holds change.
 FORMAT = "gaitopt-points-1"

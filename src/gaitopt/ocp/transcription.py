@@ -143,13 +143,17 @@ class Transcription:
         if build_solver:
             self.solver(self.options)
 
-    def pointwise_nlp(self, *, interval_templates: bool = True, compile_c: bool = True
+    def pointwise_nlp(self, *, interval_templates: bool | None = None, compile_c: bool = True
                       ) -> PointwiseNlp:
         """The solver functions of ``compiled="points"`` (:mod:`gaitopt.ocp.pointwise`):
         with ``interval_templates`` the terms of the intervals come from functions of one
         interval derived once per process and mapped over the mesh, else they are derived
-        within the outer functions of this mesh (the same NLP; kept to check the first
-        against)."""
+        within the outer functions of this mesh (the same NLP). Default: templates on a mesh
+        of at least :data:`gaitopt.ocp.pointwise.TEMPLATE_MIN_INTERVALS` intervals, where
+        deriving costs more than the templates' fixed cost per evaluation."""
+        if interval_templates is None:
+            intervals = sum(pl.intervals for pl in self.layout.phases)
+            interval_templates = intervals >= pointwise.TEMPLATE_MIN_INTERVALS
         recorder = pointwise.PointRecorder()
         ends = self.functions[1]
         extra: dict[str, Any] = ({"interval_calls": recorder.intervals}
