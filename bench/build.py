@@ -182,32 +182,39 @@ def builds(variants: dict[str, Path], repeat: int, rounds: int) -> None:
                   f"{new[kind]:.3f} | {new[kind] / ref[kind]:.2f} |")
 
 
-def solves(variants: dict[str, Path], repeat: int) -> None:
-    """Whole ``gaitopt solve`` processes, reference against this branch."""
+def solves(variants: dict[str, Path], repeat: int, only: str = "") -> None:
+    """Whole ``gaitopt solve`` processes, reference against this branch, run alternately
+    (reference, this branch, reference, ...): the best of ``repeat`` each."""
     print()
     print("| solve | variant | wall s (best) | CPU s (best) | peak RSS MB | cost | "
           "stages: iterations | relative cost difference |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     with tempfile.TemporaryDirectory(prefix="gaitopt-build-") as tmp:
         for label, args in SOLVES:
-            costs = {}
-            for name, src in variants.items():
-                walls, cpus, peak, data = [], [], 0.0, {}
-                for r in range(repeat):
+            if only not in label:
+                continue
+            walls: dict[str, list[float]] = {name: [] for name in variants}
+            cpus: dict[str, list[float]] = {name: [] for name in variants}
+            peaks: dict[str, float] = dict.fromkeys(variants, 0.0)
+            data: dict[str, Any] = {}
+            for r in range(repeat):
+                for name, src in variants.items():
                     out = Path(tmp) / f"{name.replace(' ', '_')}-{r}.gait.json"
                     proc, wall, rss, cpu = run(src, "solve", *args, "-o", str(out))
                     if proc.returncode not in (0, 3):
                         raise RuntimeError(f"{label} {name} failed:\n{proc.stderr[-3000:]}")
-                    walls.append(wall)
-                    cpus.append(cpu)
-                    peak = max(peak, rss)
-                    data = json.loads(out.read_text())
-                costs[name] = data["cost"]["value"]
-                its = ",".join(str(s["iterations"]) for s in data["solver"]["stages"])
+                    walls[name].append(wall)
+                    cpus[name].append(cpu)
+                    peaks[name] = max(peaks[name], rss)
+                    data[name] = json.loads(out.read_text())
+            ref_cost = data["reference"]["cost"]["value"]
+            for name in variants:
+                cost = data[name]["cost"]["value"]
+                its = ",".join(str(st["iterations"]) for st in data[name]["solver"]["stages"])
                 diff = ("" if name == "reference" else
-                        f"{abs(costs[name] - costs['reference']) / abs(costs['reference']):.1e}")
-                print(f"| {label} | {name} | {min(walls):.2f} | {min(cpus):.2f} | {peak:.0f} | "
-                      f"{costs[name]:.6f} | {its} | {diff} |", flush=True)
+                        f"{abs(cost - ref_cost) / abs(ref_cost):.1e}")
+                print(f"| {label} | {name} | {min(walls[name]):.2f} | {min(cpus[name]):.2f} | "
+                      f"{peaks[name]:.0f} | {cost:.6f} | {its} | {diff} |", flush=True)
 
 
 def main() -> None:
@@ -221,6 +228,8 @@ def main() -> None:
                         help="also time whole gaitopt solve processes")
     parser.add_argument("--solve-repeat", type=int, default=2)
     parser.add_argument("--no-builds", action="store_true")
+    parser.add_argument("--only-solves", default="",
+                        help="only the solves whose label contains this text")
     args = parser.parse_args()
     if args.child:
         meshes = [tuple(int(k) for k in m.split(",")) for m in args.child[1:]]
@@ -238,7 +247,7 @@ def main() -> None:
         if not args.no_builds:
             builds(variants, args.repeat, args.rounds)
         if args.solves:
-            solves(variants, args.solve_repeat)
+            solves(variants, args.solve_repeat, args.only_solves)
 
 
 if __name__ == "__main__":
