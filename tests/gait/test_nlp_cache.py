@@ -92,3 +92,41 @@ def test_compiled_walking_nlp_is_the_point_derivatives_or_refused() -> None:
     assert transcriptions.evaluation_mode(OPTIONS, None) is None
     with pytest.raises(GaitOptionsError, match="compiled: the 'hermite-simpson' NLP"):
         gait_solve.solve_walking(load_model("five-link"), OPTIONS, compiled="codegen")
+
+
+@pytest.mark.parametrize(("model_name", "knots"), [("five-link", (5, 4)),
+                                                   ("seven-link", (6, 4))])
+def test_walking_interval_templates_give_the_derivatives_of_the_mesh(
+        model_name: str, knots: tuple[int, int]) -> None:
+    # The walking NLP's outer derivatives from interval functions derived once per process
+    # (the default of compiled="points") against those derived within this mesh's outer
+    # functions: the same sparsity and values at a point near the naive guess (the terms
+    # summed in another order: 1e-12 relative). The seven-link heel-toe walk has four
+    # phases, knot states and durations that are expressions of the parameters.
+    from gaitopt.gait.formulation import problem_for
+    from gaitopt.gait.model_defaults import options_for_model
+    from gaitopt.ocp import pointwise, transcribe
+
+    model = load_model(model_name)
+    options = options_for_model(model, GaitOptions(knots=knots))
+    problem = problem_for(model, options)
+    tr = transcribe(problem, method="hermite-simpson-separated", build_solver=False)
+    before = pointwise.interval_derivations
+    # The point functions compiled (once per model, shared with the other walking tests).
+    templates = tr.pointwise_nlp(interval_templates=True)
+    whole = tr.pointwise_nlp(interval_templates=False)
+    tr.pointwise_nlp(interval_templates=True)  # a second build derives nothing
+    assert pointwise.interval_derivations - before <= len(problem.phases)
+    rng = np.random.default_rng(7)
+    w = tr.initial_guess() / tr.nlp.d_w * (1 + 0.01 * rng.standard_normal(tr.layout.size))
+    lam = rng.standard_normal(tr.nlp.lbg.size)
+    for kind, fn in whole.functions.items():
+        args = [w, []] + ([0.7, lam] if kind == "nlp_hess_l" else [])
+        expected, got = fn(*args), templates.functions[kind](*args)
+        for e, g in zip(*[r if isinstance(r, list | tuple) else [r] for r in (expected, got)],
+                        strict=True):
+            assert g.sparsity() == e.sparsity(), kind
+            e_nz, g_nz = np.array(e.nonzeros()), np.array(g.nonzeros())
+            assert np.all(np.isfinite(e_nz)), kind
+            assert np.max(np.abs(g_nz - e_nz), initial=0.0) <= 1e-12 * max(
+                1.0, np.max(np.abs(e_nz), initial=0.0)), kind

@@ -29,11 +29,12 @@ from gaitopt.ocp.solver import EVAL_KINDS
 SEPARATED = "hermite-simpson-separated"
 
 
-def nonlinear(gain: float = 1.0, intervals: int = 5) -> Problem:
+def nonlinear(gain: float = 1.0, intervals: int = 5, rate: float = 0.0) -> Problem:
     """A pendulum-like phase whose dynamics, path constraint and integrand depend nonlinearly
     on the states, controls, time and parameters, with a duration that is a nonlinear
     expression of a free parameter (so the knot times are nonlinear in w): every term of the
-    chain rule (outer, cross, point and time Hessians) is nonzero."""
+    chain rule (outer, cross, point and time Hessians) is nonzero. ``rate``: the weight of a
+    control-rate term (``r int tau'^2 dt``, with 1 / h of the duration expression)."""
     def f(x: ca.SX, u: ca.SX, p: ca.SX, t: ca.SX) -> ca.SX:
         return ca.vertcat(x[1] * p[0], -gain * ca.sin(x[0]) * p[1] + u[0] * ca.cos(t * x[0]))
 
@@ -44,7 +45,8 @@ def nonlinear(gain: float = 1.0, intervals: int = 5) -> Problem:
                   path_constraints=[PathConstraint("reach", lambda x, u, p, t:
                                                    x[0] * x[1] + ca.exp(0.1 * u[0] * t),
                                                    lower=-5.0, upper=5.0)],
-                  intervals=intervals)
+                  intervals=intervals,
+                  control_rate_weights={"tau": rate} if rate else {})
     return Problem([swing], parameters=[Parameter("a", 0.5, 2.0, guess=1.0),
                                         Parameter("b", 1.0, 1.0)])
 
@@ -64,13 +66,17 @@ def solver_values(tr: Transcription, w: np.ndarray, lam: np.ndarray
 
 
 @pytest.mark.parametrize("make", [nonlinear, lambda: P.periodic_ratio(intervals=4),
-                                  lambda: P.brachistochrone(intervals=6)],
-                         ids=["nonlinear", "periodic_ratio", "brachistochrone"])
+                                  lambda: P.brachistochrone(intervals=6),
+                                  lambda: nonlinear(rate=0.3)],
+                         ids=["nonlinear", "periodic_ratio", "brachistochrone", "control_rate"])
 @pytest.mark.parametrize("compiled_points", [True, False], ids=["compiled", "vm"])
 def test_point_derivatives_equal_those_of_the_expanded_nlp(
         make: object, compiled_points: bool, tmp_path: Path,
         monkeypatch: pytest.MonkeyPatch) -> None:
+    from gaitopt.ocp import pointwise
+
     monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    monkeypatch.setattr(pointwise, "TEMPLATE_MIN_INTERVALS", 0)  # the interval templates too
     if not compiled_points:
         monkeypatch.setattr(codegen, "has_compiler", lambda: False)
     problem = make()  # type: ignore[operator]
@@ -196,3 +202,132 @@ def test_large_point_functions_compile_with_the_fast_flags() -> None:
     assert small.n_instructions() <= LARGE_POINT < big.n_instructions()
     assert point_flags(small) == POINT_FLAGS and "-O1" in POINT_FLAGS
     assert point_flags(big) == LARGE_POINT_FLAGS and "-O0" in LARGE_POINT_FLAGS
+
+
+def _functions_values(nlp: object, w: np.ndarray, lam: np.ndarray
+                      ) -> dict[str, list[ca.DM]]:
+    """Every function of a :class:`~gaitopt.ocp.pointwise.PointwiseNlp` at scaled ``w``."""
+    out = {}
+    for kind, fn in nlp.functions.items():  # type: ignore[attr-defined]
+        args = [w, []] + ([0.7, lam] if kind == "nlp_hess_l" else [])
+        res = fn(*args)
+        out[kind] = [ca.DM(r) for r in (res if isinstance(res, list | tuple) else [res])]
+    return out
+
+
+def _knot_states_problem() -> Problem:
+    from test_knot_states import rest_to_rest
+
+    return rest_to_rest(given=True, ends_read_z=True)
+
+
+@pytest.mark.parametrize(("make", "method"), [
+    (nonlinear, SEPARATED), (lambda: nonlinear(rate=0.3), SEPARATED),
+    (lambda: P.periodic_ratio(intervals=4), SEPARATED),
+    (lambda: P.two_phase_jump(intervals=3), SEPARATED), (_knot_states_problem, SEPARATED),
+    # Trapezoidal (no midpoints) where it is point-wise: no path constraints at midpoints.
+    (lambda: P.periodic_ratio(intervals=4), "trapezoidal"),
+    (_knot_states_problem, "trapezoidal")],
+    ids=["nonlinear", "control_rate", "periodic_ratio", "two_phase_jump", "knot_states",
+         "trapezoidal-periodic_ratio", "trapezoidal-knot_states"])
+def test_interval_templates_give_the_outer_derivatives_of_the_mesh(make: object,
+                                                                   method: str) -> None:
+    # The terms of the intervals from one function of an interval, derived once and mapped
+    # (the default), against the same terms derived within the outer functions of this mesh:
+    # the same sparsity and values at a random point (one function's derivatives summed in
+    # another order: 1e-12 relative).
+    problem = make()  # type: ignore[operator]
+    tr = transcribe(problem, method=method, build_solver=False)
+    templates = tr.pointwise_nlp(compile_c=False, interval_templates=True)
+    whole = tr.pointwise_nlp(compile_c=False, interval_templates=False)
+    rng = np.random.default_rng(5)
+    w = tr.initial_guess() / tr.nlp.d_w * (1 + 0.1 * rng.standard_normal(tr.layout.size))
+    w += 0.05 * rng.standard_normal(w.size)
+    lam = rng.standard_normal(tr.nlp.lbg.size)
+    got, expected = _functions_values(templates, w, lam), _functions_values(whole, w, lam)
+    for kind in expected:
+        for e, g in zip(expected[kind], got[kind], strict=True):
+            assert g.sparsity() == e.sparsity(), kind
+            e_nz, g_nz = np.array(e.nonzeros()), np.array(g.nonzeros())
+            assert np.all(np.isfinite(e_nz)), kind
+            assert np.max(np.abs(g_nz - e_nz), initial=0.0) <= 1e-12 * max(
+                1.0, np.max(np.abs(e_nz), initial=0.0)), kind
+    assert np.count_nonzero(np.array(expected["nlp_hess_l"][0].nonzeros())) > 0
+
+
+def test_another_mesh_derives_no_interval_template(monkeypatch: pytest.MonkeyPatch) -> None:
+    # A new mesh of a problem costs an evaluation of the derived interval functions, not a
+    # derivation: the second transcription finds every template derived by the first (the
+    # same function objects), and derives none.
+    from gaitopt.ocp import pointwise
+
+    monkeypatch.setattr(pointwise, "TEMPLATE_MIN_INTERVALS", 0)  # templates on small meshes
+
+    first = transcribe(nonlinear(intervals=4), method=SEPARATED, compiled="points",
+                       build_solver=False)
+    before = pointwise.interval_derivations
+    derived = dict(pointwise._INTERVAL_DERIVATIVES)
+    second = transcribe(nonlinear(intervals=11), method=SEPARATED, compiled="points",
+                        build_solver=False, functions=first.functions)
+    assert pointwise.interval_derivations == before
+    assert dict(pointwise._INTERVAL_DERIVATIVES) == derived
+    assert second.solve().success
+    # A template of another form (another duration) is derived once, then found again.
+    other = Problem([Phase("swing", ["q", "w"], ["tau"],
+                           lambda x, u, p, t: ca.vertcat(x[1], u[0]), 2.0,
+                           initial_state={"q": 0.0, "w": 0.0}, final_state={"q": 1.0},
+                           lagrange=lambda x, u, p, t: u[0] ** 2, intervals=3)])
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False)
+    assert pointwise.interval_derivations == before + 1
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False,
+               intervals=7)
+    assert pointwise.interval_derivations == before + 1
+    # Below the threshold the mesh's outer functions are derived: no template.
+    monkeypatch.setattr(pointwise, "TEMPLATE_MIN_INTERVALS", 8)
+    other = Problem([Phase("swing", ["q", "w"], ["tau"],
+                           lambda x, u, p, t: ca.vertcat(x[1], u[0]), 3.0,
+                           initial_state={"q": 0.0, "w": 0.0}, final_state={"q": 1.0},
+                           lagrange=lambda x, u, p, t: u[0] ** 2, intervals=3)])
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False)
+    assert pointwise.interval_derivations == before + 1
+    transcribe(other, method=SEPARATED, compiled="points", build_solver=False, intervals=8)
+    assert pointwise.interval_derivations == before + 2
+
+
+@pytest.mark.parametrize("selections", [True, False], ids=["selections", "general"])
+def test_scatter_is_the_product_with_constant_matrices(selections: bool) -> None:
+    # C1 B C2 as a constant map of B's nonzeros (repeated columns of C2: entries that add up).
+    from gaitopt.ocp.pointwise import _Scatter
+
+    rng = np.random.default_rng(2)
+    block = ca.Sparsity.triplet(4, 5, [0, 1, 3, 2, 0, 3], [0, 1, 1, 3, 4, 4])
+    if selections:
+        C1 = ca.DM.triplet([0, 2, 1], [0, 1, 3], [2.0, -1.0, 0.5], 3, 4)
+        C2 = ca.DM.triplet([0, 1, 3, 4], [2, 0, 2, 1], [1.0, 3.0, -2.0, 1.5], 5, 3)
+    else:
+        C1 = ca.DM(rng.standard_normal((3, 4)))
+        C2 = ca.DM(rng.standard_normal((5, 3)))
+    values = rng.standard_normal(block.nnz())
+    scatter = _Scatter(C1, block, C2)
+    got = ca.Function("f", [x := ca.MX.sym("x", block.nnz())], [scatter(x)])(values)
+    expected = ca.mtimes([C1, ca.DM(block, values), C2])
+    assert np.allclose(np.array(ca.densify(got)), np.array(ca.densify(expected)),
+                       rtol=1e-14, atol=1e-14)
+
+
+def test_identity_cache_finds_the_same_objects_and_keeps_the_newest() -> None:
+    from gaitopt.ocp.functions import IdentityCache
+
+    cache = IdentityCache(2)
+    made: list[int] = []
+
+    def make(value: int) -> object:
+        return lambda: made.append(value) or value
+
+    a, b = object(), object()
+    assert cache.get(("x", a), make(1)) == 1
+    assert cache.get(("x", a), make(2)) == 1          # the same object: found
+    assert cache.get(("y", a), make(3)) == 3          # another key
+    assert cache.get(("x", b), make(4)) == 4          # another object: made (evicts x, a)
+    assert cache.get(("x", a), make(5)) == 5
+    assert made == [1, 3, 4, 5]

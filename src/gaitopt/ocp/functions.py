@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -216,11 +217,46 @@ def with_knot_states(pf: PhaseFunction, x: Any, values: Any) -> Any:
                         for r in range(int(x.shape[0]))])
 
 
+class IdentityCache:
+    """Values made from some objects, found again by the objects' identity (the cache keeps
+    them alive, so an identity is not reused while its entry lives): the newest ``size``
+    entries. The transcriptions of one problem on other meshes share its functions, so the
+    functions made from them are made, and hashed, once."""
+
+    def __init__(self, size: int = 16) -> None:
+        self.size = size
+        self._items: OrderedDict[tuple[Any, ...], tuple[tuple[Any, ...], Any]] = OrderedDict()
+
+    def get(self, objects: tuple[Any, ...], make: Callable[[], Any]) -> Any:
+        """The value for ``objects`` (compared by identity), made by ``make`` if missing."""
+        plain = int | str | float | tuple
+        key = tuple(o if isinstance(o, plain) else id(o) for o in objects)
+        hit = self._items.get(key)
+        if hit is not None and all(a == b if isinstance(b, plain) else a is b
+                                   for a, b in zip(hit[0], objects, strict=True)):
+            self._items.move_to_end(key)
+            return hit[1]
+        value = make()
+        self._items[key] = (objects, value)
+        while len(self._items) > self.size:
+            self._items.popitem(last=False)
+        return value
+
+
+#: The knot-state point functions made from a problem's functions: a few problems' worth
+#: (an entry keeps the problem's phase functions alive).
+_MADE = IdentityCache(16)
+
+
 def knot_point(pf: PhaseFunction) -> ca.Function:
     """The point function of a phase with knot states at its knots after the first, on the
     state variables: ``(x (n,1), u, p, t) -> (xdot, path, lagrange, values (d,1))`` where
     ``values = knot_states(x, p)`` replace the rows ``knot_state_rows`` of ``x`` before the
     point function is evaluated (they do not depend on those rows) and are returned too."""
+    return _MADE.get(("knot_point", pf), lambda: _knot_point(pf))
+
+
+def _knot_point(pf: PhaseFunction) -> ca.Function:
     assert pf.knot_states is not None
     point = pf.point
     x = ca.SX.sym("x", point.size1_in(0))
@@ -237,6 +273,12 @@ def ends_with_knot_states(fn: ca.Function, phases: Sequence[tuple[int, PhaseFunc
     variables: for each ``(start, pf)`` in ``phases``, the knot states of ``pf`` replace their
     rows of the final state at ``E[start:start + n]`` (computed from it and ``p``) before
     ``fn`` is evaluated."""
+    key = ("ends", fn, *[(start, id(pf)) for start, pf in phases], *[pf for _, pf in phases])
+    return _MADE.get(key, lambda: _ends_with_knot_states(fn, phases))
+
+
+def _ends_with_knot_states(fn: ca.Function, phases: Sequence[tuple[int, PhaseFunction]]
+                           ) -> ca.Function:
     E = ca.SX.sym("E", fn.size1_in(0))
     p = ca.SX.sym("p", fn.size1_in(1))
     placed = E

@@ -18,6 +18,7 @@ The NLP handed to the solver is ``min J / objective_scale`` over ``w_hat = w / d
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -130,6 +131,72 @@ def called_ends(fn: ca.Function, E: Any, p: Any) -> list[Any]:
 
 
 @dataclass(frozen=True)
+class IntervalInputs:
+    """What the terms of a phase's N intervals read (columns per interval): the knot states
+    ``x_k, x_k1`` (n, N; the knot states of :class:`~gaitopt.ocp.problem.KnotStates` in
+    place), the midpoint states ``xm`` (n, N; the separated form, else None), the dynamics
+    ``f_k, f_k1, f_m`` and the integrand ``l_k, l_k1, l_m`` (1, N) at the knots and midpoints
+    (``f_m``, ``l_m`` None where the method has no midpoints), the phase duration ``T``, and
+    ``dtau`` (1, N), the normalised interval lengths (constants: h = T dtau).
+
+    ``u_k, u_k1`` (m, N) are the knot controls and ``rates`` the weights of the control-rate
+    term (:attr:`~gaitopt.ocp.problem.Phase.control_rate_weights`, a constant (m, 1); None
+    without the term, and then the controls are not read).
+
+    ``t_source`` (s, 1) and ``t_of`` give the duration as a function of a few entries of w:
+    ``t_of(t_source)`` is ``T`` (the duration variable itself, the parameters of a duration
+    expression, or nothing for a fixed duration), so that the terms of one interval are a
+    function of a selection of w and of the point outputs (:mod:`gaitopt.ocp.pointwise`
+    derives that function once and maps it over the intervals)."""
+
+    method: Method
+    x_k: Any
+    x_k1: Any
+    xm: Any
+    f_k: Any
+    f_k1: Any
+    f_m: Any
+    l_k: Any
+    l_k1: Any
+    l_m: Any
+    T: Any
+    dtau: ca.DM
+    t_source: Any
+    t_of: Callable[[Any], Any]
+    u_k: Any = None
+    u_k1: Any = None
+    rates: ca.DM | None = None
+
+
+def interval_terms(inp: IntervalInputs, T: Any, dtau: Any) -> tuple[Any, Any, Any]:
+    """The defects (n, N), the midpoint defects (n, N; None without midpoint variables) and
+    the cost of each interval (1, N): the quadrature of the integrand plus the control-rate
+    term, for the intervals of ``inp`` with duration ``T`` and normalised interval lengths
+    ``dtau`` (1, N)."""
+    h = T * dtau
+    Hn = ca.repmat(h, int(inp.x_k.shape[0]), 1)
+    method = inp.method
+    mid_defects = (None if inp.xm is None else
+                   inp.xm - method.midpoint_state(inp.x_k, inp.x_k1, inp.f_k, inp.f_k1, Hn))
+    defects = method.defects(inp.x_k, inp.x_k1, inp.f_k, inp.f_k1, inp.f_m, Hn)
+    cost = method.quadrature(inp.l_k, inp.l_k1, inp.l_m, h)
+    if inp.rates is not None:
+        cost = cost + control_rates(inp.rates, inp.u_k, inp.u_k1, h)
+    return defects, mid_defects, cost
+
+
+#: How the terms of a phase's intervals are evaluated: ``(i, inputs) -> (defects,
+#: midpoint defects or None, quadrature (1, N))``. The default computes them
+#: (:func:`direct_intervals`); :mod:`gaitopt.ocp.pointwise` substitutes symbols instead.
+IntervalCalls = Callable[[int, IntervalInputs], tuple[Any, Any, Any]]
+
+
+def direct_intervals(i: int, inp: IntervalInputs) -> tuple[Any, Any, Any]:
+    """The terms of the intervals as expressions (:func:`interval_terms`)."""
+    return interval_terms(inp, inp.T, inp.dtau)
+
+
+@dataclass(frozen=True)
 class Assembly:
     """The NLP expressions in the symbol type they were built with (MX or SX)."""
 
@@ -174,8 +241,8 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
                          phase_fns: tuple[PhaseFunction, ...], ends_fn: EndsFunction,
                          d_w: Array, state_scales: tuple[Array, ...], *,
                          symbols: Any = ca.MX, point_calls: PointCalls = mapped_points,
-                         ends_call: EndsCall = called_ends, fold_knot_states: bool = False
-                         ) -> Assembly:
+                         ends_call: EndsCall = called_ends, fold_knot_states: bool = False,
+                         interval_calls: IntervalCalls = direct_intervals) -> Assembly:
     """The scaled objective and constraints as expressions of ``w_hat`` (a ``symbols``
     symbol: ``ca.MX`` or ``ca.SX``), the point functions evaluated by ``point_calls`` and the
     ends function by ``ends_call``.
@@ -205,12 +272,16 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
                                               strict=True)):
         spec = ph.duration_spec()
         n, K, N = ph.n_states, pl.knots, pl.intervals
+        t_of: Callable[[Any], Any]
         if spec.kind == "expression":
             T = durations_expr[i]
+            t_source, t_of = p, functools.partial(_duration_of, ends_fn.durations, i)
         elif pl.duration_index is not None:
             T = w[pl.duration_index]
+            t_source, t_of = T, _itself
         else:
             T = sym(spec.lower)
+            t_source, t_of = sym(0, 1), functools.partial(_constant, sym, float(spec.lower))
         durations.append(T)
         Z = ca.reshape(w[pl.knot_block()], pl.stride, K)
         X, U = Z[:n, :], Z[n:, :]
@@ -223,10 +294,7 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
         tk = t_start + T * ca.DM(tau).T
         tm = t_start + T * ca.DM(0.5 * (tau[:-1] + tau[1:])).T
         dtau = ca.DM(np.diff(tau)).T
-        h = T * dtau
-        Hn = ca.repmat(h, n, 1)
         Um = midpoint_control(U[:, :-1], U[:, 1:])
-        mid_defects = None
         f_m = L_m = None
         # Separated form: one call of the point function per knot and per midpoint, all in
         # one map, at the variable midpoint states (no dynamics nested in dynamics).
@@ -245,12 +313,13 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
             f_m, Cm, L_m = XD[:, K:], C[:, K:], L[:, K:]
             XD, C, L = XD[:, :K], C[:, :K], L[:, :K]
         x_k, x_k1, f_k, f_k1 = X[:, :-1], X[:, 1:], XD[:, :-1], XD[:, 1:]
-        if Xm is not None:
-            mid_defects = Xm - method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
-        elif method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0:
-            Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, Hn)
+        x_mid = Xm
+        if Xm is None and (method.needs_midpoint_dynamics or pf.midpoint_rows.size > 0):
+            Xm = method.midpoint_state(x_k, x_k1, f_k, f_k1, ca.repmat(T * dtau, n, 1))
             f_m, Cm, L_m = point_calls(i, pf.point, Xm, Um, p, tm)
-        defects = method.defects(x_k, x_k1, f_k, f_k1, f_m, Hn)
+        defects, mid_defects, quadrature = interval_calls(i, IntervalInputs(
+            method, x_k, x_k1, x_mid, f_k, f_k1, f_m, L[:, :-1], L[:, 1:], L_m, T, dtau,
+            t_source, t_of, U[:, :-1], U[:, 1:], rate_weights(ph)))
         dx = state_scales[i]
         rows.add(f"{ph.name}/defects", ph.name, "defects", flat(defects), (N, n),
                  np.zeros(N * n), np.zeros(N * n), np.tile(dx, N))
@@ -271,8 +340,7 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
             sc = max(abs(v) for v in (spec.lower, spec.upper) if math.isfinite(v)) or 1.0
             rows.add(f"{ph.name}/duration", ph.name, "duration", ca.reshape(T, 1, 1), (1,),
                      np.array([spec.lower]), np.array([spec.upper]), np.array([sc]))
-        numerator = numerator + ca.sum2(method.quadrature(L[:, :-1], L[:, 1:], L_m, h))
-        numerator = numerator + control_rate_term(ph, U, h)
+        numerator = numerator + ca.sum2(quadrature)
         t_end = t_start + T
         if fold:  # the ends function computes the last knot's knot states itself
             folded_ends.append((ends_fn.ends_offsets[i] + 2 + n, pf))
@@ -303,16 +371,41 @@ def assemble_expressions(problem: Problem, method: Method, mesh: Mesh, layout: L
                     ca.vertcat(*dependent_values) if dependent_values else sym(0, 1))
 
 
+def _duration_of(durations: ca.Function, i: int, p: Any) -> Any:
+    """Phase ``i``'s duration from the parameters ``p``."""
+    return durations(p)[i]
+
+
+def _itself(x: Any) -> Any:
+    return x
+
+
+def _constant(sym: Any, value: float, _: Any) -> Any:
+    return sym(value)
+
+
 def control_rate_term(phase: Phase, U: Any, h: Any) -> Any:
     """``sum_j r_j sum_k (U[j, k+1] - U[j, k])^2 / h_k``: the exact ``sum_j r_j int u_j'^2 dt``
     of the piecewise-linear controls ``U`` (m, K) on intervals ``h`` (1, K - 1)
     (:attr:`~gaitopt.ocp.problem.Phase.control_rate_weights`); 0 without weights."""
-    weights = phase.control_rate_weights
-    if not weights or U.shape[1] < 2:
+    r = rate_weights(phase)
+    if r is None or U.shape[1] < 2:
         return 0.0
-    r = ca.DM([float(weights.get(name, 0.0)) for name in phase.controls])
-    dU = U[:, 1:] - U[:, :-1]
-    return ca.sum2(ca.mtimes(r.T, dU * dU) / h)
+    return ca.sum2(control_rates(r, U[:, :-1], U[:, 1:], h))
+
+
+def rate_weights(phase: Phase) -> ca.DM | None:
+    """The weights of the control-rate term by control (m, 1), None without weights."""
+    weights = phase.control_rate_weights
+    if not weights:
+        return None
+    return ca.DM([float(weights.get(name, 0.0)) for name in phase.controls])
+
+
+def control_rates(r: ca.DM, u_k: Any, u_k1: Any, h: Any) -> Any:
+    """The control-rate term of each interval, ``r^T (u_k1 - u_k)^2 / h`` (1, N)."""
+    dU = u_k1 - u_k
+    return ca.mtimes(r.T, dU * dU) / h
 
 
 def _folded_knots(i: int, pf: PhaseFunction, pl: PhaseLayout, X: Any, U: Any, p: Any,

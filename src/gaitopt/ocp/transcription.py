@@ -117,6 +117,7 @@ class Transcription:
         self.functions: tuple[tuple[PhaseFunction, ...], EndsFunction] = (
             self.phase_functions, ends)
         d_w = variable_scales(problem, self.layout, scaling)
+        self._state_scales = sx
         self.nlp: Nlp = assemble(problem, METHODS[method], mesh, self.layout,
                                  self.phase_functions, ends, d_w, sx)
         self.midpoint_bounds = midpoint_bounds
@@ -132,12 +133,7 @@ class Transcription:
                                    f"dynamics at single grid points (hermite-simpson-separated,"
                                    f" or trapezoidal without midpoint path constraints), not "
                                    f"{method!r}")
-            recorder = pointwise.PointRecorder()
-            outer = assemble_expressions(problem, METHODS[method], mesh, self.layout,
-                                         self.phase_functions, ends, d_w, sx, symbols=ca.SX,
-                                         point_calls=recorder, ends_call=recorder.ends,
-                                         fold_knot_states=True)
-            self._pointwise = pointwise.build_pointwise(outer, recorder.groups, compile_c=True)
+            self._pointwise = self.pointwise_nlp()
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, False)
         else:
             self._symbols = nlp_symbols(self.nlp.w_hat, self.nlp.f, self.nlp.g, self.expand)
@@ -146,6 +142,28 @@ class Transcription:
         self._solvers: dict[str, tuple[ca.Function, bool]] = {}
         if build_solver:
             self.solver(self.options)
+
+    def pointwise_nlp(self, *, interval_templates: bool | None = None, compile_c: bool = True
+                      ) -> PointwiseNlp:
+        """The solver functions of ``compiled="points"`` (:mod:`gaitopt.ocp.pointwise`):
+        with ``interval_templates`` the terms of the intervals come from functions of one
+        interval derived once per process and mapped over the mesh, else they are derived
+        within the outer functions of this mesh (the same NLP). Default: templates on a mesh
+        of at least :data:`gaitopt.ocp.pointwise.TEMPLATE_MIN_INTERVALS` intervals, where
+        deriving costs more than the templates' fixed cost per evaluation."""
+        if interval_templates is None:
+            intervals = sum(pl.intervals for pl in self.layout.phases)
+            interval_templates = intervals >= pointwise.TEMPLATE_MIN_INTERVALS
+        recorder = pointwise.PointRecorder()
+        ends = self.functions[1]
+        extra: dict[str, Any] = ({"interval_calls": recorder.intervals}
+                                 if interval_templates else {})
+        outer = assemble_expressions(self.problem, METHODS[self.method], self.mesh,
+                                     self.layout, self.phase_functions, ends, self.nlp.d_w,
+                                     self._state_scales, symbols=ca.SX, point_calls=recorder,
+                                     ends_call=recorder.ends, fold_knot_states=True, **extra)
+        return pointwise.build_pointwise(outer, recorder.groups, compile_c=compile_c,
+                                         intervals=recorder.interval_groups)
 
     # -- solvers ---------------------------------------------------------------------------
     def solver(self, options: Mapping[str, Any]) -> ca.Function:
