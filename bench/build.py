@@ -5,7 +5,7 @@ not a derivation. For each model and mesh this measures, in fresh processes of t
 for this branch's sources and one for the reference revision's (``--reference``, default
 ``main``: its ``src`` extracted with ``git archive``, the same interpreter and packages):
 
-* ``build``: :func:`gaitopt.gait.transcriptions.transcription_for` of the walking problem on
+* ``build``: :func:`gaitopt.gait.solve.transcriptions.transcription_for` of the walking problem on
   the mesh plus its IPOPT solver, in a process that has already built another grid of the
   same problem (the symbolic functions and the compiled point libraries loaded, as in a
   staged solve or a refinement round); best of ``--repeat``;
@@ -56,9 +56,9 @@ SOLVES: list[tuple[str, list[str]]] = [
 def child(model_name: str, meshes: list[tuple[int, int]], repeat: int) -> dict[str, Any]:
     """In a fresh process: build the first mesh (warm-up), then each other mesh ``repeat``
     times (the transcription cache emptied in between); the best times and the peak RSS."""
-    from gaitopt.gait import transcriptions
-    from gaitopt.gait.model_defaults import options_for_model
-    from gaitopt.gait.options import GaitOptions
+    from gaitopt.gait.options.gait_options import GaitOptions
+    from gaitopt.gait.options.model_defaults import options_for_model
+    from gaitopt.gait.solve import transcriptions
     from gaitopt.process_memory import peak_resident_bytes
     from gaitopt.robot import load_model
 

@@ -69,7 +69,8 @@ def test_flat_foot_dynamics_solve_the_kkt_system(seven: RobotModel) -> None:
         m = pin.crba(pm, pd, P(q))
         m = back(np.triu(m) + np.triu(m, 1).T)
         # Pinocchio has no joint damping: the model's (the ankles') is added as D qd.
-        h = back(pin.nonLinearEffects(pm, pd, P(q), P(qd))) + np.asarray(seven.coordinate_damping) * qd
+        h = back(pin.nonLinearEffects(pm, pd, P(q), P(qd)))
+        h = h + np.asarray(seven.coordinate_damping) * qd
         pin.computeJointJacobians(pm, pd, P(q))
         pin.forwardKinematics(pm, pd, P(q), P(qd), np.zeros(seven.nq))
         pin.updateFramePlacements(pm, pd)

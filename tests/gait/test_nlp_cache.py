@@ -103,8 +103,8 @@ def test_walking_interval_templates_give_the_derivatives_of_the_mesh(
     # functions: the same sparsity and values at a point near the naive guess (the terms
     # summed in another order: 1e-12 relative). The seven-link heel-toe walk has four
     # phases, knot states and durations that are expressions of the parameters.
-    from gaitopt.gait.formulation import problem_for
-    from gaitopt.gait.model_defaults import options_for_model
+    from gaitopt.gait.formulations.select import problem_for
+    from gaitopt.gait.options.model_defaults import options_for_model
     from gaitopt.ocp import pointwise, transcribe
 
     model = load_model(model_name)
