@@ -28,9 +28,9 @@ from pathlib import Path
 from typing import Any
 
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
-from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from gait_grid import load_average  # noqa: E402  (the five-link grid's helpers)
@@ -59,12 +59,12 @@ def solve_point(model: str, base: GaitOptions, variant: str, speed_m_min: float 
     options = base.replace(impulse=VARIANTS[variant],
                            speed=None if speed_m_min is None else speed_m_min / 60.0)
     start = time.perf_counter()
-    solution = solve_gait_solution(model, options)
+    solution = solve_staged_run(model, options)
     wall = time.perf_counter() - start
     nan = math.nan
     status = solution.result.status
     try:
-        gait = gait_from_solution(solution) if solution.success else None
+        gait = gait_from_run(solution) if solution.success else None
     except MotionOutOfReachError:
         gait, status = None, "motion out of reach between knots"
     verdict = "-"

@@ -29,9 +29,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from gait_grid import VARIANTS, load_average, verify_summary  # noqa: E402
 
-from gaitopt.gait.api import solve_gait_solution  # noqa: E402
+from gaitopt.gait.api import solve_staged_run  # noqa: E402
 from gaitopt.gait.options.gait_options import GaitOptions  # noqa: E402
-from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution  # noqa: E402
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run  # noqa: E402
 
 FORMS = ("hermite-simpson", "hermite-simpson-separated")
 SHORT_FORM = {"hermite-simpson": "compressed", "hermite-simpson-separated": "separated"}
@@ -58,10 +58,10 @@ def solve(variant: str, speed_m_min: float, knots: tuple[int, int], form: str,
                           transcription=form,  # type: ignore[arg-type]
                           **VARIANTS[variant])
     start = time.perf_counter()
-    solution = solve_gait_solution("five-link", options)
+    solution = solve_staged_run("five-link", options)
     wall = time.perf_counter() - start
     try:
-        gait = gait_from_solution(solution) if solution.success else None
+        gait = gait_from_run(solution) if solution.success else None
     except MotionOutOfReachError:
         gait = None
     nan = float("nan")

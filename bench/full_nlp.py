@@ -52,13 +52,13 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import gaitopt.ocp.transcription as transcription  # noqa: E402
-from gaitopt.gait.api import solve_gait_solution  # noqa: E402
+from gaitopt.gait.api import solve_staged_run  # noqa: E402
 from gaitopt.gait.formulations.full import problem as full  # noqa: E402
 from gaitopt.gait.formulations.full.problem import HELD, STEP_LENGTH  # noqa: E402
 from gaitopt.gait.options.gait_options import GaitOptions  # noqa: E402
 from gaitopt.gait.record.file import Gait  # noqa: E402
 from gaitopt.gait.solve import transcriptions  # noqa: E402
-from gaitopt.gait.solve.record import gait_from_solution  # noqa: E402
+from gaitopt.gait.solve.record import gait_from_run  # noqa: E402
 from gaitopt.ocp.solver import EVAL_KINDS  # noqa: E402
 from gaitopt.ocp.transcription import Transcription  # noqa: E402
 from gaitopt.robot import load_model  # noqa: E402
@@ -238,7 +238,7 @@ def capture(knots: tuple[int, int], gait_file: Path) -> Captured:
     options = GaitOptions.paper(speed=SPEED * SPEED_STEP, knots=knots, formulation="full",
                                 transcription="hermite-simpson-separated")
     with capturing() as out:
-        solution = solve_gait_solution(model, options, warm_start=Gait.load(gait_file))
+        solution = solve_staged_run(model, options, warm_start=Gait.load(gait_file))
     print(f"warm start: {solution.result.iterations} iterations, J {solution.result.objective:.6f}")
     return out
 
@@ -270,7 +270,7 @@ def main(argv: list[str] | None = None) -> None:
             options = GaitOptions.paper(speed=SPEED, knots=knots, formulation="full",
                                         transcription="hermite-simpson-separated")
             gait_file = Path(tmp) / "start.gait.json"
-            gait_from_solution(solve_gait_solution(model, options)).save(gait_file)
+            gait_from_run(solve_staged_run(model, options)).save(gait_file)
         cap = capture(knots, gait_file)
     assert cap.tr is not None and cap.options is not None and cap.args is not None
     options = {k: v for k, v in cap.options.items() if k != "expand"}

@@ -62,11 +62,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait
-from gaitopt.gait.solve.record import gait_from_solution
-from gaitopt.gait.solve.staged import WalkingSolution, solve_walking
+from gaitopt.gait.solve.record import gait_from_run
+from gaitopt.gait.solve.staged import StagedRun, solve_walking
 from gaitopt.gait.solve.transcriptions import clear_cache
 from gaitopt.ocp import Result
 from gaitopt.ocp.result import METHODS
@@ -133,8 +133,8 @@ def recording() -> Iterator[list[Result]]:
         Transcription.solve = original  # type: ignore[method-assign]
 
 
-def measure(name: str, knots: tuple[int, int], run: Callable[[], WalkingSolution]
-            ) -> tuple[Measure, WalkingSolution]:
+def measure(name: str, knots: tuple[int, int], run: Callable[[], StagedRun]
+            ) -> tuple[Measure, StagedRun]:
     with recording() as results:
         start = time.perf_counter()
         solution = run()
@@ -153,7 +153,7 @@ def measure(name: str, knots: tuple[int, int], run: Callable[[], WalkingSolution
 
 
 def best_of(repeat: int, name: str, knots: tuple[int, int],
-            run: Callable[[], WalkingSolution]) -> tuple[Measure, WalkingSolution]:
+            run: Callable[[], StagedRun]) -> tuple[Measure, StagedRun]:
     runs = [measure(name, knots, run) for _ in range(repeat)]
     return min(runs, key=lambda mr: mr[0].wall_s)
 
@@ -176,9 +176,9 @@ def bench_grid(knots: tuple[int, int], repeat: int, formulation: str = "reduced"
     moved, _ = best_of(repeat, f"warm (speed +{(SPEED_STEP - 1) * 100:.0f} %)", knots,
                        lambda: solve_walking(model, faster, warm_start=start))
     # The public path from a saved gait: the file's NLP point and multipliers (WarmStart).
-    saved = Gait.from_dict(gait_from_solution(solution).to_dict())
+    saved = Gait.from_dict(gait_from_run(solution).to_dict())
     from_file, _ = best_of(repeat, f"file (speed +{(SPEED_STEP - 1) * 100:.0f} %)", knots,
-                           lambda: solve_gait_solution(model, faster, warm_start=saved))
+                           lambda: solve_staged_run(model, faster, warm_start=saved))
     return [fresh, cached, same, moved, from_file]
 
 

@@ -48,29 +48,29 @@ def warm(knots: tuple[int, int], transcription: str, repeat: int, path: str,
          formulation: str = "reduced") -> dict[str, Any]:
     """Cold solve (NLPs built in this process), the same again, the gait saved to ``path``,
     then the warm start from it at +5 % speed (best of ``repeat``)."""
-    from gaitopt.gait.api import solve_gait_solution
+    from gaitopt.gait.api import solve_staged_run
     from gaitopt.gait.options.gait_options import GaitOptions
     from gaitopt.gait.record.file import Gait
-    from gaitopt.gait.solve.record import gait_from_solution
+    from gaitopt.gait.solve.record import gait_from_run
     from gaitopt.robot import load_model
 
     model = load_model("five-link")
     options = paper_options(GaitOptions)(speed=SPEED, knots=knots,  # type: ignore[arg-type]
                                          transcription=transcription, formulation=formulation)
     out: dict[str, Any] = {}
-    wall, sol = timed(lambda: solve_gait_solution(model, options))
+    wall, sol = timed(lambda: solve_staged_run(model, options))
     out["cold_first_s"] = wall
-    wall, sol = timed(lambda: solve_gait_solution(model, options))
+    wall, sol = timed(lambda: solve_staged_run(model, options))
     it, ev, tot = share(sol)
     out.update(cold_cached_s=wall, cold_iterations=it, cold_eval_s=ev, cold_ipopt_s=tot,
                cost=sol.result.objective, success=sol.success)
-    gait = gait_from_solution(sol)
+    gait = gait_from_run(sol)
     gait.save(path)
     saved = Gait.from_dict(gait.to_dict())
     faster = options.replace(speed=SPEED * SPEED_STEP)
     best = None
     for _ in range(repeat):
-        wall, moved = timed(lambda: solve_gait_solution(model, faster, warm_start=saved))
+        wall, moved = timed(lambda: solve_staged_run(model, faster, warm_start=saved))
         if best is None or wall < best[0]:
             best = (wall, moved)
     assert best is not None
@@ -86,7 +86,7 @@ def first_warm(knots: tuple[int, int], transcription: str, path: str,
                formulation: str = "reduced") -> dict[str, Any]:
     """The first warm start in this process from the gait file ``path`` (+5 % speed)."""
     start = time.perf_counter()
-    from gaitopt.gait.api import solve_gait_solution
+    from gaitopt.gait.api import solve_staged_run
     from gaitopt.gait.options.gait_options import GaitOptions
     from gaitopt.gait.record.file import Gait
     from gaitopt.robot import load_model
@@ -96,7 +96,7 @@ def first_warm(knots: tuple[int, int], transcription: str, path: str,
     options = paper_options(GaitOptions)(speed=SPEED * SPEED_STEP,  # type: ignore[arg-type]
                                          knots=knots, transcription=transcription,
                                          formulation=formulation)
-    wall, sol = timed(lambda: solve_gait_solution(model, options, warm_start=Gait.load(path)))
+    wall, sol = timed(lambda: solve_staged_run(model, options, warm_start=Gait.load(path)))
     it, ev, tot = share(sol)
     return dict(imports_s=imports, first_warm_s=wall, first_warm_cpu_s=CPU[id(sol)],
                 iterations=it, eval_s=ev, ipopt_s=tot,

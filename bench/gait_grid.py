@@ -33,10 +33,10 @@ import numpy as np
 
 from gaitopt.analysis.verify import LIMITS, verify_gait
 from gaitopt.dynamics.functions import contact_dynamics_function
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import KNOT_SPACINGS, TRANSCRIPTIONS, GaitOptions
 from gaitopt.gait.record.file import Gait
-from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 
 VARIANTS = {
     "ankle+impulse": {"ankle": True, "impulse": True},
@@ -124,13 +124,13 @@ def solve_point(variant: str, speed_m_min: float, *, check: bool,
                           formulation=formulation,  # type: ignore[arg-type]
                           **VARIANTS[variant])
     start = time.perf_counter()
-    solution = solve_gait_solution("five-link", options)
+    solution = solve_staged_run("five-link", options)
     wall = time.perf_counter() - start
     failed = solution.failed_stage
     nan = float("nan")
     status, stage = solution.result.status, failed.name if failed else ""
     try:
-        gait = gait_from_solution(solution) if solution.success else None
+        gait = gait_from_run(solution) if solution.success else None
     except MotionOutOfReachError:
         gait, status, stage = None, "motion out of reach between knots", "record"
     return Point(

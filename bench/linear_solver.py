@@ -72,7 +72,7 @@ from dataclasses import dataclass, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-from gaitopt.gait.api import solve_gait_solution  # noqa: E402
+from gaitopt.gait.api import solve_staged_run  # noqa: E402
 from gaitopt.gait.options.gait_options import GaitOptions  # noqa: E402
 from gaitopt.gait.solve.transcriptions import clear_cache  # noqa: E402
 from gaitopt.ocp import Transcription  # noqa: E402
@@ -161,7 +161,7 @@ def extra_options(options: Mapping[str, Any]) -> Iterator[None]:
 def solve_case(case: Case) -> Run:
     """One cold solve of ``case`` (stages, check grid) with the current options."""
     start = time.perf_counter()
-    sol = solve_gait_solution(case.model, case.options)
+    sol = solve_staged_run(case.model, case.options)
     wall = time.perf_counter() - start
     costs = tuple(c for _, c in sol.grid_costs) if sol.success else ()
     return Run(sol.success, costs, sum(s.iterations for s in sol.stages),

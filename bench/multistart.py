@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.robot import load_model
 from gaitopt.study.driver import run_sweep
@@ -122,7 +122,7 @@ def main(argv: list[str] | None = None) -> None:
                 options = base.replace(speed=speed / 60.0, ankle=ankle, impulse=impulse,
                                        multistart=kind == "multistart")
                 t0 = time.perf_counter()
-                sol = solve_gait_solution(model, options)
+                sol = solve_staged_run(model, options)
                 wall = time.perf_counter() - t0
                 cost = sol.result.objective if sol.success else float("nan")
                 rel = cost / ref - 1.0

@@ -23,11 +23,11 @@ import pinocchio as pin
 import pytest
 from numpy.typing import NDArray
 
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitPhase
-from gaitopt.gait.solve.record import gait_from_solution
-from gaitopt.gait.solve.staged import WalkingSolution
+from gaitopt.gait.solve.record import gait_from_run
+from gaitopt.gait.solve.staged import StagedRun
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.symmetry import swap_matrices
 from tests.dynamics.pinocchio_model import PinModel, build
@@ -48,7 +48,7 @@ TIP_TOL = 1e-6
 class Solved:
     """A solve and its gait record."""
 
-    solution: WalkingSolution
+    solution: StagedRun
     gait: Gait
 
 
@@ -67,8 +67,8 @@ def solved() -> Iterator[SolveFn]:
         opts = options or GaitOptions.paper()
         key = (robot.content_hash(), repr(opts))
         if key not in cache:
-            solution = solve_gait_solution(robot, opts)
-            cache[key] = Solved(solution, gait_from_solution(solution))
+            solution = solve_staged_run(robot, opts)
+            cache[key] = Solved(solution, gait_from_run(solution))
         return cache[key]
 
     yield solve

@@ -168,8 +168,8 @@ def test_motion_out_of_reach_exits_1_with_the_reason_and_writes_nothing(
         raise MotionOutOfReachError("the solution's motion between knots leaves a leg's reach "
                                     "in phase double_support; solve on a finer grid")
 
-    monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", converged)
-    monkeypatch.setattr("gaitopt.gait.solve.record.gait_from_solution", unrecordable)
+    monkeypatch.setattr("gaitopt.gait.api.solve_staged_run", converged)
+    monkeypatch.setattr("gaitopt.gait.solve.record.gait_from_run", unrecordable)
     out = tmp_path / "g.gait.json"
     result = solve("-o", str(out))
     assert result.exit_code == 1, result.output

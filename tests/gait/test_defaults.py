@@ -183,7 +183,7 @@ def test_solve_chooses_the_form_of_the_grid_unless_told(
         seen.append(options)
         raise _Stop
 
-    monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", fake_solve)
+    monkeypatch.setattr("gaitopt.gait.api.solve_staged_run", fake_solve)
     result = CliRunner().invoke(cli, ["solve", *args, "-o", str(tmp_path / "g.gait.json")])
     assert isinstance(result.exception, _Stop), result.output
     assert [o.transcription for o in seen] == [expected]

@@ -18,10 +18,10 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.api import solve_gait, solve_gait_solution
+from gaitopt.gait.api import solve_gait, solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.gait.solve.diagnose import diagnose
-from gaitopt.gait.solve.staged import WalkingSolution, transcription_for
+from gaitopt.gait.solve.staged import StagedRun, transcription_for
 from gaitopt.robot import load_model, model_from_dict, model_to_yaml
 from tests.gait.conftest import Solved
 
@@ -37,7 +37,7 @@ def _weak_biped() -> object:
 
 
 def test_infeasible_torque_bounds_are_named() -> None:
-    solution = solve_gait_solution(_weak_biped(), GaitOptions.paper(continuation=False))
+    solution = solve_staged_run(_weak_biped(), GaitOptions.paper(continuation=False))
     assert not solution.success
     diagnosis = diagnose(solution)
     text = diagnosis.text()
@@ -78,7 +78,7 @@ def test_a_step_too_fast_for_the_legs_says_which_torques_saturate(tmp_path) -> N
     assert advice and len(advice) == len(set(advice))
 
 
-def _failed_at(solution: WalkingSolution, state: str, value: float) -> WalkingSolution:
+def _failed_at(solution: StagedRun, state: str, value: float) -> StagedRun:
     """``solution`` marked failed at its last stage, with ``state`` at ``value`` at every
     knot of every phase (the NLP point itself is unchanged: no constraint is violated)."""
     res = solution.result

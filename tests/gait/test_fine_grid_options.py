@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.solve.stages import (
     FULL_WALK_FINE_GRID_OPTIONS,
@@ -39,7 +39,7 @@ def _solved_with(monkeypatch: pytest.MonkeyPatch, options: GaitOptions, key: str
         return original(self, *args, **kwargs)
 
     monkeypatch.setattr(Transcription, "solve", recording)
-    assert solve_gait_solution(load_model("five-link"), options).success
+    assert solve_staged_run(load_model("five-link"), options).success
     return calls
 
 

@@ -14,10 +14,10 @@ from typing import Any
 
 import pytest
 
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.solve import stages
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.gait.solve.stages import CHECK_GRID_OPTIONS, HELD_STAGE_TOL, held_stage_options
 from gaitopt.ocp import Transcription
 from gaitopt.robot import load_model
@@ -35,7 +35,7 @@ def _fine_tolerances(monkeypatch: pytest.MonkeyPatch, options: GaitOptions
 
 
 def _fine_calls(monkeypatch: pytest.MonkeyPatch, options: GaitOptions, key: str
-                ) -> tuple[list[Any], WalkingSolution]:
+                ) -> tuple[list[Any], StagedRun]:
     """Solve ``options``; the option ``key`` given to each IPOPT call on a grid finer than the
     coarse one, in order (None: not given), and the solution."""
     given: list[Any] = []
@@ -47,7 +47,7 @@ def _fine_calls(monkeypatch: pytest.MonkeyPatch, options: GaitOptions, key: str
         return original(self, *args, **kwargs)
 
     monkeypatch.setattr(Transcription, "solve", recording)
-    solution = solve_gait_solution(load_model("five-link"), options)
+    solution = solve_staged_run(load_model("five-link"), options)
     assert solution.success
     return given, solution
 
@@ -78,7 +78,7 @@ def test_a_looser_user_tolerance_wins() -> None:
     assert "ipopt.tol" not in held_stage_options(GaitOptions(), released=False)
 
 
-def _check_cost(solution: WalkingSolution) -> float:
+def _check_cost(solution: StagedRun) -> float:
     (check,) = [s for s in solution.stages if s.name == "check grid"]
     assert check.success
     return check.objective

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.api import guess_from_gait, solve_gait_solution
+from gaitopt.gait.api import guess_from_gait, solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait
-from gaitopt.gait.solve.record import gait_from_solution
+from gaitopt.gait.solve.record import gait_from_run
 from gaitopt.gait.solve.staged import solve_walking
 from gaitopt.robot import load_model
 from tests.gait.conftest import Solved, SolveFn
@@ -131,10 +131,10 @@ def test_the_cost_error_estimate_bounds_the_difference_to_a_fine_grid() -> None:
     """The refined cost (mesh_tol 1e-4) differs from the cost on a uniform 160 + 40 grid by
     less than its reported estimate."""
     options = GaitOptions(knots=(8, 5), control_model="jumps", mesh_tol=1e-4)
-    refined = solve_gait_solution("five-link", options)
-    fine = solve_gait_solution("five-link", options.replace(mesh_tol=None, knots=(160, 40)))
+    refined = solve_staged_run("five-link", options)
+    fine = solve_staged_run("five-link", options.replace(mesh_tol=None, knots=(160, 40)))
     assert refined.success and fine.success
-    acc = gait_from_solution(refined).solver["accuracy"]
+    acc = gait_from_run(refined).solver["accuracy"]
     gap = abs(refined.result.objective - fine.result.objective)
     print(f"refined {refined.result.objective:.4f} (estimate {acc['cost_error']:+.4f}), "
           f"160 + 40: {fine.result.objective:.4f}")

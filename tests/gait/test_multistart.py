@@ -59,7 +59,7 @@ def test_the_cli_passes_the_multistart_choice(monkeypatch: pytest.MonkeyPatch, t
         seen.append(options)
         raise _Stop
 
-    monkeypatch.setattr("gaitopt.gait.api.solve_gait_solution", fake_solve)
+    monkeypatch.setattr("gaitopt.gait.api.solve_staged_run", fake_solve)
     result = CliRunner().invoke(cli, ["solve", *args, "-o", str(tmp_path / "g.gait.json")])
     assert isinstance(result.exception, _Stop), result.output
     assert [o.multistart for o in seen] == [expected]

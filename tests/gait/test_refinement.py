@@ -16,7 +16,7 @@ from click.testing import CliRunner
 
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.cli import cli
-from gaitopt.gait.api import solve_gait_solution
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.formulations.select import checked_sequence, contact_sequence
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.record.file import Gait
@@ -28,7 +28,7 @@ from gaitopt.gait.solve.refinement import (
     solved_shares,
     worst_estimate,
 )
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import reduced_biped
 
@@ -46,7 +46,7 @@ def test_relative_estimates_and_the_worst() -> None:
 
 @dataclasses.dataclass(frozen=True)
 class FakeSolution:
-    """What refine_to_accuracy reads of a WalkingSolution."""
+    """What refine_to_accuracy reads of a StagedRun."""
 
     options: GaitOptions
     success: bool = True
@@ -171,7 +171,7 @@ FAST_NO_ANKLE = GaitOptions(speed=0.5, ankle=False, impulse=False)  # 30 m/min
 def test_a_solve_above_its_accuracy_is_refined_until_within() -> None:
     """30 m/min without ankle torques: on the default 16 + 6 knots the step length's estimate
     is above 1 % (measured 1.2 %); once refined to 24 + 8 it is within."""
-    solution: WalkingSolution = solve_gait_solution("five-link", FAST_NO_ANKLE)
+    solution: StagedRun = solve_staged_run("five-link", FAST_NO_ANKLE)
     extra = solution.accuracy_extra
     assert solution.success and extra is not None
     assert extra["refinements"] >= 1 and extra["within_target"] is True
@@ -183,14 +183,14 @@ def test_a_solve_above_its_accuracy_is_refined_until_within() -> None:
     assert gait_accuracy.passed and gait_accuracy.limit == pytest.approx(0.01)
 
 
-def _gait(solution: WalkingSolution) -> Gait:
-    from gaitopt.gait.solve.record import gait_from_solution
+def _gait(solution: StagedRun) -> Gait:
+    from gaitopt.gait.solve.record import gait_from_run
 
-    return gait_from_solution(solution)
+    return gait_from_run(solution)
 
 
 def test_given_knots_keep_their_grid_and_report_the_estimate() -> None:
-    solution = solve_gait_solution("five-link", FAST_NO_ANKLE.replace(knots=(16, 6)))
+    solution = solve_staged_run("five-link", FAST_NO_ANKLE.replace(knots=(16, 6)))
     assert tuple(solution.options.knots) == (16, 6)
     assert solution.accuracy_extra is not None and solution.accuracy_extra["target"] is None
     check = verify_gait(_gait(solution)).check("accuracy.estimate")
@@ -232,7 +232,7 @@ def _fake_solves(monkeypatch: pytest.MonkeyPatch, fails_at: float) -> list[float
 
 @dataclasses.dataclass(frozen=True)
 class FakeSolved:
-    """What solve_gait_solution reads of a solve before the refinement."""
+    """What solve_staged_run reads of a solve before the refinement."""
 
     success: bool
     options: GaitOptions
@@ -247,7 +247,7 @@ def test_a_failed_solve_at_the_default_speed_is_tried_at_the_walks_default(
 
     heel_toe, walk = default_speed(model, "heel-toe"), default_speed(model, "walk")
     asked = _fake_solves(monkeypatch, fails_at=heel_toe)
-    solution = solve_gait_solution(model, GaitOptions())
+    solution = solve_staged_run(model, GaitOptions())
     assert asked == [pytest.approx(heel_toe), pytest.approx(walk)]
     assert solution.success and solution.options.speed == pytest.approx(walk)
     assert solution.stages == (f"at {heel_toe}", f"at {walk}")  # both attempts kept
@@ -255,5 +255,5 @@ def test_a_failed_solve_at_the_default_speed_is_tried_at_the_walks_default(
 
 def test_a_speed_the_caller_gave_is_not_changed(monkeypatch: pytest.MonkeyPatch) -> None:
     asked = _fake_solves(monkeypatch, fails_at=1.2)
-    solution = solve_gait_solution(load_model("seven-link"), GaitOptions(speed=1.2))
+    solution = solve_staged_run(load_model("seven-link"), GaitOptions(speed=1.2))
     assert asked == [1.2] and not solution.success

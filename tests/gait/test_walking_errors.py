@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 import yaml
 
-from gaitopt.gait.api import solve_gait, solve_gait_solution
+from gaitopt.gait.api import solve_gait, solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.gait.record.file import FAILED_WARNING, Gait, GaitFileError
-from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.robot import ModelError, load_model
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.robot.loader import builtin_text
@@ -94,13 +94,13 @@ def test_model_without_two_legs_raises_before_any_solve(no_solve: None, tmp_path
 
 
 def test_a_forced_failure_is_reported_as_failed(tmp_path: Path) -> None:
-    solution = solve_gait_solution("five-link", FAILING)
+    solution = solve_staged_run("five-link", FAILING)
     assert not solution.success
     assert solution.stages and not any(s.success for s in solution.stages)
     assert solution.failed_stage is not None
     assert solution.failed_stage.name == "relaxed contact"
     assert solution.failed_stage.status == "Maximum_Iterations_Exceeded"
-    gait = gait_from_solution(solution)
+    gait = gait_from_run(solution)
     assert not gait.success and gait.status == "Maximum_Iterations_Exceeded"
     assert [s["name"] for s in gait.solver["stages"]] == [s.name for s in solution.stages]
     target = tmp_path / "failed.gait.json"
@@ -133,8 +133,8 @@ def test_motion_out_of_reach_between_knots_is_a_clear_error(default_solved: Solv
     broken = dataclasses.replace(solution, result=result)
     t3, t4 = single.t[3], single.t[4]
     with pytest.raises(MotionOutOfReachError, match="phase single_support") as err:
-        gait_from_solution(broken)
+        gait_from_run(broken)
     times = [float(v) for v in re.findall(r"t = ([0-9.]+) to ([0-9.]+) s", str(err.value))[0]]
     assert t3 < times[0] <= times[1] < t4
     # The unmodified solution records.
-    assert np.all(np.isfinite(gait_from_solution(solution).samples.q))
+    assert np.all(np.isfinite(gait_from_run(solution).samples.q))

@@ -15,10 +15,10 @@ import time
 import numpy as np
 import pytest
 
-from gaitopt.gait.api import solve_gait, solve_gait_solution
+from gaitopt.gait.api import solve_gait, solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait
-from gaitopt.gait.solve.record import gait_from_solution
+from gaitopt.gait.solve.record import gait_from_run
 
 VARIANTS = {
     "ankle+impulse": {"ankle": True, "impulse": True},
@@ -36,7 +36,7 @@ def test_grid_point_converges_from_scratch(variant: str, speed_m_min: int,
                                           request: pytest.FixtureRequest) -> None:
     options = GaitOptions(speed=speed_m_min / 60.0, **VARIANTS[variant])
     start = time.perf_counter()
-    solution = solve_gait_solution("five-link", options)
+    solution = solve_staged_run("five-link", options)
     wall = time.perf_counter() - start
     # Test properties (in --junitxml output with junit_family=legacy, and in report hooks).
     request.node.user_properties += [("wall_time_s", round(wall, 3)),
@@ -44,7 +44,7 @@ def test_grid_point_converges_from_scratch(variant: str, speed_m_min: int,
     failed = solution.failed_stage
     assert solution.success, (f"{variant} at {speed_m_min} m/min failed at stage "
                               f"{failed.name if failed else '?'}: {solution.result.status}")
-    gait = gait_from_solution(solution)
+    gait = gait_from_run(solution)
     assert gait.speed == pytest.approx(speed_m_min / 60.0)
     # IPOPT's tolerance applies to the scaled NLP: on the default 16+6 grid 45 of the 80 points
     # end with an unscaled violation of 2e-6 to 4e-6 (measured 2026-12-01; 8+5 stayed below

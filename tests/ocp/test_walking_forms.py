@@ -24,7 +24,7 @@ from gaitopt.gait.formulations.reduced.problem import (
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.solve.staged import (
     PRIMAL_WARM_OPTIONS,
-    WalkingSolution,
+    StagedRun,
     solve_walking,
     transcription_for,
 )
@@ -39,7 +39,7 @@ MODEL = load_model("five-link")
 FINE_GAP = 1e-3
 
 
-def walk(knots: tuple[int, int], form: str, **changes: object) -> WalkingSolution:
+def walk(knots: tuple[int, int], form: str, **changes: object) -> StagedRun:
     options = GaitOptions.paper(speed=0.2, knots=knots, transcription=form,  # type: ignore[arg-type]
                           **changes)  # type: ignore[arg-type]
     return solve_walking(MODEL, options)

@@ -46,7 +46,7 @@ from gaitopt.gait.options.model_defaults import MULTI_PHASE_KNOTS, options_for_m
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.options.preflight import refuse_unwalkable
 from gaitopt.gait.record.file import Gait, GaitFileError
-from gaitopt.gait.solve.staged import REFERENCE_SPEED, StageReport, reference_speed
+from gaitopt.gait.solve.staged import REFERENCE_SPEED, StageRecord, reference_speed
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
 
@@ -252,8 +252,8 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.cli.gait_summary import summary_table
-    from gaitopt.gait.api import as_model, solve_gait_solution, warm_start_usable
-    from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+    from gaitopt.gait.api import as_model, solve_staged_run, warm_start_usable
+    from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 
     console = make_console()
     model = as_model(model_name)
@@ -344,13 +344,13 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
         console.print(f"note: {warm_start} was solved with other ankle torques or another "
                       "single-support fraction; starting cold")
 
-    def progress(stage: StageReport) -> None:
+    def progress(stage: StageRecord) -> None:
         console.print("  stage " + stage.line())
 
     try:
-        solution = solve_gait_solution(model, options, progress=progress, warm_start=start,
-                                       compiled="codegen" if compiled else None,
-                                       refine=refine, speed_given=speed is not None)
+        solution = solve_staged_run(model, options, progress=progress, warm_start=start,
+                                    compiled="codegen" if compiled else None,
+                                    refine=refine, speed_given=speed is not None)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:
@@ -362,7 +362,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       "(in the constraints' own units). No gait file written.")
         sys.exit(1)
     try:
-        gait = gait_from_solution(solution)
+        gait = gait_from_run(solution)
     except MotionOutOfReachError as exc:
         console.print(f"FAILED after the last stage, which converged: {exc}. No gait file "
                       "written.")

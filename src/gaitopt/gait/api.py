@@ -1,5 +1,9 @@
 """The Python entry point: ``solve_gait(model, options) -> Gait``, usable from a notebook.
 
+The :class:`Gait` is the one result a user gets (docs/architecture.md, "One public result");
+:func:`solve_staged_run` is the internal solve under it, for the command line, the benches
+and the tests.
+
 The paper's problem at 12 m/min (0.2 m/s) on the built-in five-link biped, solved in a few
 seconds, then checked and saved:
 
@@ -22,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Callable
 
 import numpy as np
 
@@ -32,9 +37,15 @@ from gaitopt.gait.options.preflight import refuse_unwalkable
 from gaitopt.gait.record.file import Gait
 from gaitopt.gait.solve.accuracy import accuracy_record
 from gaitopt.gait.solve.diagnose import SolveFailedError, diagnose
-from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.refinement import refine_to_accuracy
-from gaitopt.gait.solve.staged import ProgressFn, WalkingSolution, solve_walking, transcription_for
+from gaitopt.gait.solve.staged import (
+    ProgressFn,
+    StagedRun,
+    StageRecord,
+    solve_walking,
+    transcription_for,
+)
 from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
@@ -71,20 +82,24 @@ def warm_start_usable(gait: Gait, options: GaitOptions) -> bool:
                 options.single_support_fraction)
 
 
-def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
-                        options: GaitOptions | None = None, *,
-                        warm_start: Gait | None = None, progress: ProgressFn | None = None,
-                        compiled: str | None = None,
-                        refine: bool | None = None,
-                        speed_given: bool | None = None) -> WalkingSolution:
-    """Like :func:`solve_gait` but returns the solver's :class:`WalkingSolution`.
+def solve_staged_run(model: RobotModel | str | os.PathLike[str],
+                     options: GaitOptions | None = None, *,
+                     warm_start: Gait | None = None, progress: ProgressFn | None = None,
+                     compiled: str | None = None,
+                     refine: bool | None = None,
+                     speed_given: bool | None = None) -> StagedRun:
+    """Internal: :func:`solve_gait` before the gait is recorded. Returns the
+    :class:`~gaitopt.gait.solve.staged_run.StagedRun` (the engine's final result, every
+    stage's record and result), which the command line, the study, the benches and the tests
+    read; users get its :class:`Gait` from :func:`solve_gait`. ``progress`` is called with
+    each stage's :class:`~gaitopt.gait.solve.staged_run.StageRecord`.
 
     ``refine``: whether the solve refines its grid to ``options.accuracy``
     (:mod:`gaitopt.gait.solve.refinement`); None: where the knots are left to the model's default.
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
-    in the solution.
+    in the run.
 
     Raises:
         UnwalkableModelError: something in the model prevents walking
@@ -108,7 +123,7 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
             first = dataclasses.replace(retry, stages=first.stages + retry.stages,
                                         wall_time_s=first.wall_time_s + retry.wall_time_s)
 
-    def solve_on(finer: GaitOptions, before: WalkingSolution) -> WalkingSolution:
+    def solve_on(finer: GaitOptions, before: StagedRun) -> StagedRun:
         # Started from the check grid's result, which is the solution of this very NLP (the
         # check grid of the coarser grid is the finer grid), values and multipliers: IPOPT
         # confirms it in a few iterations. Without one, from the coarser grid's result (its
@@ -122,15 +137,15 @@ def solve_gait_solution(model: RobotModel | str | os.PathLike[str],
     if refine is None:
         refine = follows_model(given.knots)
     refines = refine and opts.accuracy is not None and opts.mesh_tol is None
-    solution, _ = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
-                                     accuracy_of=accuracy_record)
-    return solution
+    run, _ = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
+                                accuracy_of=accuracy_record)
+    return run
 
 
-def check_result(solution: WalkingSolution) -> Result | None:
+def check_result(run: StagedRun) -> Result | None:
     """The converged result of the solve's last ``check grid`` stage (the problem on the
     check grid of its knots, :meth:`gaitopt.gait.solve.staged._Run.check`), or None."""
-    for name, result in reversed(solution.stage_results):
+    for name, result in reversed(run.stage_results):
         if name.endswith("check grid"):
             return result if result.success else None
     return None
@@ -170,10 +185,15 @@ def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
 
 
 def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions | None = None,
-               *, warm_start: Gait | None = None, progress: ProgressFn | None = None,
+               *, warm_start: Gait | None = None, progress: Callable[[str], None] | None = None,
                compiled: str | None = None) -> Gait:
-    """Solve the minimum-energy walking problem and return the gait (converged or not:
-    ``gait.success`` says; :meth:`Gait.save` refuses to write a failed gait).
+    """Solve the minimum-energy walking problem and return the gait, the one result of a
+    solve (converged or not: ``gait.success`` says; :meth:`Gait.save` refuses to write a
+    failed gait). Everything the solve found is in it: ``gait.status``, ``gait.solver`` (the
+    iterations, the NLP size, the largest violation, every stage in ``solver["stages"]`` and
+    the error estimates in ``solver["accuracy"]``), the costates and interval error estimates
+    of its phases, and for a failed solve :attr:`Gait.diagnosis` (why it failed and what to
+    change).
 
     Args:
         model: a :class:`RobotModel`, a built-in model name or a model file.
@@ -181,21 +201,33 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
             for the five-link biped; on another model the defaults that follow it, as
             ``gaitopt solve --model M``: :mod:`gaitopt.gait.options.model_defaults`).
         warm_start: a neighbouring gait to start from (the cold path is the fallback).
-        progress: called with a :class:`~gaitopt.gait.solve.solution.StageReport` after every stage.
+        progress: called after every stage with a line of text on it (its name, grid,
+            outcome, iterations, cost, speed, step length, violation and time: the lines
+            ``gaitopt solve`` prints); the stages are also in ``gait.solver["stages"]``.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
 
     Raises:
         MotionOutOfReachError: the converged solution's motion between knots leaves a leg's
             reach (it cannot be recorded as a gait; solve on a finer grid).
         SolveFailedError: the solve failed and its last values cannot even be recorded; the
-            message is the diagnosis (:func:`gaitopt.gait.solve.diagnose.diagnose`).
+            message is the diagnosis (what :attr:`Gait.diagnosis` holds otherwise).
     """
-    solution = solve_gait_solution(model, options, warm_start=warm_start, progress=progress,
-                                   compiled=compiled)
+    lines = None if progress is None else _stage_lines(progress)
+    run = solve_staged_run(model, options, warm_start=warm_start, progress=lines,
+                           compiled=compiled)
     try:
-        return gait_from_solution(solution)
+        return gait_from_run(run)
     except MotionOutOfReachError:
-        if solution.success:
+        if run.success:
             raise
 
-        raise SolveFailedError(diagnose(solution).text()) from None
+        raise SolveFailedError(diagnose(run).text()) from None
+
+
+def _stage_lines(progress: Callable[[str], None]) -> ProgressFn:
+    """A stage callback that hands ``progress`` each stage's line of text."""
+
+    def report(stage: StageRecord) -> None:
+        progress(stage.line())
+
+    return report

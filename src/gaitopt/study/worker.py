@@ -32,8 +32,8 @@ from typing import Any
 from gaitopt.gait.api import guess_from_gait
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
-from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_solution
-from gaitopt.gait.solve.staged import WalkingSolution, solve_walking
+from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
+from gaitopt.gait.solve.staged import StagedRun, solve_walking
 from gaitopt.ocp import Guess, Result
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
@@ -145,7 +145,7 @@ def failed_point_row(task: PointTask, status: str, *, iterations: int = 0,
                       speed_m_s=speed, iterations=iterations, wall_time_s=wall_time_s)
 
 
-def _failure_status(solution: WalkingSolution) -> str:
+def _failure_status(solution: StagedRun) -> str:
     stage = solution.failed_stage
     where = stage.name if stage is not None else "solve"
     return f"failed at {where}: {solution.result.status}"
@@ -159,7 +159,7 @@ def solve_point(task: PointTask) -> PointOutcome:
     warm, how = _warm_start(task)
     timings = {"warm_start_s": clock() - start}
     options = task.options.replace(max_iter=1) if task.force_fail else task.options
-    solution: WalkingSolution | None = None
+    solution: StagedRun | None = None
     result: Result | None = None
     data: dict[str, Any] | None = None
     error = ""
@@ -170,7 +170,7 @@ def solve_point(task: PointTask) -> PointOutcome:
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt
             mark = clock()
-            gait = gait_from_solution(solution) if solution.success else None
+            gait = gait_from_run(solution) if solution.success else None
             data = gait.to_dict() if gait is not None else None
             timings["record_s"] = clock() - mark
         if solution.success and gait is not None:

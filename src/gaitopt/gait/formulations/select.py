@@ -49,7 +49,7 @@ from gaitopt.gait.sequence.phase_fractions import (
     with_free_fractions,
     with_shares,
 )
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.ocp import Bounds, Problem, Transcription
 from gaitopt.robot.biped import (
     Biped,
@@ -103,7 +103,7 @@ class Formulation(Protocol):
         """
         ...
 
-    def record(self, solution: WalkingSolution,
+    def record(self, solution: StagedRun,
                costates: Callable[[], Mapping[str, Array]]) -> RecordParts:
         """The phases, events and dense samples of a solution's gait record; ``costates``
         gives its phases' costates, for a formulation that records them."""
@@ -140,7 +140,7 @@ class Reduced:
                            knots=knots, ankle=options.ankle, r_max=r_max, ankle_torques=False,
                            full=False)
 
-    def record(self, solution: WalkingSolution,
+    def record(self, solution: StagedRun,
                costates: Callable[[], Mapping[str, Array]]) -> RecordParts:
         return reduced_record(solution, costates)
 
@@ -202,7 +202,7 @@ class Full:
                            single_support_fraction=o.single_support_fraction, knots=knots,
                            ankle=o.ankle, r_max=r_max, ankle_torques=False, full=True)
 
-    def record(self, solution: WalkingSolution,
+    def record(self, solution: StagedRun,
                costates: Callable[[], Mapping[str, Array]]) -> RecordParts:
         """(The full formulation records no costates.)"""
         return full_record(solution, contact_sequence(solution.model, solution.options))

@@ -36,6 +36,8 @@ def parse_model(data: Any) -> RobotModel:
 
 
 def check_solver(value: Any) -> dict[str, Any]:
+    """Returns a checked copy of a gait's ``solver`` record (:data:`SOLVER_KEYS` present and
+    typed, an optional ``diagnosis`` a string); raises :class:`GaitFileError` naming the field."""
     solver = mapping_of("solver", value, required=SOLVER_KEYS)
     if not isinstance(solver["status"], str):
         raise bad_field("solver.status", "expected a string")
@@ -56,6 +58,9 @@ def check_solver(value: Any) -> dict[str, Any]:
             raise bad_field(f"solver.evaluations.{kind}",
                             f"expected an integer >= 0, got {count!r}")
     solver["evaluations"] = {str(k): int(v) for k, v in evaluations.items()}
+    if "diagnosis" in solver and not isinstance(solver["diagnosis"], str):
+        raise bad_field("solver.diagnosis", "expected a string (the diagnosis of a failed "
+                        "solve)")
     return solver
 
 

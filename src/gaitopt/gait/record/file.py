@@ -178,11 +178,28 @@ class Gait:
 
     @property
     def success(self) -> bool:
+        """Whether the solve converged (``solver.success``)."""
         return bool(self.solver["success"])
 
     @property
     def status(self) -> str:
+        """IPOPT's status of the final solve (``solver.status``)."""
         return str(self.solver["status"])
+
+    @property
+    def stages(self) -> tuple[Mapping[str, Any], ...]:
+        """Every stage of the solve in order (``solver.stages``: each stage's ``name``,
+        ``knots``, ``status``, ``success``, ``iterations``, ``objective``, ``violation``,
+        ``parameters``, ``wall_time_s``); empty if the file keeps none."""
+        return tuple(self.solver.get("stages", ()))
+
+    @property
+    def diagnosis(self) -> str | None:
+        """Why the solve failed and what to change, as lines of text (``solver.diagnosis``:
+        the failed stage, the most likely cause, the largest violation, the binding bounds
+        and advice); None for a converged gait or a file that keeps none."""
+        text = self.solver.get("diagnosis")
+        return None if text is None else str(text)
 
     def stride_samples(self, n_steps: int = 2) -> GaitSamples:
         """Samples of ``n_steps`` consecutive steps (a stride is 2), legs labelled physically.

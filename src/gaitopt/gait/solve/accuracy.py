@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from gaitopt.gait.solve.check_grid import first_order_factor
-from gaitopt.gait.solve.staged import WalkingSolution
+from gaitopt.gait.solve.staged import StagedRun
 
 #: How the cost's discretization error is estimated (written to the gait file), with a check
 #: grid (``{factor}``: the first-order factor) and from the previous grid (``mesh_tol``).
@@ -50,7 +50,7 @@ def _finite(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
-def accuracy_record(solution: WalkingSolution) -> dict[str, Any]:
+def accuracy_record(solution: StagedRun) -> dict[str, Any]:
     """``solver.accuracy`` of a solution's gait file (plain JSON data).
 
     Keys: ``collocation_error`` (by phase name, the largest per-interval estimate, or null
@@ -115,7 +115,7 @@ def accuracy_record(solution: WalkingSolution) -> dict[str, Any]:
     return out
 
 
-def _parameters_of(solution: WalkingSolution, cost: float) -> dict[str, float] | None:
+def _parameters_of(solution: StagedRun, cost: float) -> dict[str, float] | None:
     """The parameters of the last converged full-problem stage with objective ``cost`` (the
     previous grid's solution), or None."""
     for stage in reversed(solution.stages):

@@ -13,14 +13,14 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.gait.solve.transcriptions import Grid, transcription_for
 from gaitopt.ocp import ProblemError, costates
 
 Array = NDArray[np.float64]
 
 
-def solution_costates(solution: WalkingSolution) -> Mapping[str, Array]:
+def solution_costates(solution: StagedRun) -> Mapping[str, Array]:
     """``{phase: (K, n)}`` costates at the knots by the phase's state order, for the phases
     whose costates the transcription gives (not those with knot states, e.g. a placed floating
     base); empty for a failed solve or when the result does not fit the options' problem

@@ -19,8 +19,11 @@ user asked for (not a relaxed stage's):
   when torques saturate, a shorter step when the landing or the legs' reach fails, a finer
   grid or another start when the dynamics do not close, multistart.
 
-Only the walking solve's public pieces are used: the :class:`WalkingSolution`, its options
-and the cached transcription of the grid the result lives on.
+Only the walking solve's own pieces are used: the (internal)
+:class:`~gaitopt.gait.solve.staged_run.StagedRun`, its options and the cached transcription
+of the grid the result lives on. Users read the diagnosis from the failed solve's
+:class:`~gaitopt.gait.record.file.Gait` (:attr:`~gaitopt.gait.record.file.Gait.diagnosis`,
+its :meth:`Diagnosis.text`, written by :func:`gaitopt.gait.solve.record.gait_from_run`).
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ import numpy as np
 from gaitopt.gait.formulations.reduced.problem import Relaxation
 from gaitopt.gait.formulations.select import stage_bounds
 from gaitopt.gait.options.gait_options import GaitOptions
-from gaitopt.gait.solve.staged import Grid, WalkingSolution, transcription_for
+from gaitopt.gait.solve.staged import Grid, StagedRun, transcription_for
 from gaitopt.ocp import Problem, Result, Transcription
 from gaitopt.ocp.functions import broadcast_bound
 from gaitopt.ocp.validate import as_bound
@@ -98,10 +101,10 @@ class Diagnosis:
         return "\n".join(lines)
 
 
-def diagnose(solution: WalkingSolution) -> Diagnosis:
-    """The :class:`Diagnosis` of a failed walking solve (see the module docstring)."""
-    options, model = solution.options, solution.model
-    res, stage = best_failed_point(solution)
+def diagnose(run: StagedRun) -> Diagnosis:
+    """Returns the :class:`Diagnosis` of a failed staged run (see the module docstring)."""
+    options, model = run.options, run.model
+    res, stage = best_failed_point(run)
     found: list[Finding] = []
     meshes = [np.asarray(m, dtype=float) for m in res.mesh]
     uniform = all(np.allclose(m, np.linspace(0.0, 1.0, m.size)) for m in meshes)
@@ -154,17 +157,17 @@ def _cause(found: list[Finding], largest: Finding | None) -> tuple[str, str] | N
     return largest.kind, words
 
 
-def best_failed_point(solution: WalkingSolution) -> tuple[Result, str]:
-    """The failed stage's result closest to what was asked: among the stages solved at the
-    requested speed (all, if the speed is free) the one with the smallest constraint
-    violation, and its name; the solution's final result if no stage result is kept."""
-    target = solution.options.speed
-    pairs = [(r, name) for name, r in solution.stage_results
+def best_failed_point(run: StagedRun) -> tuple[Result, str]:
+    """Returns the failed stage's result closest to what was asked: among the stages solved
+    at the requested speed (all, if the speed is free) the one with the smallest constraint
+    violation, and its name; the run's final result if no stage result is kept."""
+    target = run.options.speed
+    pairs = [(r, name) for name, r in run.stage_results
              if not r.success and np.all(np.isfinite(r.w))
              and (target is None or abs(r.parameters.get("speed", target) - target) < 1e-9)]
     if not pairs:
-        failed = solution.failed_stage
-        return solution.result, failed.name if failed is not None else "solve"
+        failed = run.failed_stage
+        return run.result, failed.name if failed is not None else "solve"
     return min(pairs, key=lambda pair: pair[0].constraint_violation)
 
 

@@ -1,6 +1,7 @@
-"""Turning a solved walking problem into a :class:`~gaitopt.gait.record.file.Gait` record.
+"""Turning a staged run (internal) into its :class:`~gaitopt.gait.record.file.Gait`, the one
+public result of a solve.
 
-The solution's formulation extracts the phases, events and dense samples
+The run's formulation extracts the phases, events and dense samples
 (:meth:`gaitopt.gait.formulations.select.Formulation.record`:
 :mod:`gaitopt.gait.formulations.reduced.extract`,
 :mod:`gaitopt.gait.formulations.full.extract`); this module puts the parameters, the cost, the
@@ -20,30 +21,32 @@ from gaitopt.gait.formulations.select import contact_sequence, formulation_of
 from gaitopt.gait.record.file import Gait, GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.solve.accuracy import accuracy_record
 from gaitopt.gait.solve.costates import solution_costates
-from gaitopt.gait.solve.staged import WalkingSolution
+from gaitopt.gait.solve.diagnose import diagnose
+from gaitopt.gait.solve.staged import StagedRun
 from gaitopt.ocp import Result, warm_start_of
 
 
-def gait_from_solution(solution: WalkingSolution) -> Gait:
-    """The gait record of a walking solution (converged or not: ``solver.success`` says).
+def gait_from_run(run: StagedRun) -> Gait:
+    """Returns the :class:`Gait` of a staged run, the one public result of a solve (converged
+    or not: ``solver.success`` says). A failed run's gait carries its diagnosis
+    (``solver.diagnosis``: :func:`gaitopt.gait.solve.diagnose.diagnose` as text).
 
     Raises:
         MotionOutOfReachError: the interpolated motion leaves a leg's reach between knots.
     """
-    parts = formulation_of(solution.options).record(
-        solution, lambda: solution_costates(solution))
-    return _gait(solution, parts.phases, parts.events, parts.samples)
+    parts = formulation_of(run.options).record(run, lambda: solution_costates(run))
+    return _gait(run, parts.phases, parts.events, parts.samples)
 
 
-def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
+def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
           events: tuple[GaitEvent, ...], samples: GaitSamples) -> Gait:
-    model, options, res = solution.model, solution.options, solution.result
+    model, options, res = run.model, run.options, run.result
     step, speed = res.parameters["step_length"], res.parameters["speed"]
     impulse = max(res.parameters["impulse"], 0.0)
     t1 = res.phases[0].duration
     solver = {
         "status": res.status, "success": bool(res.success), "iterations": int(res.iterations),
-        "wall_time_s": float(solution.wall_time_s),
+        "wall_time_s": float(run.wall_time_s),
         "variables": res.nlp_size.variables,
         "equality_constraints": res.nlp_size.equality_constraints,
         "inequality_constraints": res.nlp_size.inequality_constraints,
@@ -53,9 +56,11 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
         **({"warm_start": _warm_start_data(res)} if res.success else {}),
         "stages": [{"name": s.name, "knots": list(s.knots), "status": s.status,
                     "success": s.success, "iterations": s.iterations,
-                    "objective": s.objective, "wall_time_s": s.wall_time_s}
-                   for s in solution.stages],
-        "accuracy": {**accuracy_record(solution), **(solution.accuracy_extra or {})},
+                    "objective": s.objective, "violation": s.violation,
+                    "parameters": dict(s.parameters), "wall_time_s": s.wall_time_s}
+                   for s in run.stages],
+        "accuracy": {**accuracy_record(run), **(run.accuracy_extra or {})},
+        **({} if res.success else {"diagnosis": diagnose(run).text()}),
     }
     return Gait(
         model_data=model.to_dict(), options=options.to_dict(),
@@ -64,7 +69,7 @@ def _gait(solution: WalkingSolution, phases: tuple[GaitPhase, ...],
         cost={"value": float(res.objective), "name": options.cost,
               "formula": cost.formula(options)},
         solver=solver, phases=phases, events=events, samples=samples,
-        contact_sequence=_solved_sequence(solution))
+        contact_sequence=_solved_sequence(run))
 
 
 def _warm_start_data(res: Result) -> dict[str, Any]:
@@ -75,11 +80,11 @@ def _warm_start_data(res: Result) -> dict[str, Any]:
             "lam_g": point.lam_g.tolist(), "layout": point.layout, "method": point.method}
 
 
-def _solved_sequence(solution: WalkingSolution) -> dict[str, Any]:
-    """The contact sequence of the solution, with the phase fractions it solved (they are
+def _solved_sequence(run: StagedRun) -> dict[str, Any]:
+    """The contact sequence of the run, with the phase fractions it solved (they are
     decision parameters when the single-support fraction is free)."""
-    data = contact_sequence(solution.model, solution.options).to_dict()
-    durations = [ph.duration for ph in solution.result.phases]
+    data = contact_sequence(run.model, run.options).to_dict()
+    durations = [ph.duration for ph in run.result.phases]
     total = sum(durations)
     phases: list[dict[str, Any]] = list(data["phases"])
     for phase, duration in zip(phases, durations, strict=True):

@@ -32,7 +32,7 @@ from gaitopt.gait.formulations.select import contact_sequence
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.sequence.phase_fractions import free_phases
 from gaitopt.gait.solve.check_grid import check_knots
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 
 #: How many times a solve is repeated on a finer grid at most.
 MAX_ROUNDS = 3
@@ -70,7 +70,7 @@ def describe(worst: tuple[float, str], target: float) -> str:
     return f"{name.replace('_', ' ')} estimate {shown} {op} {100 * target:g} %"
 
 
-def solved_shares(solution: WalkingSolution) -> tuple[float, ...] | None:
+def solved_shares(solution: StagedRun) -> tuple[float, ...] | None:
     """Each phase's share of the step in ``solution`` (its duration over the step time),
     where the contact sequence leaves some share free; else None."""
     seq = contact_sequence(solution.model, solution.options)
@@ -81,10 +81,10 @@ def solved_shares(solution: WalkingSolution) -> tuple[float, ...] | None:
     return tuple(d / step for d in durations)
 
 
-def refine_to_accuracy(solution: WalkingSolution, *, refines: bool,
-                       solve_on: Callable[[GaitOptions, WalkingSolution], WalkingSolution],
-                       accuracy_of: Callable[[WalkingSolution], dict[str, Any]],
-                       ) -> tuple[WalkingSolution, dict[str, Any]]:
+def refine_to_accuracy(solution: StagedRun, *, refines: bool,
+                       solve_on: Callable[[GaitOptions, StagedRun], StagedRun],
+                       accuracy_of: Callable[[StagedRun], dict[str, Any]],
+                       ) -> tuple[StagedRun, dict[str, Any]]:
     """Refine ``solution`` while its worst relative estimate exceeds the options' accuracy.
 
     Args:

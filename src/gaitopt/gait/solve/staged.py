@@ -49,12 +49,13 @@ paper's control model, ankle torques held) and the requested one (at 60 m/min on
 knots the long-step branch is 0.06 % lower there and 19 % higher in the end). Given a warm start
 (a neighbouring gait), the target problem is solved from it directly and the cold path is the
 fallback.
-Every stage is reported through ``progress`` and kept in the solution, so a failure says which
+Every stage is reported through ``progress`` and kept in the run, so a failure says which
 stage failed and why.
 
 Transcriptions (NLP and IPOPT solver) are built once per process for each problem structure
 and reused (:mod:`gaitopt.gait.solve.transcriptions`): speed, step length and impulse enter through
-parameter bounds only. What a solve returns is in :mod:`gaitopt.gait.solve.solution`.
+parameter bounds only. What a solve returns inside gaitopt is in
+:mod:`gaitopt.gait.solve.staged_run`; users get its :class:`~gaitopt.gait.record.file.Gait`.
 """
 
 from __future__ import annotations
@@ -90,10 +91,10 @@ from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, val
 from gaitopt.gait.options.model_defaults import default_gait, default_speed, options_for_model
 from gaitopt.gait.options.model_scale import REFERENCE, ModelScale, model_scale
 from gaitopt.gait.solve.check_grid import check_knots
-from gaitopt.gait.solve.solution import (
+from gaitopt.gait.solve.staged_run import (
     ProgressFn,
-    StageReport,
-    WalkingSolution,
+    StagedRun,
+    StageRecord,
     as_failed,
     best_of,
     converged_or_failed,
@@ -191,7 +192,7 @@ class _Run:
         #: The model's size (:mod:`gaitopt.gait.options.model_scale`) and reference speed (m/s).
         self.scale = model_scale(model)
         self.reference_speed = reference_speed(model, options)
-        self.stages: list[StageReport] = []
+        self.stages: list[StageRecord] = []
         #: Put before every stage name (the start being completed, with several).
         self.prefix = ""
         self.results: list[Result] = []
@@ -226,7 +227,7 @@ class _Run:
         result = converged_or_failed(result)
         full = (relax == Relaxation() and not hold_ankles and problem in (None, self.options)
                 and dict(bounds) == dict(parameter_bounds(self.options)))
-        report = StageReport(
+        report = StageRecord(
             name=self.prefix + name, knots=grid_knots(knots, self.options),
             status=result.status,
             success=result.success, iterations=result.iterations, objective=result.objective,
@@ -480,7 +481,7 @@ class _Run:
         o = self.options
         paper = o.replace(cost="paper", cost_regularization=0.0)
 
-        def report(stage: StageReport) -> None:
+        def report(stage: StageRecord) -> None:
             stage = dataclasses.replace(stage, name=f"paper cost: {stage.name}")
             self.stages.append(stage)
             if self.progress is not None:
@@ -531,9 +532,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   warm_start: Guess | Result | WarmStart | None = None,
                   progress: ProgressFn | None = None,
                   compiled: str | None = None,
-                  check_warm_start: bool = False) -> WalkingSolution:
+                  check_warm_start: bool = False) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
-    the returned solution says whether it succeeded and which stage failed.
+    the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
+    succeeded and which stage failed.
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
@@ -585,10 +587,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     if not run.results:  # no stage ran: every naive start was beyond the legs' reach
         raise GaitOptionsError(unplaced_message(options, run.unplaced))
     final = outcome if outcome is not None and outcome.success else run.final()
-    return WalkingSolution(model=model, options=options, result=final,
-                           stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
-                           grid_costs=tuple(run.grid_costs),
-                           stage_results=tuple(run.named_results))
+    return StagedRun(model=model, options=options, result=final,
+                     stages=tuple(run.stages), wall_time_s=time.perf_counter() - start,
+                     grid_costs=tuple(run.grid_costs),
+                     stage_results=tuple(run.named_results))
 
 
 #: Two coarse optima are the same start for :func:`distinct` when their costs differ by less
@@ -628,5 +630,5 @@ def unplaced_message(options: GaitOptions, unplaced: list[tuple[float, float, st
             "lower speed or a smaller single-support fraction")
 
 
-__all__ = ["PRIMAL_WARM_OPTIONS", "REFERENCE_SPEED", "Grid", "ProgressFn", "StageReport",
-           "WalkingSolution", "solve_walking", "transcription_for", "warm_start_grid"]
+__all__ = ["PRIMAL_WARM_OPTIONS", "REFERENCE_SPEED", "Grid", "ProgressFn", "StageRecord",
+           "StagedRun", "solve_walking", "transcription_for", "warm_start_grid"]

@@ -30,7 +30,7 @@ from gaitopt.gait.formulations.record_points import (
 from gaitopt.gait.record.file import GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.sequence.contact_sequence import ContactSequence
 from gaitopt.gait.solve.function_cache import disk_cached, function_file
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.robot.model import RobotModel
 
 Array = NDArray[np.float64]
@@ -142,7 +142,7 @@ def full_samples(model: RobotModel, res: Any, count: int,
     return GaitSamples(t=t, q=q, qd=qd, u=u, points=points)
 
 
-def full_record(solution: WalkingSolution, seq: ContactSequence) -> RecordParts:
+def full_record(solution: StagedRun, seq: ContactSequence) -> RecordParts:
     """The phases, events and samples of a full-coordinate solution on its contact sequence
     ``seq``."""
     model, res = solution.model, solution.result

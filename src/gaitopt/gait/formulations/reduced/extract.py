@@ -30,7 +30,7 @@ from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.solve.function_cache import disk_cached, function_file
-from gaitopt.gait.solve.solution import WalkingSolution
+from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
@@ -82,7 +82,7 @@ def _evaluate(fn: ca.Function, x: Array, u: Array, step: float) -> list[Array]:
     return [np.asarray(o, dtype=float).T for o in out]
 
 
-def reduced_record(solution: WalkingSolution, costates: Callable[[], Mapping[str, Array]]
+def reduced_record(solution: StagedRun, costates: Callable[[], Mapping[str, Array]]
                    ) -> RecordParts:
     """The phases, events and samples of a reduced-coordinate solution; ``costates`` gives
     the costates of its phases (:func:`gaitopt.gait.solve.costates.solution_costates`).

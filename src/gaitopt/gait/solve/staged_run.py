@@ -1,5 +1,12 @@
-"""What a staged solve returns: a report per stage and the solution, and the judgement of one
-stage's IPOPT result (converged or not, the best of several).
+"""Internal: what a staged solve returns inside gaitopt, a record per stage and the run, and
+the judgement of one stage's IPOPT result (converged or not, the best of several).
+
+:class:`StagedRun` and :class:`StageRecord` are not results for users: the one public result
+is :class:`~gaitopt.gait.record.file.Gait`, which :func:`gaitopt.gait.solve.record.gait_from_run`
+makes of a run (its status, stages, solver statistics, error estimates, costates and, for a
+failed solve, its diagnosis). They are not exported from ``gaitopt`` nor in the API reference
+(docs/architecture.md, "One public result"); the command line, the study worker, the benches
+and the tests use them.
 
 A stage converges when IPOPT says so and, at its "acceptable" level (which CasADi reports as
 success, with a constraint violation up to ``acceptable_constr_viol_tol``), only if the
@@ -22,12 +29,13 @@ from gaitopt.robot.model import RobotModel
 #: verify checks what the transcription imposes exactly.
 ACCEPTABLE_VIOLATION = 1e-6
 
-ProgressFn = Callable[["StageReport"], None]
+ProgressFn = Callable[["StageRecord"], None]
 
 
 @dataclass(frozen=True)
-class StageReport:
-    """What one stage did: its name, the grid, the outcome and the time it took."""
+class StageRecord:
+    """Internal: what one stage did: its name, the grid, the outcome and the time it took (the
+    gait keeps it as an entry of ``solver["stages"]``)."""
 
     name: str
     knots: tuple[int, int]
@@ -43,6 +51,8 @@ class StageReport:
     full_problem: bool = False
 
     def line(self) -> str:
+        """The stage as one line of text for a terminal (what ``gaitopt solve`` prints and
+        :func:`gaitopt.solve_gait` hands its ``progress``)."""
         p = self.parameters
         return (f"{self.name:<22} {self.knots[0]}+{self.knots[1]} knots  "
                 f"{'ok ' if self.success else 'FAILED'} {self.status:<28} "
@@ -53,14 +63,16 @@ class StageReport:
 
 
 @dataclass(frozen=True)
-class WalkingSolution:
-    """The outcome of :func:`~gaitopt.gait.solve.staged.solve_walking`: the final OCP result and
-    every stage."""
+class StagedRun:
+    """Internal: the outcome of :func:`~gaitopt.gait.solve.staged.solve_walking`, the final
+    result of the collocation engine (:class:`gaitopt.ocp.Result`) and every stage. Users get
+    the :class:`~gaitopt.gait.record.file.Gait` made of it
+    (:func:`gaitopt.gait.solve.record.gait_from_run`)."""
 
     model: RobotModel
     options: GaitOptions
     result: Result
-    stages: tuple[StageReport, ...]
+    stages: tuple[StageRecord, ...]
     wall_time_s: float
     stage_results: tuple[tuple[str, Result], ...] = ()
     """Every stage's name and result, in order (for diagnosing a failure)."""
@@ -73,10 +85,11 @@ class WalkingSolution:
 
     @property
     def success(self) -> bool:
+        """Whether the final result converged."""
         return self.result.success
 
     @property
-    def failed_stage(self) -> StageReport | None:
+    def failed_stage(self) -> StageRecord | None:
         """The last failed stage when the solve failed."""
         if self.success:
             return None
