@@ -84,46 +84,27 @@ _L, _V, _P = STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX
 ALPHA_BOUND = 1.3
 
 
-@dataclass(frozen=True)
-class Relaxation:
-    """How far the unilateral contact conditions may be violated (N, N s): 0 enforces them.
+def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
+    """The OCP of one periodic step for ``model`` with ``options`` (see the module docstring).
 
-    The continuation solves a relaxed problem first (the paper's two-stage process). The
-    relaxation is applied through the bounds of those rows (:func:`relaxed_bounds`), so
-    the relaxed and the enforced problem share one NLP."""
-
-    force: float = 0.0
-    impulse: float = 0.0
-
-
-def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
-    """The transcription's bounds with the unilateral contact conditions relaxed by
-    ``relax`` (lower bounds ``-relax.force`` on normal forces and friction rows,
-    ``-relax.impulse`` on normal impulses)."""
-    bounds = tr.bounds()
-    if relax == Relaxation():
-        return bounds
-
-    def lower(b: Bounds, rows: Any, by: float) -> Bounds:
-        # Only ever loosen: a row without a lower bound keeps none.
-        return b.with_rows(rows, np.minimum(b.lbg[rows], -by), ca.inf)
-
-    def block_rows(name: str, count: int | None = None) -> slice:
-        rows = tr.nlp.constraints.block(name).rows
-        return rows if count is None else slice(rows.start, rows.start + count)
-
-    names = {ph.name for ph in tr.problem.phases}
-    if SINGLE in names:
-        bounds = lower(bounds, tr.path_rows(SINGLE, SS_FORCE), relax.force)
-    if DOUBLE in names:
-        bounds = lower(bounds, tr.path_rows(DOUBLE, DS_FORCES), relax.force)
-        bounds = lower(bounds, block_rows(STRIKE_IMPULSES), relax.impulse)
-        bounds = lower(bounds, block_rows(LIFTOFF_CONDITIONS, 1), relax.impulse)
-    else:
-        bounds = lower(bounds, block_rows(STRIKE_ALONE, 1), relax.impulse)
-    if any(b.name == EVENT_FRICTION for b in tr.nlp.constraints.blocks):
-        bounds = lower(bounds, block_rows(EVENT_FRICTION), relax.impulse)
-    return bounds
+    Call :func:`gaitopt.gait.options.gait_options.validate_options` first.
+    """
+    two_phases = options.double_support
+    phases = [single_support_phase(model, options)]
+    if two_phases:
+        phases.append(double_support_phase(model, options))
+    paper = options.cost == "paper"
+    return Problem(
+        phases=phases,
+        parameters=parameters_of(parameter_bounds(options), model_scale(model)),
+        linkages=step_linkages(model, options),
+        boundary_constraints=event_constraints(model, options),
+        parameter_cost=(lambda p: p[_P] ** 2) if paper else
+        (lambda p: cost.parameter_cost(model, options, p)),
+        mayer=None if paper or not two_phases else
+        (lambda ends, p: liftoff_cost(model, options, liftoff_at(model, ends, p), p[_P])),
+        cost_denominator=lambda ends, p: cost.denominator(model, options, p),
+        objective_scale=cost.objective_scale(options, model_scale(model)))
 
 
 class _PointCache:
@@ -147,46 +128,6 @@ class _PointCache:
     def dynamics(self, x: Any, u: Any, p: Any, t: Any) -> Any:
         """The phase's ``xdot = [zd, zdd]`` at ``(x, u, p)``, for :class:`Phase`."""
         return self(x, u, p).xdot
-
-
-def with_step_time(bounds: Bounds, options: GaitOptions) -> Bounds:
-    """``bounds`` with the step-time row fixed to ``options.step_time`` (s), if given."""
-    if options.step_time is None:
-        return bounds
-    return bounds.with_constraint(STEP_TIME, options.step_time, options.step_time)
-
-
-def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
-    """Bounds of ``L, v, P`` for a variant: a given value becomes equal bounds. (Free phase
-    fractions keep the bounds their parameters have in the problem.)"""
-    if options.step_length is not None:
-        step = (options.step_length, options.step_length)
-    elif options.step_time is not None and options.speed is not None:
-        implied = options.step_time * options.speed
-        step = (implied, implied)
-    else:
-        step = options.step_length_bounds
-    speed = options.speed_bounds if options.speed is None else (options.speed, options.speed)
-    # Without double support the trailing leg leaves at the heel strike with no impulse.
-    with_impulse = options.impulse and options.double_support
-    impulse = (0.0, options.max_impulse) if with_impulse else (0.0, 0.0)
-    return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
-
-
-#: Scales of the parameters on the reference biped: step length (m), speed (m/s), liftoff
-#: impulse (N s); carried over as a length, a speed and an impulse
-#: (:mod:`gaitopt.gait.options.model_scale`).
-STEP_LENGTH_SCALE, SPEED_SCALE, IMPULSE_SCALE = 0.5, 1.0, 5.0
-
-
-def parameters_of(bounds: Mapping[str, tuple[float, float]], scale: ModelScale
-                  ) -> list[Parameter]:
-    """The step length, speed and impulse parameters within ``bounds``, scaled for the model
-    of ``scale`` (:data:`STEP_LENGTH_SCALE`, :data:`SPEED_SCALE`, :data:`IMPULSE_SCALE`)."""
-    return [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH],
-                      scale=scale.length(STEP_LENGTH_SCALE)),
-            Parameter(SPEED, *bounds[SPEED], scale=scale.speed(SPEED_SCALE)),
-            Parameter(IMPULSE, *bounds[IMPULSE], scale=scale.impulse(IMPULSE_SCALE))]
 
 
 def state_bounds(model: RobotModel, options: GaitOptions, names: Sequence[str]
@@ -312,38 +253,6 @@ def step_linkages(model: RobotModel, options: GaitOptions) -> list[Linkage | Con
     return linkages
 
 
-def walking_problem(model: RobotModel, options: GaitOptions) -> Problem:
-    """The OCP of one periodic step for ``model`` with ``options`` (see the module docstring).
-
-    Call :func:`gaitopt.gait.options.gait_options.validate_options` first.
-    """
-    two_phases = options.double_support
-    phases = [single_support_phase(model, options)]
-    if two_phases:
-        phases.append(double_support_phase(model, options))
-    paper = options.cost == "paper"
-    return Problem(
-        phases=phases,
-        parameters=parameters_of(parameter_bounds(options), model_scale(model)),
-        linkages=step_linkages(model, options),
-        boundary_constraints=event_constraints(model, options),
-        parameter_cost=(lambda p: p[_P] ** 2) if paper else
-        (lambda p: cost.parameter_cost(model, options, p)),
-        mayer=None if paper or not two_phases else
-        (lambda ends, p: liftoff_cost(model, options, liftoff_at(model, ends, p), p[_P])),
-        cost_denominator=lambda ends, p: cost.denominator(model, options, p),
-        objective_scale=cost.objective_scale(options, model_scale(model)))
-
-
-def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition,
-                 magnitude: Any) -> Any:
-    """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
-    lifting = reduced_biped(model).stance.contact
-
-    v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
-    return cost.impulse_cost(model, options, tr.impulses[lifting], v_after, magnitude)
-
-
 def relabel_actuator(model: RobotModel, name: str) -> str | None:
     """The actuator of the other leg in the same role (hip_1 <-> hip_2, ...), or None."""
     legs = reduced_biped(model).legs
@@ -358,7 +267,7 @@ def relabel_actuator(model: RobotModel, name: str) -> str | None:
 
 
 def periodic_controls(model: RobotModel, from_phase: str, from_controls: Sequence[str],
-                       to_controls: Sequence[str]) -> ControlLinkage:
+                      to_controls: Sequence[str]) -> ControlLinkage:
     """``u_first(0)[a] = u_last(T)[relabel(a)]`` for every control ``a`` whose relabelled
     counterpart acts at the end of the step."""
     targets = [a for a in to_controls if relabel_actuator(model, a) in from_controls]
@@ -370,3 +279,94 @@ def periodic_controls(model: RobotModel, from_phase: str, from_controls: Sequenc
 
     return ControlLinkage(from_phase, SINGLE, fn=fn, controls=targets,
                           name="controls periodic (legs relabelled)")
+
+
+def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition,
+                 magnitude: Any) -> Any:
+    """The cost term of the liftoff impulse (:func:`cost.impulse_cost`) from its transition."""
+    lifting = reduced_biped(model).stance.contact
+
+    v_after = contact_velocity(model, tr.q, tr.qd_after, lifting)
+    return cost.impulse_cost(model, options, tr.impulses[lifting], v_after, magnitude)
+
+
+def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
+    """Bounds of ``L, v, P`` for a variant: a given value becomes equal bounds. (Free phase
+    fractions keep the bounds their parameters have in the problem.)"""
+    if options.step_length is not None:
+        step = (options.step_length, options.step_length)
+    elif options.step_time is not None and options.speed is not None:
+        implied = options.step_time * options.speed
+        step = (implied, implied)
+    else:
+        step = options.step_length_bounds
+    speed = options.speed_bounds if options.speed is None else (options.speed, options.speed)
+    # Without double support the trailing leg leaves at the heel strike with no impulse.
+    with_impulse = options.impulse and options.double_support
+    impulse = (0.0, options.max_impulse) if with_impulse else (0.0, 0.0)
+    return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
+
+
+#: Scales of the parameters on the reference biped: step length (m), speed (m/s), liftoff
+#: impulse (N s); carried over as a length, a speed and an impulse
+#: (:mod:`gaitopt.gait.options.model_scale`).
+STEP_LENGTH_SCALE, SPEED_SCALE, IMPULSE_SCALE = 0.5, 1.0, 5.0
+
+
+def parameters_of(bounds: Mapping[str, tuple[float, float]], scale: ModelScale
+                  ) -> list[Parameter]:
+    """The step length, speed and impulse parameters within ``bounds``, scaled for the model
+    of ``scale`` (:data:`STEP_LENGTH_SCALE`, :data:`SPEED_SCALE`, :data:`IMPULSE_SCALE`)."""
+    return [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH],
+                      scale=scale.length(STEP_LENGTH_SCALE)),
+            Parameter(SPEED, *bounds[SPEED], scale=scale.speed(SPEED_SCALE)),
+            Parameter(IMPULSE, *bounds[IMPULSE], scale=scale.impulse(IMPULSE_SCALE))]
+
+
+@dataclass(frozen=True)
+class Relaxation:
+    """How far the unilateral contact conditions may be violated (N, N s): 0 enforces them.
+
+    The continuation solves a relaxed problem first (the paper's two-stage process). The
+    relaxation is applied through the bounds of those rows (:func:`relaxed_bounds`), so
+    the relaxed and the enforced problem share one NLP."""
+
+    force: float = 0.0
+    impulse: float = 0.0
+
+
+def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
+    """The transcription's bounds with the unilateral contact conditions relaxed by
+    ``relax`` (lower bounds ``-relax.force`` on normal forces and friction rows,
+    ``-relax.impulse`` on normal impulses)."""
+    bounds = tr.bounds()
+    if relax == Relaxation():
+        return bounds
+
+    def lower(b: Bounds, rows: Any, by: float) -> Bounds:
+        # Only ever loosen: a row without a lower bound keeps none.
+        return b.with_rows(rows, np.minimum(b.lbg[rows], -by), ca.inf)
+
+    def block_rows(name: str, count: int | None = None) -> slice:
+        rows = tr.nlp.constraints.block(name).rows
+        return rows if count is None else slice(rows.start, rows.start + count)
+
+    names = {ph.name for ph in tr.problem.phases}
+    if SINGLE in names:
+        bounds = lower(bounds, tr.path_rows(SINGLE, SS_FORCE), relax.force)
+    if DOUBLE in names:
+        bounds = lower(bounds, tr.path_rows(DOUBLE, DS_FORCES), relax.force)
+        bounds = lower(bounds, block_rows(STRIKE_IMPULSES), relax.impulse)
+        bounds = lower(bounds, block_rows(LIFTOFF_CONDITIONS, 1), relax.impulse)
+    else:
+        bounds = lower(bounds, block_rows(STRIKE_ALONE, 1), relax.impulse)
+    if any(b.name == EVENT_FRICTION for b in tr.nlp.constraints.blocks):
+        bounds = lower(bounds, block_rows(EVENT_FRICTION), relax.impulse)
+    return bounds
+
+
+def with_step_time(bounds: Bounds, options: GaitOptions) -> Bounds:
+    """``bounds`` with the step-time row fixed to ``options.step_time`` (s), if given."""
+    if options.step_time is None:
+        return bounds
+    return bounds.with_constraint(STEP_TIME, options.step_time, options.step_time)
