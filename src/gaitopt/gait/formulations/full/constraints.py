@@ -182,7 +182,7 @@ def phase_path(model: RobotModel, options: GaitOptions, seq: ContactSequence, ph
                point: PointFn, placed: str | None) -> list[PathConstraint]:
     """The path constraints of phase ``phase``, in row order: :func:`held_point_rows` of the
     hold rows not stated by the point ``placed`` (which places the base instead,
-    :func:`~gaitopt.gait.formulations.full.problem.base_point`), if any;
+    :func:`~gaitopt.gait.formulations.full.base_placement.base_point`), if any;
     :func:`contact_force_rows` if a point is held; :func:`height_rows` of the free points
     (:data:`CLEARANCE`), then of those landing at the phase's end
     (:data:`LANDING_CLEARANCE`), where there are any; and in the first phase, with a swing

@@ -18,15 +18,15 @@ formulation works for any planar tree with contact points and any :class:`Contac
   constraint manifold. The held points' positions ``p_c(q) = (a_c L + b_c, 0)`` (only ``y``
   for a normal-only hold) and velocities ``J qd = 0`` are enforced at every knot after the
   first (at the first they follow from the event map and the previous phase, so they are not
-  stated twice), and
-  ``gamma = nu = 0`` at the first knot. The first pinned point of a phase states them by
-  construction instead (:func:`base_point`): at those knots the base's ``x, y`` and their
-  rates are not variables but its position and velocity solved for the base
+  stated twice), and ``gamma = nu = 0`` at the first knot. The first pinned point of a
+  phase states them by construction instead
+  (:mod:`~gaitopt.gait.formulations.full.base_placement`): at those knots the base's ``x, y``
+  and their rates are not variables but its position and velocity solved for the base
   (:class:`~gaitopt.ocp.problem.KnotStates`), the same optimum with 4 fewer unknowns and
-  rows per knot. This makes the NLP square in the constraint
-  directions: the projection is the discrete correction of the collocation's drift (as in
-  Posa, Kuindersma and Tedrake 2016) and vanishes as the grid is refined. The contact points
-  stay put to the solver's tolerance at every knot;
+  rows per knot. This makes the NLP square in the constraint directions: the projection is
+  the discrete correction of the collocation's drift (as in Posa, Kuindersma and Tedrake
+  2016) and vanishes as the grid is refined. The contact points stay put to the solver's
+  tolerance at every knot;
 * events: an inelastic impact (:func:`gaitopt.dynamics.impact.impact`) when points touch
   down, the liftoff impulse (:func:`gaitopt.dynamics.impact.liftoff_impulse`) when a point is
   released with one, and after the last event the leg swap and the shift by one step;
@@ -46,15 +46,19 @@ The rows relaxed by the first continuation stage are named like the reduced prob
 (:data:`~gaitopt.gait.formulations.full.constraints.FORCES`,
 :data:`~gaitopt.gait.formulations.full.constraints.IMPULSES`).
 
-:func:`full_problem` lists the parts of the problem; each is built by a named function: the
-phases (:func:`full_phase`: the dynamics of :class:`PointCache`, :func:`state_bounds`,
-:func:`control_bounds`, :func:`running_cost`, the base placed by :func:`base_point`), the event
-maps and control linkages (:func:`step_linkages`), the parameters and the phase times
-(:mod:`gaitopt.gait.formulations.full.parameters`) and the objective's terms
-(:func:`parameter_cost`, :func:`impulse_cost`). The constraint blocks are built in
-:mod:`gaitopt.gait.formulations.full.constraints`, one function each (the held points, the
-contact forces, the clearances, the touchdowns, the impulses, ...). :func:`full_stage_bounds`
-gives the stages' bounds.
+:func:`full_problem` lists the parts of the problem; each is built by a named function, in
+one module per concept of the formulation folder:
+
+* here, the phases (:func:`full_phase`: the dynamics of :class:`PointCache`,
+  :func:`state_bounds`, :func:`control_bounds`, :func:`running_cost`), the objective's terms
+  (:func:`parameter_cost`, :func:`impulse_cost`) and the stages' bounds
+  (:func:`full_stage_bounds`);
+* :mod:`gaitopt.gait.formulations.full.constraints`: the constraint blocks, one function each
+  (the held points, the contact forces and friction cones, the clearances, the touchdowns,
+  the impulses, the released points rising, the remainder share);
+* :mod:`gaitopt.gait.formulations.full.linkages`: the event maps and the controls' linkages;
+* :mod:`gaitopt.gait.formulations.full.parameters`: the parameters and the phase times;
+* :mod:`gaitopt.gait.formulations.full.base_placement`: the base placed by a pinned point.
 """
 
 from __future__ import annotations
@@ -66,8 +70,9 @@ import casadi as ca
 import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
-from gaitopt.dynamics.kinematics import contact_position, contact_velocity
+from gaitopt.dynamics.kinematics import contact_velocity
 from gaitopt.gait.formulations import cost
+from gaitopt.gait.formulations.full.base_placement import BASE_STATES, base_point, placed_base
 from gaitopt.gait.formulations.full.constraints import (
     CLEARANCE,
     CLEARANCE_PROFILE,
@@ -81,9 +86,9 @@ from gaitopt.gait.formulations.full.constraints import (
     remainder_row,
     split_state,
 )
+from gaitopt.gait.formulations.full.linkages import step_linkages
 from gaitopt.gait.formulations.full.parameters import (
     IMPULSE_INDEX,
-    STEP_LENGTH_INDEX,
     full_parameters,
     period_parameters,
     phase_duration,
@@ -93,34 +98,22 @@ from gaitopt.gait.formulations.full.physics import (
     actuator_names,
     event_map,
     full_controls,
-    hold_axes,
     period_map,
     phase_point,
     projection_names,
     state_names,
-    swap_state,
 )
 from gaitopt.gait.formulations.reduced.constraints import step_time_row
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.sequence.contact_sequence import ContactSequence, check_sequence, phase_knots
 from gaitopt.ocp.bounds import Bounds
-from gaitopt.ocp.problem import (
-    ControlLinkage,
-    Duration,
-    KnotStates,
-    Linkage,
-    Phase,
-    Problem,
-)
+from gaitopt.ocp.problem import Duration, KnotStates, Phase, Problem
 from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.biped import BipedStructureError, biped_of
 from gaitopt.robot.model import RobotModel
-from gaitopt.robot.symmetry import LegSwap
 
-_L, _P = STEP_LENGTH_INDEX, IMPULSE_INDEX
-#: The floating base's translation (m) and its rates (m/s), placed by a pinned point.
-BASE_STATES = ("x", "y", "x_rate", "y_rate")
+_P = IMPULSE_INDEX
 #: Bound (m) of the base position ``|x|`` and ``y`` on the reference biped (1 m legs; times
 #: ``l / l_ref`` on another model): generous, a step spans less.
 BASE_REACH = 3.0
@@ -141,8 +134,9 @@ def full_problem(model: RobotModel, options: GaitOptions, seq: ContactSequence, 
     time and remainder rows, the parameters and the objective, in the NLP's order.
 
     ``place_base`` (default): the first pinned point of each phase places the base at the
-    knots after the first (:func:`base_point`) instead of its held-point rows; False states
-    those rows (the same optimum, a larger NLP)."""
+    knots after the first (:func:`~gaitopt.gait.formulations.full.base_placement.base_point`)
+    instead of its held-point rows; False states those rows (the same optimum, a larger
+    NLP)."""
     symmetry = period_map(model, seq)
     check_sequence(model, seq, dict(symmetry.contacts))
     counts = phase_knots(seq, options.knots)
@@ -197,7 +191,8 @@ def full_phase(model: RobotModel, options: GaitOptions, seq: ContactSequence, in
     the first knot) within :func:`control_bounds`, the dynamics of :class:`PointCache`, the
     duration :func:`~gaitopt.gait.formulations.full.parameters.phase_duration`, the path
     constraints of :func:`~gaitopt.gait.formulations.full.constraints.phase_path`, the
-    :func:`running_cost`, and with ``place_base`` the base placed by :func:`base_point`."""
+    :func:`running_cost`, and with ``place_base`` the base placed by
+    :func:`~gaitopt.gait.formulations.full.base_placement.base_point`."""
     held = seq.phases[index].held
     acts = actuator_names(model, held, ankle=options.ankle)
     proj = projection_names(held)
@@ -292,121 +287,6 @@ def running_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence,
                                  period_parameters(seq, p))
 
     return fn
-
-
-def base_point(model: RobotModel, held: Sequence[str]) -> str | None:
-    """The first point of ``held`` pinned on the ground (``name``, not ``name:y``) if the
-    model's first two coordinates ``x, y`` translate the whole tree (then every point's
-    position is ``(x, y)`` plus a function of the other coordinates, and its velocity
-    ``(x_rate, y_rate)`` plus one of the others: checked at a random state), else None."""
-    pinned = [c for c in held if ":" not in c]
-    if not pinned or tuple(model.coordinate_names[:2]) != ("x", "y"):
-        return None
-    nq = model.nq
-    q, qd = ca.SX.sym("q", nq), ca.SX.sym("qd", nq)
-    qv, qdv = vector(as_scalars(q, nq, "q")), vector(as_scalars(qd, nq, "qd"))
-    fn = ca.Function("point", [q, qd], [contact_position(model, qv, pinned[0]),
-                                        contact_velocity(model, qv, qdv, pinned[0])])
-    rng = np.random.default_rng(0)
-    q0, qd0, shift = rng.normal(size=nq), rng.normal(size=nq), np.zeros(nq)
-    shift[:2] = rng.normal(size=2)
-    p0, v0 = (np.asarray(v).ravel() for v in fn(q0, qd0))
-    p1, v1 = (np.asarray(v).ravel() for v in fn(q0 + shift, qd0 + shift))
-    translates = np.allclose(p1 - p0, shift[:2], atol=1e-12) and np.allclose(
-        v1 - v0, shift[:2], atol=1e-12)
-    return pinned[0] if translates else None
-
-
-def placed_base(model: RobotModel, seq: ContactSequence, point: str, phase: int
-                ) -> Callable[[Any, Any], Any]:
-    """``(x, p) -> (x, y, x_rate, y_rate)`` (m, m/s) of the base that puts ``point`` at its
-    ground point ``(a L + b, 0)`` of phase ``phase`` at rest: minus its position and
-    velocity with the base at 0."""
-    nq = model.nq
-
-    def fn(x: Any, p: Any) -> Any:
-        xs = as_scalars(x, 2 * nq, "x")
-        q = vector([0.0, 0.0] + list(xs[2:nq]))
-        qd = vector([0.0, 0.0] + list(xs[nq + 2:]))
-        pos = as_scalars(contact_position(model, q, point), 2, "p")
-        vel = as_scalars(contact_velocity(model, q, qd, point), 2, "v")
-        return vector([seq.ground_x(point, p[_L], phase) - pos[0], -pos[1], -vel[0],
-                       -vel[1]])
-
-    return fn
-
-
-def step_linkages(model: RobotModel, options: GaitOptions, seq: ContactSequence,
-                  symmetry: LegSwap) -> list[Linkage | ControlLinkage]:
-    """The linkages of the period, in order: for each event its :func:`event_linkage` and,
-    with the paper's control model and before the last event, the actuators both phases
-    share continuous across it; then, with ``periodic_controls`` and the paper's control
-    model, :func:`periodic_controls`."""
-    actuators_of = {ph.name: actuator_names(model, ph.held, ankle=options.ankle)
-                    for ph in seq.phases}
-    paper = options.control_model == "paper"
-    n_ph = len(seq.phases)
-    linkages: list[Linkage | ControlLinkage] = []
-    for i, ev in enumerate(seq.events):
-        linkages.append(event_linkage(model, seq, symmetry, i))
-        src, dst = seq.phases[i].name, seq.phases[(i + 1) % n_ph].name
-        shared = [a for a in actuators_of[src] if a in actuators_of[dst]]
-        if i != n_ph - 1 and paper and shared:
-            linkages.append(ControlLinkage(src, dst, controls=shared,
-                                           name=f"controls continuous at {ev.name}"))
-    if options.periodic_controls and paper:
-        linkages.append(periodic_controls(model, symmetry, seq, actuators_of))
-    return linkages
-
-
-def event_linkage(model: RobotModel, seq: ContactSequence, symmetry: LegSwap, event: int
-                  ) -> Linkage:
-    """``x_next(0) = [q, qd+]`` from the end ``[q, qd]`` of phase ``event``: ``qd+`` the
-    event map's velocity after the event
-    (:func:`~gaitopt.gait.formulations.full.physics.event_map`: the impact, or the liftoff
-    impulse ``P``), and after the last event the period map too
-    (:func:`~gaitopt.gait.formulations.full.physics.swap_state`: the legs swapped and ``x``
-    moved on by ``L``, or by ``2 L`` with no swap for a stride)."""
-    n_ph, nq = len(seq.phases), model.nq
-    ev = seq.events[event]
-    last = event == n_ph - 1
-
-    def jump(xf: Any, uf: Any, p: Any) -> Any:
-        q, qd = split_state(model, xf)
-        after = event_map(model, seq, event, q, qd, p[_P]).qd_after
-        if last:
-            q_next, qd_next = swap_state(model, symmetry, q, after, seq.steps * p[_L])
-            return vector(q_next + qd_next)
-        return vector(as_scalars(q, nq, "q") + as_scalars(after, nq, "qd"))
-
-    period = " (legs swapped)" if seq.steps == 1 else " (a stride: x + 2 L, no swap)"
-    return Linkage(seq.phases[event].name, seq.phases[(event + 1) % n_ph].name, jump=jump,
-                   name=f"{ev.name}: event map" + (f" and periodicity{period}" if last else ""))
-
-
-def periodic_controls(model: RobotModel, symmetry: LegSwap, seq: ContactSequence,
-                      actuators_of: Mapping[str, Sequence[str]]) -> ControlLinkage:
-    """``u_first(0)[a] = (S_u u_last(T))[a] = sign_a u_last(T)[swap(a)]`` (N m) for every
-    actuator ``a`` of the first phase whose swapped counterpart acts at the end of the last
-    phase (``S_u`` a signed permutation: :meth:`LegSwap.actuator_source`; the identity for a
-    stride)."""
-    first, last = seq.phases[0].name, seq.phases[-1].name
-    last_acts = list(actuators_of[last])
-    names = [a.name for a in model.actuators]
-    targets, sources = [], []
-    for a in actuators_of[first]:
-        j, sign = symmetry.actuator_source(model.actuator_index(a))
-        if names[j] in last_acts:
-            targets.append(a)
-            sources.append((last_acts.index(names[j]), sign))
-    n_last = len(last_acts) + 2 * len(hold_axes(seq.phases[-1].held))
-
-    def fn(u_from: Any, p: Any) -> Any:
-        us = as_scalars(u_from, n_last, "u")
-        return vector([us[k] if sign > 0 else -us[k] for k, sign in sources])
-
-    return ControlLinkage(last, first, fn=fn, controls=targets,
-                          name="controls periodic (legs swapped)")
 
 
 def parameter_cost(model: RobotModel, options: GaitOptions, seq: ContactSequence
