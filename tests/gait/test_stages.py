@@ -8,7 +8,7 @@ import dataclasses
 
 import pytest
 
-from gaitopt.gait.formulations.reduced.problem import FRACTION, IMPULSE, SPEED, parameter_bounds
+from gaitopt.gait.formulations.step_parameters import FRACTION, IMPULSE, SPEED, parameter_bounds
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.solve.stages import (
     ANKLES,

@@ -148,12 +148,12 @@ def test_points_mode_refuses_the_compressed_form() -> None:
 def test_walking_optimum_of_the_points_mode_is_optimal_for_the_expanded_nlp() -> None:
     # The walking solve evaluates the separated form by points; from its optimum, the same
     # NLP evaluated by CasADi's derivatives of the expanded graph converges to the same point.
-    from gaitopt.gait.formulations.reduced.problem import (
+    from gaitopt.gait.formulations.select import problem_for, stage_bounds
+    from gaitopt.gait.formulations.step_parameters import (
         Relaxation,
         parameter_bounds,
         with_step_time,
     )
-    from gaitopt.gait.formulations.select import problem_for, stage_bounds
     from gaitopt.gait.options.gait_options import GaitOptions
     from gaitopt.gait.solve.staged import solve_walking
     from gaitopt.gait.solve.transcriptions import transcription_for

@@ -14,13 +14,8 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.gait.formulations.reduced.problem import (
-    Relaxation,
-    parameter_bounds,
-    relaxed_bounds,
-    walking_problem,
-    with_step_time,
-)
+from gaitopt.gait.formulations.reduced.problem import relaxed_bounds, walking_problem
+from gaitopt.gait.formulations.step_parameters import Relaxation, parameter_bounds, with_step_time
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.solve.staged import (
     PRIMAL_WARM_OPTIONS,

@@ -28,7 +28,8 @@ from gaitopt.gait.formulations.full.extract import full_record
 from gaitopt.gait.formulations.full.physics import period_map
 from gaitopt.gait.formulations.record_points import RecordParts
 from gaitopt.gait.formulations.reduced.extract import reduced_record
-from gaitopt.gait.formulations.reduced.problem import Relaxation, relaxed_bounds, walking_problem
+from gaitopt.gait.formulations.reduced.problem import relaxed_bounds, walking_problem
+from gaitopt.gait.formulations.step_parameters import Relaxation
 from gaitopt.gait.formulations.traits import FULL as FULL_TRAITS
 from gaitopt.gait.formulations.traits import REDUCED as REDUCED_TRAITS
 from gaitopt.gait.formulations.traits import FormulationTraits

@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from gaitopt.gait.formulations.reduced.problem import Relaxation
 from gaitopt.gait.formulations.select import stage_bounds
+from gaitopt.gait.formulations.step_parameters import Relaxation
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.solve.staged import Grid, StagedRun, transcription_for
 from gaitopt.ocp import Problem, Result, Transcription

@@ -68,7 +68,13 @@ from typing import Any
 import numpy as np
 
 from gaitopt.dynamics.reduced import ReachError
-from gaitopt.gait.formulations.reduced.problem import (
+from gaitopt.gait.formulations.select import (
+    biped_for,
+    checked_sequence,
+    formulation_of,
+    stage_bounds,
+)
+from gaitopt.gait.formulations.step_parameters import (
     FRACTION,
     IMPULSE,
     SPEED,
@@ -76,12 +82,6 @@ from gaitopt.gait.formulations.reduced.problem import (
     Relaxation,
     parameter_bounds,
     with_step_time,
-)
-from gaitopt.gait.formulations.select import (
-    biped_for,
-    checked_sequence,
-    formulation_of,
-    stage_bounds,
 )
 from gaitopt.gait.guess.naive import (
     default_running_step,

@@ -15,14 +15,14 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from gaitopt.gait.formulations.reduced.problem import (
+from gaitopt.gait.formulations.select import formulation_of
+from gaitopt.gait.formulations.step_parameters import (
     FRACTION,
     IMPULSE,
     SPEED,
     Relaxation,
     parameter_bounds,
 )
-from gaitopt.gait.formulations.select import formulation_of
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.sequence.contact_sequence import sequence_from_dict
 from gaitopt.gait.sequence.phase_fractions import free_phases

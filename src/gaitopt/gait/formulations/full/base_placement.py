@@ -18,7 +18,7 @@ import numpy as np
 
 from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
-from gaitopt.gait.formulations.full.parameters import STEP_LENGTH_INDEX
+from gaitopt.gait.formulations.step_parameters import STEP_LENGTH_INDEX
 from gaitopt.gait.sequence.contact_sequence import ContactSequence
 from gaitopt.robot.model import RobotModel
 

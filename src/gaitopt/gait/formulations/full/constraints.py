@@ -39,12 +39,11 @@ from gaitopt.gait.formulations.full.physics import (
     hold_axes,
 )
 from gaitopt.gait.formulations.reduced.constraints import (
-    IMPULSE_INDEX,
     LENGTH_SCALE,
-    STEP_LENGTH_INDEX,
     clearance_profile,
     friction_rows,
 )
+from gaitopt.gait.formulations.step_parameters import IMPULSE_INDEX, STEP_LENGTH_INDEX
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.sequence.contact_sequence import ContactSequence

@@ -17,13 +17,13 @@ from typing import Any
 
 from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.gait.formulations.full.constraints import split_state
-from gaitopt.gait.formulations.full.parameters import IMPULSE_INDEX, STEP_LENGTH_INDEX
 from gaitopt.gait.formulations.full.physics import (
     actuator_names,
     event_map,
     hold_axes,
     swap_state,
 )
+from gaitopt.gait.formulations.step_parameters import IMPULSE_INDEX, STEP_LENGTH_INDEX
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.sequence.contact_sequence import ContactSequence
 from gaitopt.ocp.problem import ControlLinkage, Linkage

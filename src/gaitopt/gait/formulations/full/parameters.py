@@ -2,7 +2,7 @@
 
 ``p = [L, v, P, fraction_<phase> ...]``: the step length ``L`` (m), the speed ``v`` (m/s) and
 the liftoff impulse ``P`` (N s), as in the reduced formulation
-(:func:`gaitopt.gait.formulations.reduced.problem.parameters_of`), then one share of the step
+(:func:`gaitopt.gait.formulations.step_parameters.parameters_of`), then one share of the step
 time (1) per free phase but the last free one
 (:func:`gaitopt.gait.sequence.phase_fractions.fraction_parameters`). Phase ``i`` lasts
 ``s_i steps L / v`` (s), ``s_i`` its share: the period is a step, or the stride of
@@ -16,12 +16,14 @@ from typing import Any
 
 import casadi as ca
 
-from gaitopt.gait.formulations.reduced.constraints import (
+from gaitopt.gait.formulations.step_parameters import (
+    IMPULSE,
     IMPULSE_INDEX,
     SPEED_INDEX,
     STEP_LENGTH_INDEX,
+    parameter_bounds,
+    parameters_of,
 )
-from gaitopt.gait.formulations.reduced.problem import IMPULSE, parameter_bounds, parameters_of
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.sequence.contact_sequence import ContactSequence
@@ -36,7 +38,7 @@ _L, _V, _P, _F = STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX, FRACTION_INDEX
 
 def full_parameters(model: RobotModel, options: GaitOptions, seq: ContactSequence
                     ) -> list[Parameter]:
-    """``L, v, P`` within :func:`~gaitopt.gait.formulations.reduced.problem.parameter_bounds`
+    """``L, v, P`` within :func:`~gaitopt.gait.formulations.step_parameters.parameter_bounds`
     (``P`` fixed to 0 N s when no event of ``seq`` has a liftoff impulse), scaled for
     ``model``, then the free phase fractions within their bounds (scale 1)."""
     bounds = parameter_bounds(options)

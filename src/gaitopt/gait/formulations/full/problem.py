@@ -88,7 +88,6 @@ from gaitopt.gait.formulations.full.constraints import (
 )
 from gaitopt.gait.formulations.full.linkages import step_linkages
 from gaitopt.gait.formulations.full.parameters import (
-    IMPULSE_INDEX,
     full_parameters,
     period_parameters,
     phase_duration,
@@ -104,6 +103,7 @@ from gaitopt.gait.formulations.full.physics import (
     state_names,
 )
 from gaitopt.gait.formulations.reduced.constraints import step_time_row
+from gaitopt.gait.formulations.step_parameters import IMPULSE_INDEX
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.sequence.contact_sequence import ContactSequence, check_sequence, phase_knots

@@ -30,15 +30,18 @@ from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.kinematics import point_position
 from gaitopt.gait.formulations.reduced import physics as walking
 from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
+from gaitopt.gait.formulations.step_parameters import (
+    IMPULSE_INDEX,
+    SPEED_INDEX,
+    STEP_LENGTH_INDEX,
+    STEP_TIME,
+)
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.ocp.problem import BoundaryConstraint, PathConstraint
 from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
-#: Where the step length ``L`` (m), the speed ``v`` (m/s) and the liftoff impulse ``P``
-#: (N s) are in the parameter vector ``p`` (the full formulation's begins the same).
-STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX = range(3)
 _L, _V, _P = STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX
 
 #: Scale (m) of the constraints that are lengths (tip heights, landing positions) on the
@@ -60,13 +63,6 @@ DS_GEOMETRY = "front leg reach and hip limits"
 CLEARANCE = "swing clearance profile"
 #: The swing tip's landing point.
 LANDING = "swing tip lands at (L, 0)"
-#: The step time ``L / v`` (s): a row of the NLP when a step time is given, bounded by
-#: :func:`~gaitopt.gait.formulations.reduced.problem.with_step_time`, so problems with
-#: different step times share one NLP. Problems without a step time have no such row: even
-#: a free row changes IPOPT's path (a warm start in a speed sweep took 353 iterations instead
-#: of 79 with it).
-STEP_TIME = "step time L / v"
-
 #: A phase's dynamics at one point, ``(x, u, p) -> PhasePoint``.
 PointFn = Callable[[Any, Any, Any], walking.PhasePoint]
 
@@ -243,7 +239,7 @@ def landing_rows(model: RobotModel) -> BoundaryConstraint:
 
 def step_time_row() -> BoundaryConstraint:
     """:data:`STEP_TIME`: the row ``L / v`` (s), free here (bounded by
-    :func:`~gaitopt.gait.formulations.reduced.problem.with_step_time`)."""
+    :func:`~gaitopt.gait.formulations.step_parameters.with_step_time`)."""
     return BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
                               lower=-ca.inf, upper=ca.inf, scale=1.0)
 

@@ -20,13 +20,12 @@ the phases (:func:`single_support_phase`, :func:`double_support_phase`: their
 event maps and control linkages (:func:`step_linkages`), the parameters
 (:func:`parameter_bounds`, :func:`parameters_of`) and the objective's terms. The constraint
 blocks themselves are built in :mod:`gaitopt.gait.formulations.reduced.constraints`, one
-function each. :func:`relaxed_bounds` and :func:`with_step_time` give the stages' bounds.
+function each. :func:`relaxed_bounds` gives the stages' bounds.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import casadi as ca
@@ -39,12 +38,8 @@ from gaitopt.gait.formulations.reduced import physics as walking
 from gaitopt.gait.formulations.reduced.constraints import (
     DS_FORCES,
     EVENT_FRICTION,
-    IMPULSE_INDEX,
     LIFTOFF_CONDITIONS,
-    SPEED_INDEX,
     SS_FORCE,
-    STEP_LENGTH_INDEX,
-    STEP_TIME,
     STRIKE_ALONE,
     STRIKE_IMPULSES,
     PointFn,
@@ -56,14 +51,21 @@ from gaitopt.gait.formulations.reduced.constraints import (
     single_support_path,
 )
 from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
+from gaitopt.gait.formulations.step_parameters import (
+    IMPULSE_INDEX,
+    SPEED_INDEX,
+    STEP_LENGTH_INDEX,
+    Relaxation,
+    parameter_bounds,
+    parameters_of,
+)
 from gaitopt.gait.options.gait_options import GaitOptions
-from gaitopt.gait.options.model_scale import ModelScale, model_scale
+from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.problem import (
     ControlLinkage,
     Duration,
     Linkage,
-    Parameter,
     PathConstraint,
     Phase,
     Problem,
@@ -72,12 +74,6 @@ from gaitopt.ocp.transcription import Transcription
 from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
-STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
-#: What the stage ``phase fractions free`` frees: the free phase fractions of the full
-#: formulation (its parameters ``fraction_<phase>``,
-#: :func:`gaitopt.gait.sequence.phase_fractions.fraction_parameters`; bounded there, not here).
-FRACTION = "phase fractions"
-PARAMETERS = (STEP_LENGTH, SPEED, IMPULSE)
 _L, _V, _P = STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX
 
 #: Largest forward lean of the virtual stance leg considered (rad), a generous box on alpha.
@@ -290,51 +286,6 @@ def liftoff_cost(model: RobotModel, options: GaitOptions, tr: walking.Transition
     return cost.impulse_cost(model, options, tr.impulses[lifting], v_after, magnitude)
 
 
-def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
-    """Bounds of ``L, v, P`` for a variant: a given value becomes equal bounds. (Free phase
-    fractions keep the bounds their parameters have in the problem.)"""
-    if options.step_length is not None:
-        step = (options.step_length, options.step_length)
-    elif options.step_time is not None and options.speed is not None:
-        implied = options.step_time * options.speed
-        step = (implied, implied)
-    else:
-        step = options.step_length_bounds
-    speed = options.speed_bounds if options.speed is None else (options.speed, options.speed)
-    # Without double support the trailing leg leaves at the heel strike with no impulse.
-    with_impulse = options.impulse and options.double_support
-    impulse = (0.0, options.max_impulse) if with_impulse else (0.0, 0.0)
-    return {STEP_LENGTH: step, SPEED: speed, IMPULSE: impulse}
-
-
-#: Scales of the parameters on the reference biped: step length (m), speed (m/s), liftoff
-#: impulse (N s); carried over as a length, a speed and an impulse
-#: (:mod:`gaitopt.gait.options.model_scale`).
-STEP_LENGTH_SCALE, SPEED_SCALE, IMPULSE_SCALE = 0.5, 1.0, 5.0
-
-
-def parameters_of(bounds: Mapping[str, tuple[float, float]], scale: ModelScale
-                  ) -> list[Parameter]:
-    """The step length, speed and impulse parameters within ``bounds``, scaled for the model
-    of ``scale`` (:data:`STEP_LENGTH_SCALE`, :data:`SPEED_SCALE`, :data:`IMPULSE_SCALE`)."""
-    return [Parameter(STEP_LENGTH, *bounds[STEP_LENGTH],
-                      scale=scale.length(STEP_LENGTH_SCALE)),
-            Parameter(SPEED, *bounds[SPEED], scale=scale.speed(SPEED_SCALE)),
-            Parameter(IMPULSE, *bounds[IMPULSE], scale=scale.impulse(IMPULSE_SCALE))]
-
-
-@dataclass(frozen=True)
-class Relaxation:
-    """How far the unilateral contact conditions may be violated (N, N s): 0 enforces them.
-
-    The continuation solves a relaxed problem first (the paper's two-stage process). The
-    relaxation is applied through the bounds of those rows (:func:`relaxed_bounds`), so
-    the relaxed and the enforced problem share one NLP."""
-
-    force: float = 0.0
-    impulse: float = 0.0
-
-
 def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
     """The transcription's bounds with the unilateral contact conditions relaxed by
     ``relax`` (lower bounds ``-relax.force`` on normal forces and friction rows,
@@ -363,10 +314,3 @@ def relaxed_bounds(tr: Transcription, relax: Relaxation) -> Bounds:
     if any(b.name == EVENT_FRICTION for b in tr.nlp.constraints.blocks):
         bounds = lower(bounds, block_rows(EVENT_FRICTION), relax.impulse)
     return bounds
-
-
-def with_step_time(bounds: Bounds, options: GaitOptions) -> Bounds:
-    """``bounds`` with the step-time row fixed to ``options.step_time`` (s), if given."""
-    if options.step_time is None:
-        return bounds
-    return bounds.with_constraint(STEP_TIME, options.step_time, options.step_time)
