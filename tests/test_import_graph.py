@@ -376,6 +376,21 @@ def test_the_bottom_of_gait_imports_nothing_else_of_gait() -> None:
                           + offences_text(offences))
 
 
+def test_the_two_formulations_do_not_import_each_other() -> None:
+    # What both share lives beside them in gait/formulations/ (step_parameters, shared_rows,
+    # cost, record_points); only select.py imports both.
+    def formulation(module: str) -> str | None:
+        parts = module.split(".")
+        if parts[:3] == ["gaitopt", "gait", "formulations"] and len(parts) > 3:
+            return parts[3] if parts[3] in ("reduced", "full") else None
+        return None
+
+    offences = [f"{e.where}: {e.importer} imports {e.target}" for e in GRAPH.edges
+                if formulation(e.importer) is not None and formulation(e.target) is not None
+                and formulation(e.importer) != formulation(e.target)]
+    assert not offences, ("one formulation imports the other:\n" + offences_text(offences))
+
+
 def test_only_viz_and_cli_import_inside_functions() -> None:
     offences = [f"{e.where}: {e.importer} imports {e.target} inside a function"
                 for e in GRAPH.edges

@@ -12,10 +12,12 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import casadi as ca
+
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import ModelScale
 from gaitopt.ocp.bounds import Bounds
-from gaitopt.ocp.problem import Parameter
+from gaitopt.ocp.problem import BoundaryConstraint, Parameter
 
 STEP_LENGTH, SPEED, IMPULSE = "step_length", "speed", "impulse"
 #: What the stage ``phase fractions free`` frees: the free phase fractions of the full
@@ -32,6 +34,13 @@ STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX = range(3)
 #: a free row changes IPOPT's path (a warm start in a speed sweep took 353 iterations instead
 #: of 79 with it).
 STEP_TIME = "step time L / v"
+
+def step_time_row() -> BoundaryConstraint:
+    """:data:`STEP_TIME`: the row ``L / v`` (s), free here (bounded by
+    :func:`with_step_time`)."""
+    return BoundaryConstraint(STEP_TIME, lambda ends, p: p[STEP_LENGTH_INDEX] / p[SPEED_INDEX],
+                              lower=-ca.inf, upper=ca.inf, scale=1.0)
+
 
 def parameter_bounds(options: GaitOptions) -> dict[str, tuple[float, float]]:
     """Bounds of ``L, v, P`` for a variant: a given value becomes equal bounds. (Free phase

@@ -38,11 +38,7 @@ from gaitopt.gait.formulations.full.physics import (
     event_map,
     hold_axes,
 )
-from gaitopt.gait.formulations.reduced.constraints import (
-    LENGTH_SCALE,
-    clearance_profile,
-    friction_rows,
-)
+from gaitopt.gait.formulations.shared_rows import LENGTH_SCALE, clearance_profile, friction_rows
 from gaitopt.gait.formulations.step_parameters import IMPULSE_INDEX, STEP_LENGTH_INDEX
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale

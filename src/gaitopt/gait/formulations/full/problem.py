@@ -102,8 +102,7 @@ from gaitopt.gait.formulations.full.physics import (
     projection_names,
     state_names,
 )
-from gaitopt.gait.formulations.reduced.constraints import step_time_row
-from gaitopt.gait.formulations.step_parameters import IMPULSE_INDEX
+from gaitopt.gait.formulations.step_parameters import IMPULSE_INDEX, step_time_row
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.sequence.contact_sequence import ContactSequence, check_sequence, phase_knots

@@ -30,11 +30,12 @@ from gaitopt.dynamics.backend import as_scalars, vector
 from gaitopt.dynamics.kinematics import point_position
 from gaitopt.gait.formulations.reduced import physics as walking
 from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
+from gaitopt.gait.formulations.shared_rows import LENGTH_SCALE, clearance_profile, friction_rows
 from gaitopt.gait.formulations.step_parameters import (
     IMPULSE_INDEX,
     SPEED_INDEX,
     STEP_LENGTH_INDEX,
-    STEP_TIME,
+    step_time_row,
 )
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import model_scale
@@ -43,10 +44,6 @@ from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel
 
 _L, _V, _P = STEP_LENGTH_INDEX, SPEED_INDEX, IMPULSE_INDEX
-
-#: Scale (m) of the constraints that are lengths (tip heights, landing positions) on the
-#: reference biped (1 m legs); ``l / l_ref`` times it on another model.
-LENGTH_SCALE = 0.1
 
 # Names of the unilateral contact conditions (relaxed by the first continuation stage).
 SS_FORCE = "stance contact force"
@@ -87,14 +84,6 @@ def leg_reach(model: RobotModel, options: GaitOptions) -> tuple[float, float]:
     return r_min, r_max
 
 
-def friction_rows(friction: float | None, tangential: Any, normal: Any) -> list[Any]:
-    """``[mu n - t, mu n + t]`` (each ``>= 0``: the force or impulse ``(t, n)`` within the
-    friction cone of coefficient ``mu``), or none without friction."""
-    if friction is None:
-        return []
-    return [friction * normal - tangential, friction * normal + tangential]
-
-
 def stance_force_rows(model: RobotModel, friction: float | None, point: PointFn
                       ) -> PathConstraint:
     """:data:`SS_FORCE`, single support: ``f_y >= 0`` (N) for the ground's force ``(f_x,
@@ -123,16 +112,6 @@ def swing_clearance_and_hip_rows(model: RobotModel, point: PointFn) -> PathConst
 
     return PathConstraint(SS_GEOMETRY, fn, lower=[0.0, hip_lo], upper=[ca.inf, hip_hi],
                           scale=[model_scale(model).length(LENGTH_SCALE), 1.0])
-
-
-def clearance_profile(clearance: float, s: Any, profile: str) -> Any:
-    """The least swing-tip height (m) at normalised single-support time ``s`` in [0, 1]:
-    ``c 4 s (1 - s)`` (``"parabola"``) or ``c (4 s (1 - s))^2`` (``"quartic"``); both are 0
-    at the liftoff and the heel strike and ``c`` at mid-swing. The parabola's slope at the
-    ends, ``4 c / T1``, is a least vertical tip velocity at both events; the quartic's is
-    zero."""
-    bump = 4.0 * s * (1.0 - s)
-    return clearance * (bump if profile == "parabola" else bump * bump)
 
 
 def clearance_profile_rows(model: RobotModel, options: GaitOptions, point: PointFn
@@ -235,13 +214,6 @@ def landing_rows(model: RobotModel) -> BoundaryConstraint:
 
     return BoundaryConstraint(LANDING, fn, 0.0, 0.0,
                               scale=model_scale(model).length(LENGTH_SCALE))
-
-
-def step_time_row() -> BoundaryConstraint:
-    """:data:`STEP_TIME`: the row ``L / v`` (s), free here (bounded by
-    :func:`~gaitopt.gait.formulations.step_parameters.with_step_time`)."""
-    return BoundaryConstraint(STEP_TIME, lambda ends, p: p[_L] / p[_V],
-                              lower=-ca.inf, upper=ca.inf, scale=1.0)
 
 
 def event_friction_rows(model: RobotModel, friction: float, *, double_support: bool
