@@ -89,6 +89,25 @@ def parse_pair(text: str, option: str) -> tuple[float, float]:
     return lo, hi
 
 
+def parse_phase_knots(text: str) -> tuple[int, ...] | dict[str, int]:
+    """``--knots`` of a solve: counts ``16,6`` (single, double support; or one per phase of
+    the step) or counts by phase name ``single_support=16,double_support=6`` (a usage error
+    otherwise; the names are checked against the step's phases with the other options)."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        if all("=" in p for p in parts):
+            named = {k.strip(): int(v) for k, v in (p.split("=", 1) for p in parts)}
+            if len(named) == len(parts) and all(named):
+                return named
+        elif not any("=" in p for p in parts) and len(parts) >= 2:
+            return tuple(int(p) for p in parts)
+    except ValueError:
+        pass
+    raise UserError(f"--knots: {text!r} must be integers 'single,double' (e.g. 16,6; or one "
+                    "per phase) or counts by phase name, e.g. "
+                    "single_support=16,double_support=6")
+
+
 def parse_knots(text: str) -> tuple[int, int]:
     """``single,double`` knot counts (a usage error otherwise)."""
     parts = text.split(",")
@@ -113,12 +132,16 @@ def model_option(f: F) -> F:
 
 
 def knots_option(f: F) -> F:
-    """``--knots SINGLE,DOUBLE`` (text or None: the default grid; see :func:`grid_choice`)."""
+    """``--knots SINGLE,DOUBLE`` or ``--knots PHASE=N,...`` (text or None: the default grid;
+    see :func:`grid_choice`)."""
     from gaitopt.gait.options.gait_options import GaitOptions
     from gaitopt.gait.options.model_defaults import MULTI_PHASE_KNOTS
 
     return click.option("--knots", default=None,
-                        help="Grid points per phase: single support, double support [default: "
+                        help="Grid points per phase: single support, double support (e.g. "
+                             "16,6), one per phase, or by phase name (e.g. "
+                             "single_support=16,double_support=6; the heel-toe walk's "
+                             "foot_flat, heel_off, double_support, heel_rocker) [default: "
                              f"{','.join(map(str, GaitOptions().knots))}; "
                              f"{','.join(map(str, MULTI_PHASE_KNOTS))} for steps of more than "
                              "two phases, e.g. the heel-toe walk].")(f)
@@ -200,7 +223,7 @@ def grid_choice(knots: str | None, control_model: str | None,
         return dict(PAPER_GRID)
     out: dict[str, Any] = {}
     if knots is not None:
-        out["knots"] = parse_knots(knots)
+        out["knots"] = parse_phase_knots(knots)
     if control_model is not None:
         out["control_model"] = control_model
     if knot_spacing is not None:

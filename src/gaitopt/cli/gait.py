@@ -299,7 +299,8 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                                                  "--single-support-bounds"))
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
-    refine = follows_model(options.knots)  # knots left to the model: refine to --accuracy
+    # knots left to the model: refine to --accuracy
+    refine = follows_model(options.discretisation.knots)
     try:
         options = options_for_model(model, options)
         refuse_unwalkable(model, options)
@@ -316,7 +317,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots, control model "
+                  + f", {'+'.join(map(str, options.knots))} knots, control model "
                   f"{options.control_model}"
                   + (" (the paper's grid)" if options.paper_grid else "")
                   + f", {options.formulation} coordinates"
@@ -334,7 +335,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       "and keeps the best")
     per_step = (0 if sequence_used is None
                 else len(sequence_used.phases) // sequence_used.steps)
-    if (per_step > 2
+    if (per_step > 2 and len(options.knots) == 2
             and tuple(options.knots) < MULTI_PHASE_KNOTS):
         console.print(f"note: a {per_step}-phase step on {options.knots[0]}+"
                       f"{options.knots[1]} knots is coarse; the heel-toe walk passes verify on "

@@ -182,7 +182,7 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
         raise GaitOptionsError(why)
     if follows_model(o.formulation):
         changes["formulation"] = default_formulation(model, gait, custom, bool(o.stride))
-    if follows_model(o.knots):
+    if follows_model(o.discretisation.knots):
         changes["knots"] = (MULTI_PHASE_KNOTS if _phase_count(o, gait) > 2
                             else tuple(int(k) for k in o.knots))
     scale = model_scale(model)

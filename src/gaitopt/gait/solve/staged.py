@@ -62,7 +62,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from math import nan
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -226,8 +226,11 @@ class _Run:
         result = converged_or_failed(result)
         full = (relax == Relaxation() and not hold_ankles and problem in (None, self.options)
                 and dict(bounds) == dict(parameter_bounds(self.options)))
+        # One count per phase when the knots were given so (StageReport's annotation is the
+        # two-phase pair; it shows the first two and the gait file records them all).
         report = StageReport(
-            name=self.prefix + name, knots=grid_knots(knots, self.options),
+            name=self.prefix + name,
+            knots=cast(tuple[int, int], grid_knots(knots, self.options)),
             status=result.status,
             success=result.success, iterations=result.iterations, objective=result.objective,
             violation=result.constraint_violation, wall_time_s=time.perf_counter() - start,
