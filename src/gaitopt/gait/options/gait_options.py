@@ -19,10 +19,10 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from operator import attrgetter
-from typing import Any, Generic, Literal, TypedDict, TypeVar, Unpack, cast, overload
+from typing import TYPE_CHECKING, Any, Generic, Literal, TypedDict, TypeVar, Unpack, cast, overload
 
 from gaitopt.gait.formulations.traits import FORMULATION_TRAITS
 from gaitopt.gait.sequence.knots import BUILTIN_PHASES, KnotsError, knots_in_order
@@ -384,27 +384,28 @@ class SolverOptions:
     multistart: bool = False
 
 
-class _Alias(Generic[_T]):
-    """A read-only flat attribute of :class:`GaitOptions`: ``options.speed`` reads
-    ``options.targets.speed`` (the field of the same name in the group ``group``)."""
+if TYPE_CHECKING:
+    class _Alias(Generic[_T]):
+        """The type of a shorthand: reads ``_T`` on an instance (see below)."""
 
-    def __init__(self, group: str) -> None:
-        self.group, self.name = group, ""
-        self._get: Callable[[object], Any] = attrgetter(group)
+        def __init__(self, path: str) -> None: ...
+        @overload
+        def __get__(self, obj: None, owner: type | None = None) -> _Alias[_T]: ...
+        @overload
+        def __get__(self, obj: object, owner: type | None = None) -> _T: ...
+        def __get__(self, obj: object | None, owner: type | None = None) -> _Alias[_T] | _T:
+            ...
+else:
+    class _Alias(property):
+        """A read-only flat attribute of :class:`GaitOptions`: ``speed =
+        _Alias[float | None]("targets.speed")`` reads ``options.targets.speed`` (a property
+        whose getter is an :func:`operator.attrgetter`: as fast as a plain property)."""
 
-    def __set_name__(self, owner: type, name: str) -> None:
-        self.name = name
-        self._get = attrgetter(f"{self.group}.{name}")
-        self.__doc__ = f"Shorthand of ``{self.group}.{name}`` (read-only)."
+        def __init__(self, path: str) -> None:
+            super().__init__(attrgetter(path), doc=f"Shorthand of ``{path}`` (read-only).")
 
-    @overload
-    def __get__(self, obj: None, owner: type | None = None) -> _Alias[_T]: ...
-    @overload
-    def __get__(self, obj: object, owner: type | None = None) -> _T: ...
-    def __get__(self, obj: object | None, owner: type | None = None) -> _Alias[_T] | _T:
-        if obj is None:
-            return self
-        return cast(_T, self._get(obj))
+        def __class_getitem__(cls, item: object) -> type:
+            return cls
 
 
 #: The groups of :class:`GaitOptions`: attribute name -> group class.
@@ -549,46 +550,47 @@ class GaitOptions:
             object.__setattr__(self, group, value)
 
     # -- the shorthands (read-only) ------------------------------------------------------------
-    speed = _Alias[float | None]("targets")
-    speed_bounds = _Alias[tuple[float, float]]("targets")
-    step_length = _Alias[float | None]("targets")
-    step_length_bounds = _Alias[tuple[float, float]]("targets")
-    step_time = _Alias[float | None]("targets")
-    gait = _Alias[GaitKind]("sequence")
-    contact_sequence = _Alias[dict[str, Any] | None]("sequence")
-    stride = _Alias[bool]("sequence")
-    single_support_fraction = _Alias[float]("sequence")
-    single_support_fraction_bounds = _Alias[tuple[float, float] | None]("sequence")
-    free_phase_fractions = _Alias[bool]("sequence")
-    phase_shares = _Alias[tuple[float, ...] | None]("sequence")
-    ankle = _Alias[bool]("sequence")
-    impulse = _Alias[bool]("sequence")
-    min_stance_knee_flexion = _Alias[float]("limits")
-    torso_bounds = _Alias[tuple[float, float]]("limits")
-    rate_bound = _Alias[float]("limits")
-    max_impulse = _Alias[float]("limits")
-    unilateral_impulses = _Alias[bool]("limits")
-    friction = _Alias[float | None]("limits")
-    swing_clearance = _Alias[float | None]("limits")
-    clearance_profile = _Alias[ClearanceProfile]("limits")
-    cost = _Alias[CostName]("objective")
-    efficiency_positive = _Alias[float]("objective")
-    efficiency_negative = _Alias[float]("objective")
-    resting_power = _Alias[float]("objective")
-    cost_smoothing = _Alias[float]("objective")
-    cost_regularization = _Alias[float]("objective")
-    torque_rate_time = _Alias[float]("objective")
-    knot_spacing = _Alias[KnotSpacing]("discretisation")
-    transcription = _Alias[Transcription]("discretisation")
-    control_model = _Alias[ControlModel]("discretisation")
-    periodic_controls = _Alias[bool]("discretisation")
-    mesh_tol = _Alias[float | None]("discretisation")
-    accuracy = _Alias[float | None]("discretisation")
-    formulation = _Alias[Formulation]("solver")
-    tol = _Alias[float]("solver")
-    max_iter = _Alias[int]("solver")
-    continuation = _Alias[bool]("solver")
-    multistart = _Alias[bool]("solver")
+    speed = _Alias[float | None]("targets.speed")
+    speed_bounds = _Alias[tuple[float, float]]("targets.speed_bounds")
+    step_length = _Alias[float | None]("targets.step_length")
+    step_length_bounds = _Alias[tuple[float, float]]("targets.step_length_bounds")
+    step_time = _Alias[float | None]("targets.step_time")
+    gait = _Alias[GaitKind]("sequence.gait")
+    contact_sequence = _Alias[dict[str, Any] | None]("sequence.contact_sequence")
+    stride = _Alias[bool]("sequence.stride")
+    single_support_fraction = _Alias[float]("sequence.single_support_fraction")
+    single_support_fraction_bounds = _Alias[tuple[float, float] | None](
+        "sequence.single_support_fraction_bounds")
+    free_phase_fractions = _Alias[bool]("sequence.free_phase_fractions")
+    phase_shares = _Alias[tuple[float, ...] | None]("sequence.phase_shares")
+    ankle = _Alias[bool]("sequence.ankle")
+    impulse = _Alias[bool]("sequence.impulse")
+    min_stance_knee_flexion = _Alias[float]("limits.min_stance_knee_flexion")
+    torso_bounds = _Alias[tuple[float, float]]("limits.torso_bounds")
+    rate_bound = _Alias[float]("limits.rate_bound")
+    max_impulse = _Alias[float]("limits.max_impulse")
+    unilateral_impulses = _Alias[bool]("limits.unilateral_impulses")
+    friction = _Alias[float | None]("limits.friction")
+    swing_clearance = _Alias[float | None]("limits.swing_clearance")
+    clearance_profile = _Alias[ClearanceProfile]("limits.clearance_profile")
+    cost = _Alias[CostName]("objective.cost")
+    efficiency_positive = _Alias[float]("objective.efficiency_positive")
+    efficiency_negative = _Alias[float]("objective.efficiency_negative")
+    resting_power = _Alias[float]("objective.resting_power")
+    cost_smoothing = _Alias[float]("objective.cost_smoothing")
+    cost_regularization = _Alias[float]("objective.cost_regularization")
+    torque_rate_time = _Alias[float]("objective.torque_rate_time")
+    knot_spacing = _Alias[KnotSpacing]("discretisation.knot_spacing")
+    transcription = _Alias[Transcription]("discretisation.transcription")
+    control_model = _Alias[ControlModel]("discretisation.control_model")
+    periodic_controls = _Alias[bool]("discretisation.periodic_controls")
+    mesh_tol = _Alias[float | None]("discretisation.mesh_tol")
+    accuracy = _Alias[float | None]("discretisation.accuracy")
+    formulation = _Alias[Formulation]("solver.formulation")
+    tol = _Alias[float]("solver.tol")
+    max_iter = _Alias[int]("solver.max_iter")
+    continuation = _Alias[bool]("solver.continuation")
+    multistart = _Alias[bool]("solver.multistart")
 
     @property
     def knots(self) -> tuple[int, ...]:
@@ -600,8 +602,8 @@ class GaitOptions:
             GaitOptionsError: the mapping names a phase the step lacks or leaves one out.
         """
         knots = self.discretisation.knots
-        if not isinstance(knots, Mapping):
-            return knots
+        if not isinstance(knots, dict):  # a mapping is kept as a dict (Discretisation)
+            return cast(tuple[int, ...], knots)
         try:
             return knots_in_order(knots, phase_names(self), "discretisation.knots")
         except KnotsError as exc:
@@ -716,30 +718,31 @@ def _bounds(name: str, value: Any, *, positive: bool = False) -> tuple[float, fl
 def _check_knots(o: GaitOptions) -> None:
     """The ``knots`` of :func:`validate_options`: its form (:mod:`gaitopt.gait.sequence.knots`),
     then >= 3 knots in the first phase, >= 2 in every other, at most 400 in any."""
-    given, path, phases = o.discretisation.knots, "discretisation.knots", phase_names(o)
-    form = ("two integers (single support, double support)" if len(phases) <= 2 else
-            f"two integers (first phase, every later phase), one per phase or a mapping "
-            f"phase name -> count ({', '.join(phases)})")
-    if isinstance(given, Mapping):
-        counts: Any = o.knots  # its names checked against the phases
-        shown = "{" + ", ".join(f"{k}: {v!r}" for k, v in given.items()) + "}"
-    else:
-        counts, shown = given, repr(given)
-        if (isinstance(given, tuple | list) and len(given) != 2
-                and not len(given) == len(phases) > 2):
-            counts = None
+    given, path = o.discretisation.knots, "discretisation.knots"
+    named = isinstance(given, dict)  # a mapping is kept as a dict (Discretisation)
+    counts: Any = o.knots if named else given  # a mapping's names checked against the phases
+    if (not named and isinstance(given, tuple | list) and len(given) != 2
+            and not len(given) == len(phase_names(o)) > 2):
+        counts = None
     if (not isinstance(counts, tuple | list) or not counts
             or not all(isinstance(k, int) and not isinstance(k, bool) for k in counts)):
-        raise GaitOptionsError(f"{path} = {shown}: must be {form}")
-    if not isinstance(given, Mapping):
-        shown = str(tuple(given))
-    later = counts[1:] if len(phases) != 1 else ()
-    if counts[0] < 3 or (o.double_support and later and min(later) < 2):
-        where = ("in single support and >= 2 in double support" if len(phases) <= 2 else
-                 "in the first phase and >= 2 in every other")
-        raise GaitOptionsError(f"{path} = {shown}: need >= 3 knots {where}")
+        phases = phase_names(o)
+        form = ("two integers (single support, double support)" if len(phases) <= 2 else
+                f"two integers (first phase, every later phase), one per phase or a mapping "
+                f"phase name -> count ({', '.join(phases)})")
+        raise GaitOptionsError(f"{path} = {_knots_shown(given)}: must be {form}")
+    if counts[0] < 3 or (o.double_support and len(counts) > 1 and min(counts[1:]) < 2):
+        where = ("in single support and >= 2 in double support" if len(counts) <= 2 and not named
+                 else "in the first phase and >= 2 in every other")
+        raise GaitOptionsError(f"{path} = {_knots_shown(given)}: need >= 3 knots {where}")
     if max(counts) > 400:
-        raise GaitOptionsError(f"{path} = {shown}: at most 400 per phase")
+        raise GaitOptionsError(f"{path} = {_knots_shown(given)}: at most 400 per phase")
+
+
+def _knots_shown(given: Any) -> str:
+    if isinstance(given, Mapping):
+        return "{" + ", ".join(f"{k}: {v!r}" for k, v in given.items()) + "}"
+    return str(tuple(given)) if isinstance(given, tuple | list) else repr(given)
 
 
 def validate_options(options: GaitOptions, biped: Biped | None) -> None:
