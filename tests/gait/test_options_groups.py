@@ -219,8 +219,10 @@ def test_knots_option_forms() -> None:
     for bad in ("16", "16,x", "single_support=16,6", "=3,b=4", "a=1.5,b=2"):
         with pytest.raises(UserError, match="--knots"):
             parse_phase_knots(bad)
-    assert grid_choice("single_support=16,double_support=6", None, False) == {
+    assert grid_choice("single_support=16,double_support=6", None, False, by_phase=True) == {
         "knots": {"single_support": 16, "double_support": 6}}
+    with pytest.raises(UserError, match="must be two integers 'single,double'"):
+        grid_choice("single_support=16,double_support=6", None, False)  # a study's sweeps
 
 
 def test_solve_refuses_a_knots_name_that_is_not_a_phase(monkeypatch: pytest.MonkeyPatch) -> None:

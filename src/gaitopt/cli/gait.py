@@ -19,13 +19,13 @@ from gaitopt.cli.base import (
     formulation_option,
     grid_choice,
     knot_spacing_option,
-    knots_option,
     make_console,
     min_knee_flexion_option,
     model_option,
     paper_grid_option,
     parse_free_or_value,
     parse_pair,
+    phase_knots_option,
     resting_power_option,
 )
 from gaitopt.gait.formulations.select import (
@@ -159,7 +159,7 @@ def _step_time(text: str) -> float | None:
               help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "
                    "lengths, no leg swap assumed (for unequal legs); cost per metre of the "
                    "stride; full formulation (the default with it).")
-@knots_option
+@phase_knots_option
 @knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events; "
                      "docs/walking.md section 6) or uniform.")
 @paper_grid_option
@@ -281,7 +281,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
         contact_sequence=sequence,
         step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=(not run) if impulse is None else impulse,
-        **{**grid_choice(knots, control_model, paper_grid, knot_spacing),
+        **{**grid_choice(knots, control_model, paper_grid, knot_spacing, by_phase=True),
            **({"transcription": transcription} if transcription else {}),
            **given},
         periodic_controls=periodic_controls, friction=friction,
