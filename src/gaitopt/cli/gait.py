@@ -307,7 +307,9 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
         validate_options(options, biped_for(model, options))
         sequence_used = checked_sequence(model, options)
     except (GaitOptionsError, BipedStructureError) as exc:
-        raise UserError(str(exc)) from None
+        message = str(exc)  # the knots' form and names are --knots' (its text parsed alone)
+        raise UserError(("--knots: " if message.startswith("discretisation.knots")
+                         and knots is not None else "") + message) from None
     reference = reference_speed(model, options)
     if multistart is None:
         multistart = multistart_default(options.speed, formulation_of(options), reference,

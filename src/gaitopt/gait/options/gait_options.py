@@ -1,7 +1,15 @@
 """Options of the walking problem: the variant, the targets and every bound, validated.
 
-(One concept, kept whole at about 430 lines: the options and the check of each; a third of
-the length is the documentation of the fields.)
+:class:`GaitOptions` holds six groups (:class:`Targets`, :class:`SequenceOptions`,
+:class:`Limits`, :class:`CostOptions`, :class:`Discretisation`, :class:`SolverOptions`; the
+table in its docstring), takes every field also as a flat keyword and reads it as a flat
+read-only shorthand (``options.speed`` for ``options.targets.speed``), so the code written
+against the flat options of before reads the same. The gait file keeps the flat names
+(:meth:`GaitOptions.to_dict`); :func:`validate_options` names each field by its grouped path
+(``targets.speed = ...``).
+
+(One concept, kept whole at about 900 lines: the options, their groups and shorthands, and
+the check of each; half of the length is the documentation of the fields.)
 
 Defaults follow the paper's problem (ankle torques and the liftoff impulse on, single support
 85 % of the step, the speed given at 12 m/min, the paper's globally optimal speed, and the step
@@ -311,8 +319,10 @@ class Discretisation:
             phase of the step, in phase order. 16 + 6 by default (the cost within 0.1 % of
             the fine-grid limit with ``control_model="jumps"``); the paper's 8 + 5 with
             :meth:`GaitOptions.paper`; 24 + 16 for steps of more than two phases
-            (:data:`gaitopt.gait.options.model_defaults.MULTI_PHASE_KNOTS`). Each phase has
-            3 to 400 knots (a double support at least 2).
+            (:data:`gaitopt.gait.options.model_defaults.MULTI_PHASE_KNOTS`). The first phase
+            has at least 3 knots, every later one at least 2, none more than 400. A gait file
+            stores the form given (:meth:`GaitOptions.to_dict`); ``GaitOptions.knots`` reads
+            the counts in phase order.
         knot_spacing: ``"cosine"`` (the default since 2026-12-02; the paper's preset:
             ``"uniform"``) or ``"uniform"``: the knots of the target grid (``knots``, not the
             coarse stages) at ``tau_k = (1 - cos(pi k / (N - 1))) / 2`` in each phase,
