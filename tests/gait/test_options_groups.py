@@ -234,3 +234,20 @@ def test_solve_refuses_a_knots_name_that_is_not_a_phase(monkeypatch: pytest.Monk
     assert result.exit_code == 2, result.output
     assert "not phases of the step (its phases: single_support, double_support)" in " ".join(
         result.output.split())
+
+
+@pytest.mark.slow
+def test_a_heel_toe_walk_solves_on_knots_given_by_name() -> None:
+    """About 2 minutes: every stage past the coarse ones on the named counts, the check grid
+    1.5 times each, the file keeping the mapping (measured 2026-12-03: converged, 2381.5)."""
+    from gaitopt import solve_gait
+
+    knots = {"foot_flat": 12, "heel_off": 6, "double_support": 8, "heel_rocker": 5}
+    gait = solve_gait("seven-link", GaitOptions(knots=knots, knot_spacing="uniform",
+                                                accuracy=None))
+    assert gait.success
+    assert [(p.name, len(p.t)) for p in gait.phases] == list(knots.items())
+    stages = {s["name"]: s["knots"] for s in gait.solver["stages"]}
+    assert stages["target grid, all free"] == [12, 6, 8, 5]
+    assert stages["check grid"] == [18, 9, 12, 8]
+    assert gait.options["knots"] == knots
