@@ -5,6 +5,8 @@ name (the walk's two, the heel-toe walk's four, a name the step lacks refused; `
 from __future__ import annotations
 
 import dataclasses
+import inspect
+import re
 import typing
 from pathlib import Path
 from typing import Any
@@ -15,6 +17,7 @@ from click.testing import CliRunner
 from gaitopt.cli import cli
 from gaitopt.cli.base import UserError, grid_choice, parse_phase_knots
 from gaitopt.gait.formulations.select import biped_for, contact_sequence, problem_for
+from gaitopt.gait.options import gait_options
 from gaitopt.gait.options.gait_options import (
     FIELD_GROUPS,
     GROUPS,
@@ -27,6 +30,7 @@ from gaitopt.gait.options.gait_options import (
     SequenceOptions,
     SolverOptions,
     Targets,
+    field_path,
     validate_options,
 )
 from gaitopt.gait.options.model_defaults import options_for_model
@@ -54,10 +58,24 @@ def test_six_groups_hold_every_option_once() -> None:
                             "solver"]
     assert [f.name for f in dataclasses.fields(GaitOptions)] == list(GROUPS)
     assert len(FIELD_GROUPS) == 41
-    assert set(typing.get_type_hints(FlatOptions)) == set(FIELD_GROUPS)
+    flat = typing.get_type_hints(FlatOptions)
+    assert set(flat) == set(FIELD_GROUPS)
     for name, group in FIELD_GROUPS.items():
-        assert name in {f.name for f in dataclasses.fields(GROUPS[group])}
+        assert typing.get_type_hints(GROUPS[group])[name] == flat[name], name  # same types
         assert getattr(GaitOptions, name).__doc__ is not None  # a documented shorthand
+
+
+def test_each_shorthand_is_declared_with_its_fields_type() -> None:
+    """The shorthands are typed by hand for mypy (``speed = _Alias[float | None](
+    "targets.speed")``): each names its own field and that field's annotation."""
+    source = inspect.getsource(gait_options)
+    declared = {m[0]: (m[1], m[2]) for m in re.findall(
+        r"^    (\w+) = _Alias\[(.+?)\]\(\s*\"(\w+\.\w+)\"\)", source, flags=re.M | re.S)}
+    assert set(declared) == set(FIELD_GROUPS) - {"knots"}  # knots: the counts, a property
+    for name, (annotation, path) in declared.items():
+        group = GROUPS[FIELD_GROUPS[name]]
+        assert path == field_path(name), name
+        assert annotation == {f.name: f.type for f in dataclasses.fields(group)}[name], name
 
 
 def test_grouped_and_flat_construction_agree() -> None:
