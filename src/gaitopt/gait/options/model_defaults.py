@@ -108,7 +108,7 @@ def gait_problem(model: RobotModel, gait: str) -> str | None:
     if gait in (allowed, "run"):
         return None  # a run stands on one point per leg, or on the toes of feet
     also = " or 'run'"
-    return (f"gait = {gait!r}: {_describe(model)}: use gait {allowed!r}{also} "
+    return (f"sequence.gait = {gait!r}: {_describe(model)}: use gait {allowed!r}{also} "
             f"(--gait {allowed}, the default)")
 
 
