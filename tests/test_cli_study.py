@@ -65,7 +65,7 @@ def test_variants() -> None:
     (["--step-length", "0"], "--step-length: '0' must be > 0 m"),
     (["--single-support", "1.5"], "--single-support: '1.5' must lie in \\(0, 1\\]"),
     (["--knots", "8;5"], "--knots"),
-    (["--speeds", "12,150", "--step-time", "1"], "150.00 m/min: step_time = 1 s"),
+    (["--speeds", "12,150", "--step-time", "1"], "150.00 m/min: targets.step_time = 1 s"),
     (["--step-length", "2", "--speeds", "12"], "step_length = 2 m: longer than the legs"),
     (["--model", "no-such-model.yaml"], "no-such-model.yaml"),
 ])

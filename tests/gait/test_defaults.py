@@ -10,7 +10,6 @@ optima recorded since 2026-11-22 (docs/guide.md, docs/walking.md section 5).
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import pytest
@@ -32,8 +31,8 @@ def test_the_paper_preset_changes_the_grid_the_control_model_and_the_form_only()
         (8, 5), "paper", "hermite-simpson", "uniform") == tuple(PAPER_GRID[f] for f in fields)
     assert tuple(getattr(default, f) for f in fields) == (
         (16, 6), "jumps", "hermite-simpson-separated", "cosine")
-    differ = {f.name for f in dataclasses.fields(GaitOptions)
-              if getattr(default, f.name) != getattr(paper, f.name)}
+    differ = {name for name, value in default.to_dict().items()
+              if paper.to_dict()[name] != value}
     assert differ == set(fields)
     assert paper.paper_grid and not default.paper_grid
     assert GaitOptions.paper(speed=None).speed is None  # changes apply on top of the preset

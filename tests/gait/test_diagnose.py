@@ -148,7 +148,7 @@ def _short_legs(tmp_path: Path, length: float = 0.2) -> Path:
     ("0.78", "longer than the legs can reach"),  # refused by the options' own check
     # The step bounds follow the model (0.8 leg lengths: 0.32 m on 0.4 m legs): a step
     # beyond them is refused by name before the reach is looked at.
-    ("0.7", "must lie in step_length_bounds [0.008, 0.32] m"),
+    ("0.7", "must lie in targets.step_length_bounds [0.008, 0.32] m"),
 ])
 def test_an_unreachable_step_is_one_line_naming_the_reach(tmp_path: Path, step: str,
                                                           words: str) -> None:
@@ -157,7 +157,7 @@ def test_an_unreachable_step_is_one_line_naming_the_reach(tmp_path: Path, step: 
                                       "--step-length", step, "-o", str(out)])
     assert result.exit_code == 2, result.output
     last = result.output.strip().splitlines()[-1]  # after the "solving ..." line, if any
-    assert last.startswith("Error: step_length = ") and words in last
+    assert last.startswith("Error: targets.step_length = ") and words in last
     assert ("shorter step" in last or "needs step_length <" in last
             or "step_length_bounds" in last)
     assert "Traceback" not in result.output and not out.exists()
@@ -170,6 +170,6 @@ def test_a_step_no_naive_start_can_place_is_one_line_naming_the_reach(tmp_path: 
     with pytest.raises(GaitOptionsError) as info:
         solve_gait(str(_short_legs(tmp_path)), options)
     message = str(info.value)
-    assert message.startswith("step_length = ")
+    assert message.startswith("targets.step_length = ")
     assert "every naive start puts a leg beyond its reach" in message
     assert "shorter step" in message or "needs step_length <" in message

@@ -242,7 +242,8 @@ def test_a_free_single_support_fraction(solved: SolveFn) -> None:
     ({"single_support_fraction_bounds": (0.6, 0.95)}, "needs formulation 'full'"),
     ({"formulation": "full", "single_support_fraction_bounds": (0.6, 1.0)}, r"\[0.05, 1\)"),
     ({"formulation": "full", "single_support_fraction_bounds": (0.9, 0.95)},
-     "single_support_fraction = 0.85: must lie in single_support_fraction_bounds"),
+     "sequence.single_support_fraction = 0.85: must lie in "
+     "sequence.single_support_fraction_bounds"),
 ])
 def test_free_fraction_errors(changes: dict[str, object], message: str) -> None:
     legs = biped_of(load_model("five-link"))

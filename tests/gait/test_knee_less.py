@@ -97,12 +97,12 @@ def test_a_step_the_legs_cannot_reach_is_a_clear_error(tmp_path: Path) -> None:
     for contact in data["contacts"]:
         contact["at"] = [0.3, 0.0]
     model = model_from_dict(data)
-    with pytest.raises(GaitOptionsError, match=r"step_length = 0.75 m: must lie in "
-                       r"step_length_bounds \[0.006, 0.24\] m"):
+    with pytest.raises(GaitOptionsError, match=r"targets.step_length = 0.75 m: must lie in "
+                       r"targets.step_length_bounds \[0.006, 0.24\] m"):
         solve_gait(model, GaitOptions(formulation="full", step_length=0.75))
-    with pytest.raises(GaitOptionsError, match=r"step_length = 0.75 m: every naive start puts "
-                       r"a leg beyond its reach \(the legs of model 'compass' cannot hold "
-                       r"'tip_1'.*misses it by 0.0"):
+    with pytest.raises(GaitOptionsError, match=r"targets.step_length = 0.75 m: every naive "
+                       r"start puts a leg beyond its reach \(the legs of model 'compass' "
+                       r"cannot hold 'tip_1'.*misses it by 0.0"):
         solve_gait(model, GaitOptions(formulation="full", step_length=0.75, speed=0.2,
                                       step_length_bounds=(0.02, 0.8)))
 

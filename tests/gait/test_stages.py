@@ -9,7 +9,7 @@ import dataclasses
 import pytest
 
 from gaitopt.gait.formulations.step_parameters import FRACTION, IMPULSE, SPEED, parameter_bounds
-from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.options.gait_options import FIELD_GROUPS, GaitOptions
 from gaitopt.gait.solve.stages import (
     ANKLES,
     COARSE_COMPLETION,
@@ -21,7 +21,7 @@ from gaitopt.gait.solve.stages import (
 from gaitopt.gait.solve.transcriptions import BOUNDS_ONLY_OPTIONS, NlpStructure
 from gaitopt.robot import load_model
 
-FIELDS = {f.name for f in dataclasses.fields(GaitOptions)}
+FIELDS = set(FIELD_GROUPS)
 
 
 def _released(options: GaitOptions) -> list[str]:

@@ -106,7 +106,8 @@ def test_a_stride_needs_the_full_formulation() -> None:
     with pytest.raises(GaitOptionsError, match="stride: a two-step stride needs formulation "
                                                "'full'"):
         validate_options(GaitOptions(stride=True), None)
-    with pytest.raises(GaitOptionsError, match="stride and single_support_fraction_bounds"):
+    with pytest.raises(GaitOptionsError,
+                       match="sequence.stride and sequence.single_support_fraction_bounds"):
         validate_options(FULL.replace(stride=True,
                                       single_support_fraction_bounds=(0.7, 0.9)), None)
     result = CliRunner().invoke(cli, ["solve", "--stride", "--formulation", "reduced",

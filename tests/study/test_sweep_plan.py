@@ -127,7 +127,7 @@ def test_bad_grids_are_refused_with_the_setting_named(kw: dict[str, object],
 
 def test_every_point_is_validated_before_any_solve() -> None:
     # (a given speed is not checked against speed_bounds; a step it cannot reach is)
-    with pytest.raises(SweepSpecError, match=r"plain .*120.00 m/min: step_time = 1 s"):
+    with pytest.raises(SweepSpecError, match=r"plain .*120.00 m/min: targets.step_time = 1 s"):
         check_points(spec(speeds=(0.2, 2.0), step_times=(1.0,), variants=("plain",)))
     with pytest.raises(SweepSpecError, match="step_length = 3 m: longer than the legs"):
         check_points(spec(speeds=(0.2,), step_lengths=(3.0,)))

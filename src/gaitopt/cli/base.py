@@ -89,6 +89,25 @@ def parse_pair(text: str, option: str) -> tuple[float, float]:
     return lo, hi
 
 
+def parse_phase_knots(text: str) -> tuple[int, ...] | dict[str, int]:
+    """``--knots`` of a solve: counts ``16,6`` (single, double support; or one per phase of
+    the step) or counts by phase name ``single_support=16,double_support=6`` (a usage error
+    otherwise; the names are checked against the step's phases with the other options)."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        if all("=" in p for p in parts):
+            named = {k.strip(): int(v) for k, v in (p.split("=", 1) for p in parts)}
+            if len(named) == len(parts) and all(named):
+                return named
+        elif not any("=" in p for p in parts) and len(parts) >= 2:
+            return tuple(int(p) for p in parts)
+    except ValueError:
+        pass
+    raise UserError(f"--knots: {text!r} must be integers 'single,double' (e.g. 16,6; or one "
+                    "per phase) or counts by phase name, e.g. "
+                    "single_support=16,double_support=6")
+
+
 def parse_knots(text: str) -> tuple[int, int]:
     """``single,double`` knot counts (a usage error otherwise)."""
     parts = text.split(",")
@@ -113,12 +132,29 @@ def model_option(f: F) -> F:
 
 
 def knots_option(f: F) -> F:
-    """``--knots SINGLE,DOUBLE`` (text or None: the default grid; see :func:`grid_choice`)."""
+    """``--knots SINGLE,DOUBLE`` of a study (text or None: the default grid; see
+    :func:`grid_choice`)."""
     from gaitopt.gait.options.gait_options import GaitOptions
     from gaitopt.gait.options.model_defaults import MULTI_PHASE_KNOTS
 
     return click.option("--knots", default=None,
                         help="Grid points per phase: single support, double support [default: "
+                             f"{','.join(map(str, GaitOptions().knots))}; "
+                             f"{','.join(map(str, MULTI_PHASE_KNOTS))} for steps of more than "
+                             "two phases, e.g. the heel-toe walk].")(f)
+
+
+def phase_knots_option(f: F) -> F:
+    """``--knots SINGLE,DOUBLE``, one count per phase or ``--knots PHASE=N,...`` of a solve
+    (text or None: the default grid; see :func:`grid_choice` with ``by_phase``)."""
+    from gaitopt.gait.options.gait_options import GaitOptions
+    from gaitopt.gait.options.model_defaults import MULTI_PHASE_KNOTS
+
+    return click.option("--knots", default=None,
+                        help="Grid points per phase: single support, double support (e.g. "
+                             "16,6), one per phase, or by phase name (e.g. "
+                             "single_support=16,double_support=6; the heel-toe walk's "
+                             "foot_flat, heel_off, double_support, heel_rocker) [default: "
                              f"{','.join(map(str, GaitOptions().knots))}; "
                              f"{','.join(map(str, MULTI_PHASE_KNOTS))} for steps of more than "
                              "two phases, e.g. the heel-toe walk].")(f)
@@ -182,12 +218,15 @@ def control_model_option(help: str) -> Callable[[F], F]:
 
 
 def grid_choice(knots: str | None, control_model: str | None,
-                paper_grid: bool, knot_spacing: str | None = None) -> dict[str, Any]:
+                paper_grid: bool, knot_spacing: str | None = None, *,
+                by_phase: bool = False) -> dict[str, Any]:
     """The ``knots``, ``control_model`` and ``knot_spacing`` of ``--knots``,
     ``--control-model``, ``--knot-spacing`` and ``--paper-grid`` (the paper's 8 + 5 uniform
     knots, control model and compressed transcription, ``GaitOptions.paper``); unset ones
     keep the :class:`~gaitopt.gait.options.gait_options.GaitOptions` defaults. ``--paper-grid`` with
-    ``--knots``, ``--control-model`` or cosine knots is a usage error."""
+    ``--knots``, ``--control-model`` or cosine knots is a usage error. ``by_phase`` (a solve):
+    ``--knots`` also by phase name or one count per phase (:func:`parse_phase_knots`); else
+    (a study's sweeps, whose grids are pairs) ``single,double``."""
     from gaitopt.gait.options.gait_options import PAPER_GRID
 
     if paper_grid:
@@ -200,7 +239,7 @@ def grid_choice(knots: str | None, control_model: str | None,
         return dict(PAPER_GRID)
     out: dict[str, Any] = {}
     if knots is not None:
-        out["knots"] = parse_knots(knots)
+        out["knots"] = parse_phase_knots(knots) if by_phase else parse_knots(knots)
     if control_model is not None:
         out["control_model"] = control_model
     if knot_spacing is not None:

@@ -19,13 +19,13 @@ from gaitopt.cli.base import (
     formulation_option,
     grid_choice,
     knot_spacing_option,
-    knots_option,
     make_console,
     min_knee_flexion_option,
     model_option,
     paper_grid_option,
     parse_free_or_value,
     parse_pair,
+    phase_knots_option,
     resting_power_option,
 )
 from gaitopt.gait.formulations.select import (
@@ -159,7 +159,7 @@ def _step_time(text: str) -> float | None:
               help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "
                    "lengths, no leg swap assumed (for unequal legs); cost per metre of the "
                    "stride; full formulation (the default with it).")
-@knots_option
+@phase_knots_option
 @knot_spacing_option("The knots of each phase: cosine-spaced (clustered at the events; "
                      "docs/walking.md section 6) or uniform.")
 @paper_grid_option
@@ -281,7 +281,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
         contact_sequence=sequence,
         step_length=_step(step_length), step_time=_step_time(step_time),
         ankle=ankle, impulse=(not run) if impulse is None else impulse,
-        **{**grid_choice(knots, control_model, paper_grid, knot_spacing),
+        **{**grid_choice(knots, control_model, paper_grid, knot_spacing, by_phase=True),
            **({"transcription": transcription} if transcription else {}),
            **given},
         periodic_controls=periodic_controls, friction=friction,
@@ -299,14 +299,17 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                                                  "--single-support-bounds"))
     if min_knee_flexion is not None:
         options = options.replace(min_stance_knee_flexion=min_knee_flexion)
-    refine = follows_model(options.knots)  # knots left to the model: refine to --accuracy
+    # knots left to the model: refine to --accuracy
+    refine = follows_model(options.discretisation.knots)
     try:
         options = options_for_model(model, options)
         refuse_unwalkable(model, options)
         validate_options(options, biped_for(model, options))
         sequence_used = checked_sequence(model, options)
     except (GaitOptionsError, BipedStructureError) as exc:
-        raise UserError(str(exc)) from None
+        message = str(exc)  # the knots' form and names are --knots' (its text parsed alone)
+        raise UserError(("--knots: " if message.startswith("discretisation.knots")
+                         and knots is not None else "") + message) from None
     reference = reference_speed(model, options)
     if multistart is None:
         multistart = multistart_default(options.speed, formulation_of(options), reference,
@@ -316,7 +319,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   f"{'free' if options.speed is None else format_speed(options.speed)}, step "
                   f"length {'free' if options.step_length is None else f'{options.step_length} m'}"
                   + ("" if options.step_time is None else f", step time {options.step_time} s")
-                  + f", {options.knots[0]}+{options.knots[1]} knots, control model "
+                  + f", {'+'.join(map(str, options.knots))} knots, control model "
                   f"{options.control_model}"
                   + (" (the paper's grid)" if options.paper_grid else "")
                   + f", {options.formulation} coordinates"
@@ -334,7 +337,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       "and keeps the best")
     per_step = (0 if sequence_used is None
                 else len(sequence_used.phases) // sequence_used.steps)
-    if (per_step > 2
+    if (per_step > 2 and len(options.knots) == 2
             and tuple(options.knots) < MULTI_PHASE_KNOTS):
         console.print(f"note: a {per_step}-phase step on {options.knots[0]}+"
                       f"{options.knots[1]} knots is coarse; the heel-toe walk passes verify on "

@@ -286,7 +286,8 @@ def refine_points(console: Console, directory: Path, model_name: str, grid: dict
     from gaitopt.study.summary import read_summary
 
     study_rows = read_summary(directory / SUMMARY_FILE)
-    previous, knots = directory / CHECK_DIR, errors.check_knots
+    previous = directory / CHECK_DIR
+    knots: tuple[int, ...] = errors.check_knots
     for level in range(1, MAX_REFINE_LEVELS + 1):
         folder = directory / refine_dir_name(level)
         points = errors.to_refine(level)

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
+from gaitopt.gait.sequence.knots import knots_text
 from gaitopt.study.findings import HUMAN_OPTIMAL_SPEED_M_MIN, HUMAN_STEP_LENGTH, optimal_row
 from gaitopt.study.plan import SETTINGS_FILE
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS, SummaryRow, read_summary, rows_of
@@ -57,7 +58,7 @@ def sweep_label(folder: Path) -> str:
     try:
         settings = json.loads((folder / SETTINGS_FILE).read_text())["settings"]
         options = settings.get("options", {})
-        knots = "+".join(str(k) for k in options.get("knots", ()))
+        knots = knots_text(options.get("knots", ()))
         gait = ("custom sequence" if options.get("contact_sequence")
                 else options.get("gait", "walk"))
         return f"{settings['model']['name']} ({gait}, {knots} knots)"

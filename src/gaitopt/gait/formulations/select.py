@@ -167,7 +167,7 @@ class Full:
         except (ContactSequenceError, ValueError) as exc:
             raise GaitOptionsError(f"contact sequence: {exc}") from None
         if options.free_phase_fractions and len(seq.phases) < 2:
-            raise GaitOptionsError(f"free_phase_fractions: sequence {seq.name!r} has one "
+            raise GaitOptionsError(f"sequence.free_phase_fractions: sequence {seq.name!r} has one "
                                    "phase, whose share is the whole step: nothing to free")
         return seq
 

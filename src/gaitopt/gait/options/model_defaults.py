@@ -108,7 +108,7 @@ def gait_problem(model: RobotModel, gait: str) -> str | None:
     if gait in (allowed, "run"):
         return None  # a run stands on one point per leg, or on the toes of feet
     also = " or 'run'"
-    return (f"gait = {gait!r}: {_describe(model)}: use gait {allowed!r}{also} "
+    return (f"sequence.gait = {gait!r}: {_describe(model)}: use gait {allowed!r}{also} "
             f"(--gait {allowed}, the default)")
 
 
@@ -182,7 +182,7 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
         raise GaitOptionsError(why)
     if follows_model(o.formulation):
         changes["formulation"] = default_formulation(model, gait, custom, bool(o.stride))
-    if follows_model(o.knots):
+    if follows_model(o.discretisation.knots):
         changes["knots"] = (MULTI_PHASE_KNOTS if _phase_count(o, gait) > 2
                             else tuple(int(k) for k in o.knots))
     scale = model_scale(model)

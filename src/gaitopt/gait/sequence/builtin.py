@@ -17,6 +17,7 @@ from gaitopt.gait.sequence.contact_sequence import (
     EventSpec,
     PhaseSpec,
 )
+from gaitopt.gait.sequence.knots import BUILTIN_PHASES
 from gaitopt.robot.model import RobotModel
 
 
@@ -29,13 +30,14 @@ def walking_sequence(model: RobotModel, single_support_fraction: float, *,
     if single_support_fraction >= 1.0:
         return ContactSequence(
             "walk-single-support",
-            (PhaseSpec("single_support", (c1,), 1.0),),
+            (PhaseSpec(BUILTIN_PHASES["walk-single-support"][0], (c1,), 1.0),),
             (EventSpec("heel_strike", touchdown=(c2,), release=(c1,)),),
             anchors)
     f = single_support_fraction
+    single, double = BUILTIN_PHASES["walk"]
     return ContactSequence(
         "walk",
-        (PhaseSpec("single_support", (c1,), f), PhaseSpec("double_support", (c1, c2), 1.0 - f)),
+        (PhaseSpec(single, (c1,), f), PhaseSpec(double, (c1, c2), 1.0 - f)),
         (EventSpec("heel_strike", touchdown=(c2,)),
          EventSpec("liftoff", release=(c1,), impulse=impulse)),
         anchors)
@@ -47,9 +49,10 @@ def running_sequence(model: RobotModel, stance_fraction: float) -> ContactSequen
     is on the toes (a forefoot run: the toe pinned, the heel above the ground)."""
     c1, c2 = run_points(model)
     f = stance_fraction
+    stance, flight = BUILTIN_PHASES["run"]
     return ContactSequence(
         "run",
-        (PhaseSpec("stance", (c1,), f), PhaseSpec("flight", (), 1.0 - f)),
+        (PhaseSpec(stance, (c1,), f), PhaseSpec(flight, (), 1.0 - f)),
         (EventSpec("toe_off", release=(c1,)), EventSpec("touchdown", touchdown=(c2,))),
         ((c1, 0.0), (c2, 1.0)))
 
@@ -118,12 +121,13 @@ def heel_toe_sequence(model: RobotModel, contact_swap: Mapping[str, str],
     if f >= 1.0:
         raise ContactSequenceError("the heel-toe gait has a double support: "
                                    "single_support_fraction must be < 1")
+    flat, heel_off, double, rocker = BUILTIN_PHASES["heel-toe"]
     return ContactSequence(
         "heel-toe",
-        (PhaseSpec("foot_flat", (h1, f"{t1}:y"), 0.5 * f),
-         PhaseSpec("heel_off", (t1,), 0.35 * f),
-         PhaseSpec("double_support", (t1, h2), 1.0 - f),
-         PhaseSpec("heel_rocker", (h2,), 0.15 * f)),
+        (PhaseSpec(flat, (h1, f"{t1}:y"), 0.5 * f),
+         PhaseSpec(heel_off, (t1,), 0.35 * f),
+         PhaseSpec(double, (t1, h2), 1.0 - f),
+         PhaseSpec(rocker, (h2,), 0.15 * f)),
         (EventSpec("heel_rise", release=(h1,)),
          EventSpec("heel_strike", touchdown=(h2,)),
          EventSpec("toe_off", release=(t1,), impulse=impulse),

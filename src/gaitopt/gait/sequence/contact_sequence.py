@@ -50,6 +50,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from gaitopt.dynamics.tree import hold_name, holds
+from gaitopt.gait.sequence.knots import knots_in_order
 from gaitopt.robot.model import RobotModel
 
 
@@ -191,19 +192,31 @@ def phase_holds(sequence: Mapping[str, Any] | None, i: int, contacts: Sequence[s
     return tuple(contacts)
 
 
-def phase_knots(seq: ContactSequence, knots: Sequence[int]) -> tuple[int, ...]:
-    """Knots of each phase from ``knots = (first, others)``: two-phase sequences (and one)
-    take them as they are (the paper's single and double support); longer ones give phase
-    0 ``first`` knots and every other phase at least ``others``, more when the density of
-    phase 0 (intervals per share of the step) asks for more, so that long phases are not
-    coarser than phase 0. A stride's steps get the knots of one step each (its second step
-    those of the first: like with like against the one-step problem), when its phases split
-    into two steps of as many phases (a stride written by hand may not: then the rule above
-    on all its phases)."""
-    first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
+def phase_knots(seq: ContactSequence, knots: Sequence[int] | Mapping[str, int]
+                ) -> tuple[int, ...]:
+    """Knots of each phase from the ``knots`` option (:mod:`gaitopt.gait.sequence.knots`).
+
+    ``knots = (first, others)``: two-phase sequences (and one) take them as they are (the
+    paper's single and double support); longer ones give phase 0 ``first`` knots and every
+    other phase at least ``others``, more when the density of phase 0 (intervals per share of
+    the step) asks for more, so that long phases are not coarser than phase 0. One count per
+    phase of the step, or a mapping phase name -> count naming every phase of the step
+    (:func:`~gaitopt.gait.sequence.knots.knots_in_order`): those counts as they are. A
+    stride's steps get the knots of one step each (its second step those of the first: like
+    with like against the one-step problem), when its phases split into two steps of as many
+    phases (a stride written by hand may not: then the rules above on all its phases).
+
+    Raises:
+        KnotsError: a mapping names a phase the step lacks or leaves one out.
+    """
     n = len(seq.phases)
     repeats = seq.steps if n % seq.steps == 0 else 1
     step = seq.phases[:n // repeats]
+    if isinstance(knots, Mapping):
+        return knots_in_order(knots, [ph.name for ph in step]) * repeats
+    if len(knots) == len(step) > 2:
+        return tuple(int(k) for k in knots) * repeats
+    first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
     if len(step) <= 2:
         counts = tuple(first if i == 0 else others for i in range(len(step)))
     else:

@@ -20,16 +20,19 @@ its check and refinement sweeps on the same grids (:mod:`gaitopt.study.grid_erro
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 #: The check grid of the known grids; any other grid is refined by half its knots.
 CHECK_KNOTS: dict[tuple[int, int], tuple[int, int]] = {(16, 6): (24, 8), (8, 5): (16, 6)}
 
 
-def check_knots(knots: tuple[int, int]) -> tuple[int, int]:
-    """The check grid of ``knots`` (single support, double support): :data:`CHECK_KNOTS`,
-    else ``ceil(1.5 * knots)`` in each phase (``(40, 10)`` -> ``(60, 15)``)."""
-    k = (int(knots[0]), int(knots[1]))
-    return CHECK_KNOTS.get(k, (math.ceil(1.5 * k[0]), math.ceil(1.5 * k[1])))
+def check_knots(knots: Sequence[int]) -> tuple[int, ...]:
+    """The check grid of ``knots`` (single support, double support; or one count per phase):
+    :data:`CHECK_KNOTS`, else ``ceil(1.5 * knots)`` in each phase (``(40, 10)`` -> ``(60,
+    15)``)."""
+    k = tuple(int(v) for v in knots)
+    found = CHECK_KNOTS.get((k[0], k[1])) if len(k) == 2 else None
+    return found if found is not None else tuple(math.ceil(1.5 * v) for v in k)
 
 
 def first_order_factor(coarse: int, fine: int, *, of_finer: bool) -> float:

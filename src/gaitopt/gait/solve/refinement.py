@@ -109,8 +109,7 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         within = worst[0] <= target if target is not None else None
         if within is not False or rounds >= MAX_ROUNDS or not solution.success:
             break
-        single, double = solution.options.knots
-        finer = solution.options.replace(knots=check_knots((int(single), int(double))),
+        finer = solution.options.replace(knots=check_knots(solution.options.knots),
                                          phase_shares=solved_shares(solution))
         again = solve_on(finer, solution)
         if not again.success:

@@ -620,12 +620,12 @@ def unplaced_message(options: GaitOptions, unplaced: list[tuple[float, float, st
     tip (step length ``L``, single-support fraction ``f``), which the stance leg must reach."""
     step, r_max, why = max(unplaced, key=lambda u: u[0]) if unplaced else (nan, nan, "")
     if r_max == 0.0:  # the generic guess (no thigh-shank legs): no closed-form reach
-        return (f"step_length = {step:.3g} m: every naive start puts a leg beyond its reach "
-                f"({why}): a shorter step or a lower speed")
+        return (f"targets.step_length = {step:.3g} m: every naive start puts a leg beyond its "
+                f"reach ({why}): a shorter step or a lower speed")
     f = options.single_support_fraction
     longest = r_max / (1.0 - f / 2.0)
-    return (f"step_length = {step:.3g} m: every naive start puts a leg beyond its reach "
-            f"({why}); at single-support fraction {f:g} a step of this model's legs "
+    return (f"targets.step_length = {step:.3g} m: every naive start puts a leg beyond its "
+            f"reach ({why}); at single-support fraction {f:g} a step of this model's legs "
             f"(reach {r_max:.3g} m) is at most about {longest:.3g} m: a shorter step, a "
             "lower speed or a smaller single-support fraction")
 

@@ -38,7 +38,8 @@ class StageRecord:
     gait keeps it as an entry of ``solver["stages"]``)."""
 
     name: str
-    knots: tuple[int, int]
+    #: Knots per phase, in phase order (two for the walk, one per phase of a longer step).
+    knots: tuple[int, ...]
     status: str
     success: bool
     iterations: int

@@ -23,7 +23,7 @@ from gaitopt.gait.formulations.step_parameters import (
     Relaxation,
     parameter_bounds,
 )
-from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.options.gait_options import ControlModel, GaitOptions
 from gaitopt.gait.sequence.contact_sequence import sequence_from_dict
 from gaitopt.gait.sequence.phase_fractions import free_phases
 from gaitopt.ocp import Bounds, Result, Transcription
@@ -176,15 +176,17 @@ def check_grid_options(options: GaitOptions) -> dict[str, Any]:
 
 
 def coarse_knots(options: GaitOptions) -> tuple[int, int]:
-    """The grid of the first stages: the requested one, at most the paper's 8 + 5."""
-    return (min(8, options.knots[0]), min(5, options.knots[1]))
+    """The grid of the first stages: the requested one, at most the paper's 8 + 5 (knots
+    given per phase: the first phase's and the fewest of the others')."""
+    knots = options.knots
+    return (min(8, knots[0]), min(5, min(knots[1:]) if len(knots) > 1 else knots[0]))
 
 
 #: What the release stages free besides parameters: the ankle torques (held at zero before).
 ANKLES = "ankle torques"
 #: The control model of the contact stages (from the naive guess) and of the continuation in
 #: speed: the paper's, whatever the requested one (:mod:`gaitopt.gait.solve.staged`).
-COLD_CONTROL_MODEL = "paper"
+COLD_CONTROL_MODEL: ControlModel = "paper"
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from gaitopt.gait.formulations.select import problem_for
-from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
+from gaitopt.gait.options.gait_options import FIELD_GROUPS, GaitOptions, GaitOptionsError
 from gaitopt.gait.solve.function_cache import cached_functions as cached_functions
 from gaitopt.gait.solve.function_cache import disk_cached as disk_cached
 from gaitopt.gait.solve.function_cache import function_file as function_file
@@ -31,9 +31,10 @@ from gaitopt.ocp import Guess, Result, Transcription, WarmStart, transcribe
 from gaitopt.process_memory import memory_budget_bytes, release_freed_memory, resident_bytes
 from gaitopt.robot.model import RobotModel
 
-#: A grid: knots per phase (single support, double support), uniform, or one array of
-#: normalised knot times in [0, 1] per phase of the problem (a refined mesh).
-Grid = tuple[int, int] | tuple[np.ndarray, ...]
+#: A grid: knots per phase (single support, double support; or one count per phase of the
+#: step, :mod:`gaitopt.gait.sequence.knots`), uniform, or one array of normalised knot times
+#: in [0, 1] per phase of the problem (a refined mesh).
+Grid = tuple[int, ...] | tuple[np.ndarray, ...]
 
 #: Options that enter a solve only through bounds or the solve's own logic, never the NLP's
 #: structure: problems that differ only in these share one transcription.
@@ -46,10 +47,11 @@ def is_mesh(grid: Grid) -> bool:
     return not all(isinstance(k, int | np.integer) for k in grid)
 
 
-def grid_knots(grid: Grid, options: GaitOptions) -> tuple[int, int]:
-    """Knots per phase of a grid (a phase the problem lacks keeps ``options.knots``)."""
+def grid_knots(grid: Grid, options: GaitOptions) -> tuple[int, ...]:
+    """Knots per phase of a grid: its counts, or a mesh's first two phases' (a phase the
+    problem lacks keeps ``options.knots``)."""
     if not is_mesh(grid):
-        return (int(grid[0]), int(grid[1]))
+        return tuple(int(k) for k in grid)
     sizes = [np.asarray(m).size for m in grid]
     return (sizes[0], sizes[1] if len(sizes) > 1 else options.knots[1])
 
@@ -72,9 +74,9 @@ class NlpStructure:
     @classmethod
     def of(cls, model: RobotModel, options: GaitOptions, grid: Grid,
            compiled: str | None) -> NlpStructure:
-        shaping = sorted((f.name, repr(getattr(options, f.name)))
-                         for f in dataclasses.fields(options)
-                         if f.name not in BOUNDS_ONLY_OPTIONS)
+        shaping = sorted((name, repr(getattr(getattr(options, group), name)))
+                         for name, group in FIELD_GROUPS.items()
+                         if name not in BOUNDS_ONLY_OPTIONS)
         if is_mesh(grid):
             key: tuple[Any, ...] = tuple(tuple(float(v) for v in np.asarray(m)) for m in grid)
         else:
