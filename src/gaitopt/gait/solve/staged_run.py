@@ -55,7 +55,7 @@ class StageRecord:
         """The stage as one line of text for a terminal (what ``gaitopt solve`` prints and
         :func:`gaitopt.solve_gait` hands its ``progress``)."""
         p = self.parameters
-        return (f"{self.name:<22} {self.knots[0]}+{self.knots[1]} knots  "
+        return (f"{self.name:<22} {'+'.join(map(str, self.knots))} knots  "
                 f"{'ok ' if self.success else 'FAILED'} {self.status:<28} "
                 f"it {self.iterations:>4}  J {self.objective:10.4g}  "
                 f"v {p.get('speed', float('nan')) * 60:6.2f} m/min  "
