@@ -85,8 +85,9 @@ class JointAngleStride:
     Attributes:
         leg: the leg's contact point names.
         joints: the leg's (hip, knee, ankle) joint names; ankle ``None`` on a point foot.
-        percent: % of the stride at each sample, increasing, in [0, 100] (0 and 100 are the
-            same instant: the initial contact, its sample repeated to close the stride).
+        percent: % of the stride at each sample, increasing, in [0, 100]; 0 and 100 are the
+            same instant, the initial contact, with the angles interpolated linearly between
+            the samples either side of it.
         hip: hip flexion, deg.
         knee: knee flexion, deg.
         ankle: ankle dorsiflexion, deg (NaN without an ankle).
@@ -185,9 +186,17 @@ def joint_angle_stride(gait: Gait, leg_index: int = 0) -> JointAngleStride:
     knee = -coordinate(joints[1])
     ankle = coordinate(joints[2]) if joints[2] is not None else np.full(phase.size, np.nan)
     stance_end = (toe_off - contact) / stride
-    # Close the stride: the initial contact again at 100 %.
-    percent = 100.0 * np.append(phase, stride) / stride
-    hip, knee, ankle = (np.append(a, a[0]) for a in (hip, knee, ankle))
+    # The initial contact falls between two samples: its angles interpolated linearly (the
+    # angles are continuous; the impacts change only velocities), at 0 and again at 100 %.
+    gap = phase[0] + (stride - phase[-1])
+    w = phase[0] / gap if gap > 0 else 0.0
+
+    def close(a: Array) -> Array:
+        at_contact = (1.0 - w) * a[0] + w * a[-1]
+        return np.concatenate([[at_contact], a, [at_contact]])
+
+    percent = np.concatenate([[0.0], 100.0 * phase / stride, [100.0]])
+    hip, knee, ankle = close(hip), close(knee), close(ankle)
     stance = percent <= 100.0 * stance_end + 1e-9
     stance[-1] = True
     return JointAngleStride(leg=leg, joints=joints, percent=percent, hip=hip, knee=knee,
@@ -196,16 +205,21 @@ def joint_angle_stride(gait: Gait, leg_index: int = 0) -> JointAngleStride:
 
 
 def people_measures(angles: JointAngleStride) -> dict[str, float]:
-    """The four measures of the module docstring, deg, keyed by :data:`MEASURES`; stance
-    share (``stance_percent``, % of the stride) besides."""
+    """The four measures of the module docstring, deg, keyed by :data:`MEASURES`; besides,
+    ``stance_percent`` (stance's share of the stride, %) and
+    ``stance_knee_flexion_percent`` (where in the stride the stance knee flexion peak lies,
+    %: at the window's end, half the stance share, it is no peak but a knee still bending)."""
     first_half = angles.stance & (angles.percent <= angles.stance_end / 2.0)
     swing = ~angles.stance
+    knee = np.where(first_half, angles.knee, -np.inf)
+    peak = int(np.argmax(knee))
     return {
-        "stance_knee_flexion": float(np.max(angles.knee[first_half])),
+        "stance_knee_flexion": float(knee[peak]),
         "swing_knee_flexion": float(np.max(angles.knee[swing])) if swing.any() else float("nan"),
         "hip_excursion": float(np.ptp(angles.hip)),
         "ankle_excursion": float(np.ptp(angles.ankle)),
         "stance_percent": angles.stance_end,
+        "stance_knee_flexion_percent": float(angles.percent[peak]),
     }
 
 
