@@ -12,8 +12,8 @@ sum of the relative errors), prints a Markdown table, and draws
 
 Run: ``python bench/people_angles.py [-o out/angles] [--costs paper work metabolic]
 [--speed 80m/min] [--extra COST=ARGS ...] [--figure docs/figures/people_joint_angles.png]
-[--resolve]``, or on gait files already solved: ``python bench/people_angles.py --gait
-LABEL=FILE ...`` (no solve, no verify).
+[--resolve] [--max-iter COST=N ...]``, or on gait files already solved: ``python
+bench/people_angles.py --gait LABEL=FILE ...`` (no solve, no verify).
 """
 
 from __future__ import annotations
@@ -58,19 +58,53 @@ def gaitopt(*args: str) -> tuple[int, float, str]:
     return done.returncode, time.perf_counter() - start, tail
 
 
-def solve_and_verify(out: Path, cost: str, speed: str, extra: list[str], resolve: bool
-                     ) -> dict[str, object]:
-    """One cost's solve (unless its file exists) and its verify."""
+def solve_api(path: Path, cost: str, speed: str, clearance: float | None, max_iter: int
+              ) -> tuple[int, float, str]:
+    """The solve of ``gaitopt solve --model seven-link --speed SPEED --cost COST
+    [--clearance C]`` through the Python API, with IPOPT's limit per stage ``max_iter``
+    (the CLI has 1000; the cost study 3000, ``gaitopt.study.cost_study.STUDY_MAX_ITER``):
+    :class:`GaitOptions` left to the model's defaults otherwise, as the CLI leaves them."""
+    from gaitopt.gait.api import solve_gait_solution
+    from gaitopt.gait.options.gait_options import GaitOptions
+    from gaitopt.gait.solve.record import gait_from_solution
+    from gaitopt.units import parse_speed
+
+    start = time.perf_counter()
+    options = GaitOptions(speed=parse_speed(speed), cost=cost,  # type: ignore[arg-type]
+                          swing_clearance=clearance, max_iter=max_iter)
+    solution = solve_gait_solution("seven-link", options)
+    wall = time.perf_counter() - start
+    lines = [f"stage {st.line()}" for st in solution.stages]
+    if not solution.success:
+        return 1, wall, "\n".join(lines[-2:])
+    gait_from_solution(solution).save(path)
+    return 0, wall, "\n".join(lines[-2:])
+
+
+def solve_and_verify(out: Path, cost: str, speed: str, extra: list[str], resolve: bool,
+                     max_iter: int | None = None) -> dict[str, object]:
+    """One cost's solve (unless its file exists) and its verify; with ``max_iter``, through
+    :func:`solve_api` (``extra`` then may hold only ``--clearance C``)."""
     path = out / f"{cost}.gait.json"
     row: dict[str, object] = {"cost": cost, "file": str(path),
                               "command": shlex.join(["gaitopt", "solve", "--model", "seven-link",
                                                      "--speed", speed, "--cost", cost, *extra,
                                                      "-o", str(path)])}
+    if max_iter is not None:
+        row["command"] = f"{row['command']}  (through the API, max_iter={max_iter})"
     if resolve or not path.exists():
         print(f"$ {row['command']}   (load {load_average()})", flush=True)
-        status, wall, tail = gaitopt("solve", "--model", "seven-link", "--speed", speed,
-                                     "--cost", cost, *extra, "-o", str(path))
-        row.update(solve_status=status, solve_wall_s=round(wall, 1))
+        if max_iter is None:
+            status, wall, tail = gaitopt("solve", "--model", "seven-link", "--speed", speed,
+                                         "--cost", cost, *extra, "-o", str(path))
+        else:
+            clearance = None
+            if extra:
+                if len(extra) != 2 or extra[0] != "--clearance":
+                    raise SystemExit(f"--max-iter takes only --clearance C as extra, got {extra}")
+                clearance = float(extra[1])
+            status, wall, tail = solve_api(path, cost, speed, clearance, max_iter)
+        row.update(solve_status=status, solve_wall_s=round(wall, 1), solve_tail=tail)
         print(f"  exit {status}, {wall:.0f} s\n{tail}", flush=True)
     status, wall, tail = gaitopt("verify", str(path))
     row.update(verify_status=status, verify="pass" if status == 0 else f"fails: {tail}")
@@ -90,17 +124,19 @@ def measure_rows(gaits: list[tuple[str, Gait]]) -> list[dict[str, Any]]:
 
 
 def markdown(rows: list[dict[str, Any]]) -> str:
-    head = ("| cost | stance knee flexion [deg] | swing knee flexion [deg] | hip excursion "
-            "[deg] | ankle excursion [deg] | distance | step | stance [% of stride] |")
+    head = ("| cost | stance knee flexion [deg] (at % of stride) | swing knee flexion [deg] "
+            "| hip excursion [deg] | ankle excursion [deg] | distance | step | stance [% of "
+            "stride] |")
     lines = [head, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
     for r in rows:
         cells = [f"{r[n]:.1f}" for n in MEASURES]
+        cells[0] += f" ({r['stance_knee_flexion_percent']:.0f} %)"
         lines.append(f"| {r['label']} | " + " | ".join(cells) + f" | {r['distance']:.2f} | "
                      f"{r['step_length']:.3f} m | {r['stance_percent']:.1f} |")
     people = [f"{lo:g}-{hi:g}" if hi > lo else f"about {lo:g}" for lo, hi in
               (PEOPLE[n] for n in MEASURES)]
     lines.append("| people (Winter 2009; Perry and Burnfield 2010) | " + " | ".join(people)
-                 + " | 0 | about 0.75 m | about 60 |")
+                 + " | 0 | | |")
     return "\n".join(lines)
 
 
@@ -117,6 +153,9 @@ def main() -> None:
     p.add_argument("--figure", default="docs/figures/people_joint_angles.png")
     p.add_argument("--json", help="write the rows here")
     p.add_argument("--resolve", action="store_true", help="solve even if the file exists")
+    p.add_argument("--max-iter", metavar="COST=N", action="append", default=[],
+                   help="COST=N: solve this cost through the API with IPOPT's limit N per "
+                        "stage (the CLI's is 1000), e.g. metabolic=3000")
     a = p.parse_args()
     info = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "machine": f"{platform.node()}, {os.cpu_count()} cores, {platform.processor()}",
@@ -126,11 +165,14 @@ def main() -> None:
         pairs = [g.split("=", 1) for g in a.gait]
     else:
         extra = {k: shlex.split(v) for k, v in (e.split("=", 1) for e in a.extra)}
+        limits = {k: int(v) for k, v in (e.split("=", 1) for e in a.max_iter)}
         out = Path(a.out)
         out.mkdir(parents=True, exist_ok=True)
         for cost in a.costs:
-            runs.append(solve_and_verify(out, cost, a.speed, extra.get(cost, []), a.resolve))
-        pairs = [[str(r["cost"]), str(r["file"])] for r in runs]
+            runs.append(solve_and_verify(out, cost, a.speed, extra.get(cost, []), a.resolve,
+                                         limits.get(cost)))
+        pairs = [[str(r["cost"]), str(r["file"])] for r in runs
+                 if Path(str(r["file"])).exists()]  # a failed solve writes no file
     gaits = [(label, Gait.load(path)) for label, path in pairs]
     rows = measure_rows(gaits)
     info["load_after"] = load_average()
