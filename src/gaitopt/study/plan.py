@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
@@ -149,12 +149,61 @@ class SweepSpec:
                 parents[p.key] = fixed[start].key if fixed else None
         return parents
 
+    @cached_property
+    def passive_model(self) -> RobotModel:
+        """The model of the variants without ankle torques: :func:`passive_ankles`."""
+        return passive_ankles(self.model)
+
+    def model_of(self, point: SweepPoint) -> RobotModel:
+        """The model a point is solved on: :attr:`model`, or for a variant without ankle
+        torques on a model with feet, the model with its ankle joints unactuated
+        (:func:`passive_ankles`; a point-foot model's ankle torques are its contact
+        actuators, which ``GaitOptions.ankle`` switches off)."""
+        ankle, _ = variant_flags(point.variant)
+        return self.model if ankle else self.passive_model
+
     def options(self, point: SweepPoint) -> GaitOptions:
         """The full problem options of a point."""
         ankle, impulse = variant_flags(point.variant)
         return self.base.replace(speed=point.speed, ankle=ankle, impulse=impulse,
                                  step_length=point.step_length, step_time=point.step_time,
                                  single_support_fraction=point.single_support)
+
+
+def foot_links(model: RobotModel) -> tuple[str, ...]:
+    """The links that carry two or more contact points (feet: heel and toe), model order."""
+    counts: dict[str, int] = {}
+    for c in model.contacts:
+        counts[c.link] = counts.get(c.link, 0) + 1
+    return tuple(link.name for link in model.links if counts.get(link.name, 0) >= 2)
+
+
+def ankle_actuators(model: RobotModel) -> tuple[str, ...]:
+    """The joint actuators of the ankles (the joints of :func:`foot_links`), model order."""
+    ankles = {link.joint.name for link in model.links
+              if link.name in foot_links(model) and link.joint is not None}
+    return tuple(a.name for a in model.actuators if a.joint in ankles)
+
+
+def passive_ankles(model: RobotModel) -> RobotModel:
+    """``model`` with its ankle joints unactuated (:func:`ankle_actuators` removed; each joint
+    keeps its damping, ``Joint.damping``: 2 N m s/rad on ``seven-link``), named
+    ``<name>-passive-ankles``; ``model`` itself when it has none (point feet, whose ankle
+    torques are contact actuators that ``GaitOptions.ankle = False`` leaves out).
+
+    This is what "without ankle torques" means on a model with feet: the full formulation
+    keeps every joint actuator whatever ``GaitOptions.ankle`` says (it switches the contact
+    actuators of held points only, :func:`gaitopt.gait.formulations.full.physics.actuator_names`),
+    so on ``seven-link`` the ankle variants and the others would be one problem solved twice.
+    """
+    removed = set(ankle_actuators(model))
+    if not removed:
+        return model
+    return replace(model, name=f"{model.name}-passive-ankles",
+                   actuators=tuple(a for a in model.actuators if a.name not in removed),
+                   description=(f"{model.description} " if model.description else "")
+                   + f"Ankles unactuated (passive, damped): {', '.join(sorted(removed))} "
+                     "removed.")
 
 
 def start_index(speeds: Sequence[float], start: float = START_SPEED) -> int:
