@@ -248,8 +248,13 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     console.print(f"check grid {finer[0]}+{finer[1]} knots (the error estimates):",
                   soft_wrap=True)
     check = study_spec(model_name, speeds, {**grid, "knots": finer})
+    # With feet a cold start on the check grid takes minutes: each chain of the check sweep
+    # starts from the study's gait of its first point (the five-link's start cold, as ever).
+    seeds = ({p.key: directory / p.key for p in check.points
+              if check.parents[p.key] is None and (directory / p.key).exists()}
+             if check.base.gait != "walk" else {})
     solve_study_sweep(console, check, directory / CHECK_DIR, workers=workers,
-                      scheduler=scheduler)
+                      scheduler=scheduler, seeds=seeds)
     rows = read_summary(directory / SUMMARY_FILE)
     if not paper_grid:  # the paper's setting is reported as it is, with its estimate
         refine_points(console, directory, spec, grid_error(directory, rows),
@@ -300,13 +305,15 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
 
 
 def solve_study_sweep(console: Console, spec: SweepSpec, directory: Path, *,
-                      workers: int | None, scheduler: str | None) -> None:
+                      workers: int | None, scheduler: str | None,
+                      seeds: dict[str, Path] | None = None) -> None:
     """One sweep of the study, then its convergence passes: the points that failed (an
     iteration limit, a restoration failure) solved once more, each warm-started from its
     converged neighbour's saved gait (the driver's rerun: another start than the first
     pass's, which continued from the neighbour's result in memory); then each speed-free
     optimum that costs more than a fixed-speed point of its variant (or failed) solved again
-    from that point's gait, the lower of the two kept (:mod:`gaitopt.study.optima`)."""
+    from that point's gait, the lower of the two kept (:mod:`gaitopt.study.optima`).
+    ``seeds``: warm starts of the chains' first points (:func:`run_with_progress`)."""
     from gaitopt.fileio import write_text_atomic
     from gaitopt.study.optima import (
         free_restarts,
@@ -317,11 +324,13 @@ def solve_study_sweep(console: Console, spec: SweepSpec, directory: Path, *,
     )
     from gaitopt.study.summary import read_summary
 
-    report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler,
+                               seeds=seeds)
     if report.counts.failed:
         console.print(f"{report.counts.failed} failed: solving them again, each from its "
                       "converged neighbour's gait file", soft_wrap=True)
-        run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+        run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler,
+                          seeds=seeds)
     restarts = free_restarts(read_summary(directory / SUMMARY_FILE), spec.variants)
     if not restarts:
         return
