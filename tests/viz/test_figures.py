@@ -174,3 +174,31 @@ def test_stick_strip_draws_links_of_the_right_length(curves: list[tuple[str, Gai
     _renders(fig)
     with pytest.raises(ValueError, match="frames"):
         stick_strip_figure(gait, frames=1)
+
+
+def test_torques_figure_takes_gaits_with_fewer_actuators() -> None:
+    """A gait whose model lacks actuators (the feet study's passive ankles) has no curve in
+    their panels; every actuator of any gait has its panel."""
+    import dataclasses
+
+    from tests.viz.synthetic import synthetic_gait
+
+    full = synthetic_gait(speed=0.4)
+    model = full.model
+    keep = [i for i, a in enumerate(model.actuators) if not a.name.startswith("ankle")]
+    data = dict(full.model_data)
+    data["actuators"] = [a for a in data["actuators"] if not a["name"].startswith("ankle")]
+    data["name"] = "no-ankles"
+    other = synthetic_gait(speed=0.5, ankle=False)
+    passive = dataclasses.replace(
+        other, model_data=data,
+        samples=dataclasses.replace(other.samples, u=other.samples.u[:, keep]),
+        phases=tuple(dataclasses.replace(ph, u=ph.u[:, keep]) for ph in other.phases))
+    fig = torques_figure([("passive", passive), ("actuated", full)])
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title().split()[0] for ax in axes] == [a.name for a in model.actuators]
+    for ax in axes:
+        labels = {ln.get_label() for ln in ax.get_lines()}
+        assert "actuated" in labels
+        assert ("passive" in labels) == (not ax.get_title().startswith("ankle"))
+    _renders(fig)

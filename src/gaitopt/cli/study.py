@@ -48,13 +48,19 @@ from gaitopt.study.grid_error import (
     grid_error,
     refine_dir_name,
 )
-from gaitopt.study.plan import START_SPEED
+from gaitopt.study.plan import SweepSpec
 from gaitopt.study.summary import SUMMARY_FILE, VARIANTS
 
 #: Default speed grid of ``gaitopt sweep`` (m/min): the paper's 3 to 60 m/min.
 DEFAULT_SPEEDS = "3:60:3"
-#: Default speed grid of ``gaitopt study`` (m/min).
+#: Default speed grid of ``gaitopt study`` (m/min): the paper's 3 to 60 m/min for the walk.
 STUDY_SPEEDS = "3:60:3"
+#: ... and for the heel-toe walk of a model with feet (``seven-link``; issue 25): 12 to 120
+#: m/min in steps of 12, ten speeds around people's 80 m/min (44 points with the four
+#: variants' speed-free optima: about as many as the five-link study's 84 take to solve).
+FEET_STUDY_SPEEDS = "12:120:12"
+#: The default speed grid by the gait of the study's model.
+STUDY_SPEEDS_BY_GAIT = {"walk": STUDY_SPEEDS, "heel-toe": FEET_STUDY_SPEEDS}
 STUDY_DIR = Path("out/study")
 #: Default directory and resting powers (W/kg) of ``gaitopt study --costs``.
 COSTS_DIR = Path("out/costs")
@@ -158,8 +164,9 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @click.option("--model", "model_names", multiple=True,
               help="Built-in model name or model file [default: five-link]; with --costs "
                    "repeat it to compare models.")
-@click.option("--speeds", default=STUDY_SPEEDS, show_default=True,
-              help="Speeds in m/min: start:stop:step and/or a comma list.")
+@click.option("--speeds", default=None,
+              help=f"Speeds in m/min: start:stop:step and/or a comma list [default: "
+                   f"{STUDY_SPEEDS}; {FEET_STUDY_SPEEDS} for a model with feet].")
 @click.option("--costs", "cost_study", is_flag=True,
               help="The cost study instead (docs/costs.md): each model's speed-free optimum "
                    "of the paper's, the work and the metabolic cost at each resting power.")
@@ -193,7 +200,7 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @knot_spacing_option("The knots of each phase of the paper's study (and of the cost study): "
                      "cosine-spaced (clustered at the events) or uniform.")
 @_workers_option
-def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str,
+def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str | None,
                   paper_grid: bool, knots: str | None, knot_spacing: str | None,
                   cost_study: bool,
                   costs: tuple[str, ...],
@@ -205,7 +212,9 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     optimum (cosine-spaced 16+6 knots), the same on a finer grid (DIR/check-grid) for the
     error estimates, the points whose estimate exceeds 1 % finer still (DIR/refine-grid),
     then the report (Figs. 3-8 with their grid and error estimate, findings) and an animation
-    of the optimal walk. With --costs, the cost study (docs/costs.md). Rerunning resumes."""
+    of the optimal walk. A model with feet (seven-link) walks heel to toe in full coordinates
+    on 24+16 knots, 12-120 m/min; without ankle torques its ankles are passive (damped).
+    With --costs, the cost study (docs/costs.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
     from gaitopt.study.summary import read_summary
 
@@ -227,21 +236,28 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     grid = {"knot_spacing": GaitOptions().knot_spacing,
             **grid_choice(knots, None, paper_grid, knot_spacing)}
     model_name = model_names[0] if model_names else "five-link"
-    spec = make_spec(model_name=model_name, speeds=speeds,
-                     variants="all", free=True, step_length="free", single_support="0.85",
-                     problem=grid)
-    run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+    spec = study_spec(model_name, speeds, grid)
+    console.print(f"study of {spec.model.name}: {spec.base.gait} walk, "
+                  f"{spec.base.formulation} coordinates, {spec.knots[0]}+{spec.knots[1]} knots, "
+                  f"{len(spec.speeds)} speeds {spec.speeds[0] * 60:g}-{spec.speeds[-1] * 60:g} "
+                  f"m/min, variants {', '.join(spec.variants)}"
+                  + (f" (without ankle torques: {spec.passive_model.name})"
+                     if spec.passive_model is not spec.model else ""), soft_wrap=True)
+    solve_study_sweep(console, spec, directory, workers=workers, scheduler=scheduler)
     finer = check_knots(spec.knots)
     console.print(f"check grid {finer[0]}+{finer[1]} knots (the error estimates):",
                   soft_wrap=True)
-    check = make_spec(model_name=model_name, speeds=speeds, variants="all", free=True,
-                      step_length="free", single_support="0.85",
-                      problem={**grid, "knots": finer})
-    run_with_progress(console, check, directory / CHECK_DIR, workers=workers,
-                      scheduler=scheduler)
+    check = study_spec(model_name, speeds, {**grid, "knots": finer})
+    # With feet a cold start on the check grid takes minutes: each chain of the check sweep
+    # starts from the study's gait of its first point (the five-link's start cold, as ever).
+    seeds = ({p.key: directory / p.key for p in check.points
+              if check.parents[p.key] is None and (directory / p.key).exists()}
+             if check.base.gait != "walk" else {})
+    solve_study_sweep(console, check, directory / CHECK_DIR, workers=workers,
+                      scheduler=scheduler, seeds=seeds)
     rows = read_summary(directory / SUMMARY_FILE)
     if not paper_grid:  # the paper's setting is reported as it is, with its estimate
-        refine_points(console, directory, model_name, grid, grid_error(directory, rows),
+        refine_points(console, directory, spec, grid_error(directory, rows),
                       workers=workers, scheduler=scheduler)
     out = directory / "report"
     pages = write_reports(console, directory, out)
@@ -270,7 +286,75 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                   soft_wrap=True)
 
 
-def refine_points(console: Console, directory: Path, model_name: str, grid: dict[str, Any],
+def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> SweepSpec:
+    """The sweep of the paper's study on a model: every variant over ``speeds`` (m/min text;
+    None: the default of the model's gait, :data:`STUDY_SPEEDS_BY_GAIT`) plus each speed-free
+    optimum, single support 0.85 of the step, step free; ``grid`` the shared problem options
+    (knots, knot spacing, control model). The gait, formulation, knots and bounds follow the
+    model (:class:`~gaitopt.study.plan.SweepSpec` resolves them as ``gaitopt solve`` does:
+    the five-link walk in reduced coordinates on 16+6 knots, a model with feet heel to toe in
+    full coordinates on 24+16); a variant without ankle torques on feet has passive ankles
+    (:func:`~gaitopt.study.plan.passive_ankles`)."""
+    def spec_of(text: str) -> SweepSpec:
+        return make_spec(model_name=model_name, speeds=text, variants="all", free=True,
+                         step_length="free", single_support="0.85", problem=grid)
+
+    spec = spec_of(speeds or STUDY_SPEEDS)
+    default = STUDY_SPEEDS_BY_GAIT.get(str(spec.base.gait), STUDY_SPEEDS)
+    return spec_of(default) if speeds is None and default != STUDY_SPEEDS else spec
+
+
+def solve_study_sweep(console: Console, spec: SweepSpec, directory: Path, *,
+                      workers: int | None, scheduler: str | None,
+                      seeds: dict[str, Path] | None = None) -> None:
+    """One sweep of the study, then its convergence passes: the points that failed (an
+    iteration limit, a restoration failure) solved once more, each warm-started from its
+    converged neighbour's saved gait (the driver's rerun: another start than the first
+    pass's, which continued from the neighbour's result in memory); then each speed-free
+    optimum that costs more than a fixed-speed point of its variant (or failed) solved again
+    from that point's gait, the lower of the two kept (:mod:`gaitopt.study.optima`).
+    ``seeds``: warm starts of the chains' first points (:func:`run_with_progress`)."""
+    from gaitopt.fileio import write_text_atomic
+    from gaitopt.study.optima import (
+        free_restarts,
+        lower_gait,
+        restart_folder,
+        restart_seeds,
+        restart_spec,
+    )
+    from gaitopt.study.summary import read_summary
+
+    report = run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler,
+                               seeds=seeds)
+    if report.counts.failed:
+        console.print(f"{report.counts.failed} failed: solving them again, each from its "
+                      "converged neighbour's gait file", soft_wrap=True)
+        run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler,
+                          seeds=seeds)
+    restarts = free_restarts(read_summary(directory / SUMMARY_FILE), spec.variants)
+    if not restarts:
+        return
+    replaced = False
+    for variant, best in restarts.items():
+        console.print(f"{variant}: the speed-free optimum is not below the fixed-speed point "
+                      f"at {best.speed_m_min:g} m/min (cost {best.cost:.6g}): solving it "
+                      "again from that point's gait", soft_wrap=True)
+        again = restart_spec(spec, variant, best)
+        folder = restart_folder(directory, variant)
+        run_with_progress(console, again, folder, workers=workers, scheduler=scheduler,
+                          seeds=restart_seeds(again, directory / best.file))
+        free = next(p for p in again.points if p.speed is None)
+        lower = lower_gait(directory / free.key, folder / free.key)
+        if lower is not None and lower != directory / free.key:
+            write_text_atomic(directory / free.key, lower.read_text(encoding="utf-8"))
+            replaced = True
+            console.print(f"{variant}: the restart's speed-free optimum is lower; kept",
+                          soft_wrap=True)
+    if replaced:  # the summary rebuilt from the gait files (every point kept)
+        run_with_progress(console, spec, directory, workers=workers, scheduler=scheduler)
+
+
+def refine_points(console: Console, directory: Path, study: SweepSpec,
                   errors: GridError | None, *, workers: int | None,
                   scheduler: str | None) -> None:
     """The refinement sweeps of a study (:mod:`gaitopt.study.grid_error`): the points whose
@@ -302,13 +386,11 @@ def refine_points(console: Console, directory: Path, model_name: str, grid: dict
                       f"estimated above {100 * WITHIN:g} % on the grid before",
                       soft_wrap=True)
         if not speeds:  # only speed-free optima: solve them from the check grid's start speed
-            speeds = [START_SPEED * 60.0]
-        spec = replace(make_spec(model_name=model_name,
-                                 speeds=",".join(f"{v:g}" for v in speeds),
-                                 variants=",".join(sorted({r.variant for r in rows})),
-                                 free=any(r.speed_mode == "free" for r in rows),
-                                 step_length="free", single_support="0.85",
-                                 problem={**grid, "knots": knots}), continuation=False)
+            speeds = [study.start * 60.0]
+        spec = replace(study, speeds=tuple(float(f"{v:g}") / 60.0 for v in speeds),
+                       variants=tuple(v for v in study.variants if v in {r.variant for r in rows}),
+                       free_speed=any(r.speed_mode == "free" for r in rows),
+                       base=study.base.replace(knots=knots), continuation=False)
         seeds = {p.key: previous / p.key for p in spec.points if (previous / p.key).exists()}
         run_with_progress(console, spec, folder, workers=workers, scheduler=scheduler,
                           seeds=seeds)

@@ -148,7 +148,7 @@ class CostSweep:
         """The direct (staged, cold) solve of the speed-free optimum, as a sweep worker's
         task: :func:`gaitopt.study.worker.solve_point` runs it anywhere."""
         point = self.free_point
-        return PointTask(key=f"{self.subdir}/{DIRECT_FILE}", model=self.spec.model,
+        return PointTask(key=f"{self.subdir}/{DIRECT_FILE}", model=self.spec.model_of(point),
                          options=self.spec.options(point), variant=point.variant,
                          speed_mode="free", structure=point.structure, warm=None,
                          relfile=DIRECT_FILE)

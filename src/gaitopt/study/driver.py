@@ -133,7 +133,7 @@ def check_points(spec: SweepSpec) -> None:
     for point in spec.points:
         options = spec.options(point)  # the legs as the point's formulation sees them
         try:
-            validate_options(options, biped_for(spec.model, options))
+            validate_options(options, biped_for(spec.model_of(point), options))
         except GaitOptionsError as exc:
             raise SweepSpecError(f"{point.label().strip()}: {exc}") from None
 
@@ -233,9 +233,10 @@ class _Driver:
         self.given[key] = offer
         # a kept neighbour's gait file is read here: workers may not see this directory
         warm = SavedGait.read(offer) if isinstance(offer, str) else offer
-        self.tasks[key] = PointTask(key=key, model=self.spec.model, options=self.spec.options(p),
-                         variant=p.variant, speed_mode=p.speed_mode, structure=p.structure,
-                         warm=warm, relfile=p.relfile, force_fail=key in self.fail_points)
+        self.tasks[key] = PointTask(key=key, model=self.spec.model_of(p),
+                                    options=self.spec.options(p), variant=p.variant,
+                                    speed_mode=p.speed_mode, structure=p.structure, warm=warm,
+                                    relfile=p.relfile, force_fail=key in self.fail_points)
         return self.tasks[key]
 
     def run(self) -> None:

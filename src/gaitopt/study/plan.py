@@ -9,8 +9,10 @@ fraction) form continuation chains along the speed axis::
                      |
                      +-> free (the speed-free optimum)
 
-The point nearest :data:`START_SPEED` (12 m/min, the paper's optimum) is solved cold; every
-other point is warm-started from its finished neighbour toward that start (its *parent*).
+The point nearest the start speed (:attr:`SweepSpec.start`: for the five-link walk
+:data:`START_SPEED`, 12 m/min, the paper's optimum; for the heel-toe walk of ``seven-link``
+72.2 m/min) is solved cold; every other point is warm-started from its finished neighbour
+toward that start (its *parent*).
 
 Directory layout: with one combination of step length and single-support fraction the sweep
 directory is a plain sweep (``summary.csv``, ``gaits/<variant>/...``, see
@@ -24,16 +26,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
 from gaitopt import __version__
-from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
+from gaitopt.gait.options.model_defaults import default_speed, options_for_model
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import VARIANTS, SpeedMode, gait_relpath, variant_flags
 
-#: Speed (m/s) of the cold start of each chain: the paper's optimal 12 m/min.
+#: Speed (m/s) of the cold start of each chain of the five-link walk: the paper's optimal
+#: 12 m/min. Another model's or gait's chains start at its gait's default speed
+#: (:func:`gaitopt.gait.options.model_defaults.default_speed`: 72.2 m/min for the heel-toe
+#: walk of ``seven-link``), which is this for the five-link walk (:attr:`SweepSpec.start`).
 START_SPEED = 0.2
 SETTINGS_FILE = "sweep.json"
 SETTINGS_FORMAT = "gaitopt.sweep"
@@ -61,7 +67,11 @@ class SweepSpec:
             fixes the step length, so give step lengths or step times, not both.
         single_support: single-support fractions of the step time.
         base: every other problem option (bounds, tolerances, grid ``knots``, ...); its
-            per-point fields (:data:`POINT_FIELDS` but ``knots``) are ignored.
+            per-point fields (:data:`POINT_FIELDS` but ``knots``) are ignored. The defaults
+            that follow the model (gait, formulation, knots, Froude-scaled bounds;
+            :func:`~gaitopt.gait.options.model_defaults.options_for_model`) are resolved for
+            ``model`` here, so ``sweep.json``, the points and the saved gait files hold the
+            values the points are solved with (for the five-link biped the same values).
         continuation: points warm-start from their neighbours along the speed axis; with
             False every point starts alone (cold, or from a seed file: the refinement sweep
             of :mod:`gaitopt.study.grid_error`).
@@ -78,7 +88,18 @@ class SweepSpec:
     continuation: bool = True
 
     def __post_init__(self) -> None:
+        try:
+            base = options_for_model(self.model, self.base)
+        except GaitOptionsError as exc:
+            raise SweepSpecError(str(exc)) from None
+        object.__setattr__(self, "base", base)
         check_spec(self)
+
+    @property
+    def start(self) -> float:
+        """The speed (m/s) nearest which each chain starts cold: the default speed of the
+        sweep's gait on its model (:data:`START_SPEED` for the five-link walk)."""
+        return default_speed(self.model, self.base.gait)
 
     @property
     def knots(self) -> tuple[int, int]:
@@ -120,13 +141,26 @@ class SweepSpec:
         for members in groups.values():
             fixed = [p for p in members if p.speed is not None]
             free = [p for p in members if p.speed is None]
-            start = start_index([p.speed for p in fixed if p.speed is not None])
+            start = start_index([p.speed for p in fixed if p.speed is not None], self.start)
             for i, p in enumerate(fixed):
                 parents[p.key] = (None if i == start else
                                   fixed[i - 1].key if i > start else fixed[i + 1].key)
             for p in free:
                 parents[p.key] = fixed[start].key if fixed else None
         return parents
+
+    @cached_property
+    def passive_model(self) -> RobotModel:
+        """The model of the variants without ankle torques: :func:`passive_ankles`."""
+        return passive_ankles(self.model)
+
+    def model_of(self, point: SweepPoint) -> RobotModel:
+        """The model a point is solved on: :attr:`model`, or for a variant without ankle
+        torques on a model with feet, the model with its ankle joints unactuated
+        (:func:`passive_ankles`; a point-foot model's ankle torques are its contact
+        actuators, which ``GaitOptions.ankle`` switches off)."""
+        ankle, _ = variant_flags(point.variant)
+        return self.model if ankle else self.passive_model
 
     def options(self, point: SweepPoint) -> GaitOptions:
         """The full problem options of a point."""
@@ -136,12 +170,48 @@ class SweepSpec:
                                  single_support_fraction=point.single_support)
 
 
-def start_index(speeds: Sequence[float]) -> int:
-    """Index of the speed nearest :data:`START_SPEED` (the lower one on a tie)."""
+def foot_links(model: RobotModel) -> tuple[str, ...]:
+    """The links that carry two or more contact points (feet: heel and toe), model order."""
+    counts: dict[str, int] = {}
+    for c in model.contacts:
+        counts[c.link] = counts.get(c.link, 0) + 1
+    return tuple(link.name for link in model.links if counts.get(link.name, 0) >= 2)
+
+
+def ankle_actuators(model: RobotModel) -> tuple[str, ...]:
+    """The joint actuators of the ankles (the joints of :func:`foot_links`), model order."""
+    ankles = {link.joint.name for link in model.links
+              if link.name in foot_links(model) and link.joint is not None}
+    return tuple(a.name for a in model.actuators if a.joint in ankles)
+
+
+def passive_ankles(model: RobotModel) -> RobotModel:
+    """``model`` with its ankle joints unactuated (:func:`ankle_actuators` removed; each joint
+    keeps its damping, ``Joint.damping``: 2 N m s/rad on ``seven-link``), named
+    ``<name>-passive-ankles``; ``model`` itself when it has none (point feet, whose ankle
+    torques are contact actuators that ``GaitOptions.ankle = False`` leaves out).
+
+    This is what "without ankle torques" means on a model with feet: the full formulation
+    keeps every joint actuator whatever ``GaitOptions.ankle`` says (it switches the contact
+    actuators of held points only, :func:`gaitopt.gait.formulations.full.physics.actuator_names`),
+    so on ``seven-link`` the ankle variants and the others would be one problem solved twice.
+    """
+    removed = set(ankle_actuators(model))
+    if not removed:
+        return model
+    return replace(model, name=f"{model.name}-passive-ankles",
+                   actuators=tuple(a for a in model.actuators if a.name not in removed),
+                   description=(f"{model.description} " if model.description else "")
+                   + f"Ankles unactuated (passive, damped): {', '.join(sorted(removed))} "
+                     "removed.")
+
+
+def start_index(speeds: Sequence[float], start: float = START_SPEED) -> int:
+    """Index of the speed nearest ``start`` (m/s; the lower one on a tie)."""
     if not speeds:
         return 0
     return min(range(len(speeds)),  # distances compared in m/min to 1e-6: ties are ties
-               key=lambda i: (round(abs(speeds[i] - START_SPEED) * 60.0, 6), speeds[i]))
+               key=lambda i: (round(abs(speeds[i] - start) * 60.0, 6), speeds[i]))
 
 
 def axis_tag(single_support: float, step_length: float | None,

@@ -125,7 +125,7 @@ def scan_directory(spec: SweepSpec, directory: Path) -> _Scan:
         except GaitFileError as exc:
             scan.notes.append(f"{point.key}: unreadable ({exc}); solving it again")
             continue
-        why = gait_file_matches(gait, spec.model, spec.options(point))
+        why = gait_file_matches(gait, spec.model_of(point), spec.options(point))
         if why:
             scan.notes.append(f"{point.key}: not kept, {why}; solving it again")
             continue

@@ -117,12 +117,12 @@ def torques_figure(curves: GaitCurves, *, title: str = "joint torques with their
     """Paper Figs. 7/8: each actuator's torque (N m) over one step against t/T, with the
     actuator's bounds from the model (dashed); dots mark the transcription's knots."""
     sty = _styles(curves, styles)
-    model = curves[0][1].model
-    names = [a.name for a in model.actuators]
-    for label, gait in curves:
-        if [a.name for a in gait.model.actuators] != names:
-            raise ValueError(f"gait {label!r} has actuators "
-                             f"{[a.name for a in gait.model.actuators]}, expected {names}")
+    # Every actuator of any gait, the model with most actuators first, in model order: a
+    # gait without one (passive ankles, gaitopt.study.plan.passive_ankles) has no curve in
+    # its panel.
+    names: list[str] = []
+    for _, gait in sorted(curves, key=lambda c: -len(c[1].model.actuators)):
+        names += [a.name for a in gait.model.actuators if a.name not in names]
     ncols = (len(names) + 1) // 2
     fig = new_figure(3.0 * ncols + 1.0, 5.8)
     axes = np.atleast_1d(fig.subplots(2, ncols, sharex=True)).ravel()
@@ -130,14 +130,19 @@ def torques_figure(curves: GaitCurves, *, title: str = "joint torques with their
     for (label, gait), style in zip(curves, sty, strict=True):
         s = gait.samples
         tau = (s.t - s.t[0]) / gait.step_time
+        own = {a.name: i for i, a in enumerate(gait.model.actuators)}
         for j, ax in enumerate(axes[: len(names)]):
-            ax.plot(tau, s.u[:, j], label=label, **style)
+            if names[j] not in own:
+                continue
+            i = own[names[j]]
+            ax.plot(tau, s.u[:, i], label=label, **style)
             for phase in gait.phases:
-                ax.plot((phase.t - s.t[0]) / gait.step_time, phase.u[:, j], linestyle="none",
+                ax.plot((phase.t - s.t[0]) / gait.step_time, phase.u[:, i], linestyle="none",
                         marker="o", markersize=2.2, color=style.get("color"))
-            peak[j] = max(peak[j], float(np.max(np.abs(s.u[:, j]))))
+            peak[j] = max(peak[j], float(np.max(np.abs(s.u[:, i]))))
     for j, ax in enumerate(axes[: len(names)]):
-        bounds = sorted({b for _, g in curves for b in g.model.actuators[j].limits})
+        bounds = sorted({b for _, g in curves for a in g.model.actuators
+                         if a.name == names[j] for b in a.limits})
         for b in bounds:
             ax.axhline(b, **BOUND_LINE)
         reach = max(abs(b) for b in bounds) if bounds else 0.0
