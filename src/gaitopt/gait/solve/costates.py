@@ -30,7 +30,10 @@ def solution_costates(solution: StagedRun) -> Mapping[str, Array]:
     if not res.success:
         return {}
     sizes = [m.size for m in res.mesh]
-    counts: Grid = (sizes[0], sizes[1] if len(sizes) > 1 else solution.options.knots[1])
+    knots = solution.options.knots
+    # A single-support step has one phase: its knots may be given alone (by phase name).
+    counts: Grid = (tuple(sizes[:2]) if len(sizes) > 1 else
+                    (sizes[0], knots[1]) if len(knots) > 1 else (sizes[0],))
     for grid in (counts, tuple(res.mesh)):
         try:
             tr = transcription_for(solution.model, solution.options, grid)
