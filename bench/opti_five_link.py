@@ -242,7 +242,7 @@ def solve(knots: int = KNOTS, verbose: bool = False) -> dict[str, Any]:
     opti.subject_to(ca.vec(path[0:2, :]) >= 0)
     opti.subject_to(opti.bounded(HIP_RANGE[0], path[2, :], HIP_RANGE[1]))
     # separated Hermite-Simpson: midpoint and Simpson defects
-    opti.subject_to(XM == (X[:, :-1] + X[:, 1:]) / 2 + h * (fk[:, :-1] - fk[:, 1:]) / 8)
+    opti.subject_to(XM - (X[:, :-1] + X[:, 1:]) / 2 - h * (fk[:, :-1] - fk[:, 1:]) / 8 == 0)
     opti.subject_to(X[:, 1:] == X[:, :-1] + h * (fk[:, :-1] + 4 * fm + fk[:, 1:]) / 6)
     cost = h * (ca.sumsqr(U[:, :-1]) + 4 * ca.sumsqr(UM) + ca.sumsqr(U[:, 1:])) / 6
     x_next, tip2, impulse, tip1_up = impact(X[:, -1])

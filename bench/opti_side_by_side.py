@@ -31,7 +31,6 @@ the median of each figure, and the ratios gaitopt / Opti (target 0.3, goal 0.25)
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import resource
 import statistics
@@ -123,7 +122,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="the measured processes compile every source they import")
     args = ap.parse_args(argv)
     opti_args = args.opti_args.split()
-    print(f"load average before: {load()} ({os.cpu_count()} cores); Python {sys.version.split()[0]}")
+    print(f"load average before: {load()} ({os.cpu_count()} cores)")
     runs: dict[str, list[dict[str, Any]]] = {"opti": [], "gaitopt": []}
     ctx = get_context("spawn")
     cache = tempfile.TemporaryDirectory(prefix="opti-side-by-side-")

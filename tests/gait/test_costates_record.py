@@ -30,3 +30,18 @@ def test_the_costates_survive_the_file(default_gait_file: Path) -> None:
     gait = Gait.load(default_gait_file)
     assert all(ph.costates is not None and np.all(np.isfinite(ph.costates))
                for ph in gait.phases)
+
+
+def test_a_single_support_step_with_knots_by_phase_name_has_costates() -> None:
+    # The step's one phase's knots given by name: the options hold one count (this raised an
+    # IndexError when the record looked for a second phase's).
+    from gaitopt import GaitOptions, solve_gait
+
+    options = GaitOptions(speed=0.5, step_length=0.3, single_support_fraction=1.0,
+                          knots={"single_support": 8}, knot_spacing="uniform")
+    gait = solve_gait("five-link", options)
+    assert gait.success
+    (phase,) = gait.phases
+    assert phase.costates is not None
+    assert phase.costates.shape == (8, len(phase.state_names))
+    assert np.all(np.isfinite(phase.costates))

@@ -26,11 +26,13 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from gaitopt.gait.formulations.full.physics import actuator_names
+from gaitopt.gait.formulations.select import contact_sequence
 from gaitopt.gait.options.gait_options import GaitOptions, follows_model
 from gaitopt.gait.options.model_defaults import default_speed, options_for_model
 from gaitopt.gait.options.preflight import refuse_unwalkable
@@ -46,6 +48,7 @@ from gaitopt.gait.solve.staged import (
     solve_walking,
     transcription_for,
 )
+from gaitopt.gait.solve.warm_accuracy import carried_estimate, refined_knots, same_problem
 from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
@@ -96,6 +99,9 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
 
     ``refine``: whether the solve refines its grid to ``options.accuracy``
     (:mod:`gaitopt.gait.solve.refinement`); None: where the knots are left to the model's default.
+    A warm start that refines starts on the grid its file was refined to and solves its check
+    grid, unless it finds the file's own optimum again, whose estimate it then keeps
+    (:mod:`gaitopt.gait.solve.warm_accuracy`).
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
@@ -109,10 +115,30 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     given = options or GaitOptions()
     opts = options_for_model(robot, given)
     refuse_unwalkable(robot, opts)
+    if refine is None:
+        refine = follows_model(given.knots)
+    refines = refine and opts.accuracy is not None and opts.mesh_tol is None
     guess: Guess | WarmStart | None = None
     if warm_start is not None and warm_start_usable(warm_start, opts):
+        if refines:  # start on the grid the file was refined to (gait/solve/warm_accuracy.py)
+            phases = tuple(ph.name for ph in contact_sequence(robot, opts).phases)
+            knots = refined_knots(warm_start, phases)
+            opts = opts if knots is None else opts.replace(knots=knots)
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
-    first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+    # A warm start that refines needs its estimate: its check grid (unless the file's holds).
+    first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled,
+                          check_warm_start=refines and guess is not None and
+                          not _file_estimate_may_hold(warm_start, opts))
+    carried = None
+    if guess is not None and warm_start is not None and refines:
+        carried = carried_estimate(warm_start, first, accuracy_record(first))
+        if carried is None and first.success and \
+                accuracy_record(first).get("cost_error") is None:
+            # The file's estimate does not hold (another optimum): the check grid now.
+            again = solve_walking(robot, opts, warm_start=first.result, progress=progress,
+                                  compiled=compiled, check_warm_start=True)
+            first = dataclasses.replace(again, stages=first.stages + again.stages,
+                                        wall_time_s=first.wall_time_s + again.wall_time_s)
     if speed_given is None:
         speed_given = not follows_model(given.speed)
     slower = slower_default(robot, opts)
@@ -134,12 +160,26 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
 
-    if refine is None:
-        refine = follows_model(given.knots)
-    refines = refine and opts.accuracy is not None and opts.mesh_tol is None
-    run, _ = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
-                                accuracy_of=accuracy_record)
+    def accuracy_of(run: StagedRun) -> dict[str, Any]:
+        record = accuracy_record(run)
+        return {**record, **carried} if carried is not None and run is first else record
+
+    run, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
+                                    accuracy_of=accuracy_of)
+    if carried is not None and run.result is first.result:
+        run = dataclasses.replace(run, accuracy_extra={**carried, **extra})
     return run
+
+
+def _file_estimate_may_hold(gait: Gait | None, options: GaitOptions) -> bool:
+    """Whether a warm start from ``gait`` with ``options`` may find the file's own optimum,
+    so that its estimate holds (:func:`~gaitopt.gait.solve.warm_accuracy.carried_estimate`
+    decides after the solve): the file has an estimate and the same problem."""
+    if gait is None:
+        return False
+    old = gait.solver.get("accuracy")
+    return (isinstance(old, Mapping) and old.get("cost_error") is not None
+            and same_problem(gait.options, options))
 
 
 def check_result(run: StagedRun) -> Result | None:

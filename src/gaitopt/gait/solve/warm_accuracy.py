@@ -1,0 +1,103 @@
+"""What a warm start's gait file says about accuracy: the grid it was refined to, and its
+estimate when the warm start finds the file's own optimum again.
+
+A solve that refines itself (:mod:`gaitopt.gait.solve.refinement`: the knots left to the model,
+``GaitOptions.accuracy`` set) needs an estimate of its grid error, which a check grid gives
+(:mod:`gaitopt.gait.solve.accuracy`). Started from a gait file, two things are already known:
+
+* **the grid** (:func:`refined_knots`): a file that refined itself to its target
+  (``solver.accuracy.target`` set and ``within_target`` true) names the knots per phase that
+  reached it; the warm start solves there first, not on the model's default grid, from which
+  it would be refined back up to the same grid (the five-link walk at 60 m/min: 16 + 6, then
+  24 + 8 and its check grid, 1.1 s against 0.3 s for 24 + 8 alone);
+* **the estimate** (:func:`carried_estimate`): when the problem is the file's (the same
+  model, the same options but the knots' form and the refinement's own settings, the same
+  grid) and the warm start converged to the file's optimum (cost, step length and speed
+  within :data:`SAME_OPTIMUM`, relative), the file's check grid has the same optimum too, so its
+  estimate holds as it is and no check grid is solved again. The gait file says so
+  (``solver.accuracy.estimate_from``: ``"warm start"``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
+from gaitopt.gait.solve.staged_run import StagedRun
+
+#: Two converged solves of one NLP are the same optimum when their costs and parameters agree
+#: within this (relative): IPOPT's tolerance (1e-7 on the scaled problem) leaves about 1e-9
+#: between two solves from different starts; a different optimum differs by far more.
+SAME_OPTIMUM = 1e-6
+#: The keys of ``solver.accuracy`` that a carried estimate takes from the file.
+ESTIMATE_KEYS = ("cost_error", "cost_error_method", "cost_error_factor", "check_knots",
+                 "check_cost", "previous_knots", "previous_cost", "cost_error_relative",
+                 "speed_change", "step_length_change", "speed_error", "step_length_error")
+#: Options that change how a solve gets to its answer, not the problem (or, for the knots,
+#: are compared as the grid solved instead).
+NOT_THE_PROBLEM = frozenset({"knots", "phase_shares", "accuracy", "multistart",
+                             "continuation", "max_iter"})
+
+
+def refined_knots(gait: Gait, phases: tuple[str, ...]) -> dict[str, int] | None:
+    """The knots per phase (by name) that ``gait`` refined itself to, if its file says it
+    reached its accuracy target and its phases are ``phases`` (the names of the new problem's
+    phases, in order); else None."""
+    record = gait.solver.get("accuracy")
+    if not isinstance(record, Mapping) or record.get("target") is None:
+        return None
+    knots = record.get("knots")
+    if record.get("within_target") is not True or not isinstance(knots, Mapping):
+        return None
+    if tuple(knots) != phases:
+        return None
+    return {str(name): int(count) for name, count in knots.items()}
+
+
+def _same(a: float, b: float) -> bool:
+    return math.isclose(a, b, rel_tol=SAME_OPTIMUM)
+
+
+def carried_estimate(gait: Gait, run: StagedRun, record: Mapping[str, Any]
+                     ) -> dict[str, Any] | None:
+    """The file's estimate (:data:`ESTIMATE_KEYS` of ``gait.solver["accuracy"]``, with
+    ``estimate_from: "warm start"``) for ``run``, a converged warm start whose own accuracy
+    ``record`` (:func:`~gaitopt.gait.solve.accuracy.accuracy_record`) has no estimate, when
+    ``run`` solved the file's problem on the file's grid to the file's optimum (module
+    docstring); else None."""
+    old = gait.solver.get("accuracy")
+    if (not run.success or record.get("cost_error") is not None
+            or not isinstance(old, Mapping) or old.get("cost_error") is None):
+        return None
+    if dict(old.get("knots") or {}) != dict(record.get("knots") or {}):
+        return None
+    if (_plain(dict(gait.model_data)) != _plain(run.model.to_dict())
+            or not same_problem(gait.options, run.options)):
+        return None
+    if not _same(run.result.objective, gait.cost_value):
+        return None
+    saved, new = gait.parameters, run.result.parameters
+    if not all(_same(float(new[k]), float(saved[k])) for k in ("step_length", "speed")
+               if k in new and k in saved):
+        return None
+    return {**{k: old.get(k) for k in ESTIMATE_KEYS}, "estimate_from": "warm start"}
+
+
+def same_problem(saved: Mapping[str, Any], options: GaitOptions) -> bool:
+    """Whether a gait file's ``options`` state the problem of ``options``: equal but for
+    :data:`NOT_THE_PROBLEM`."""
+    new = options.to_dict()
+    keys = (set(saved) | set(new)) - NOT_THE_PROBLEM
+    return all(_plain(saved.get(k)) == _plain(new.get(k)) for k in keys)
+
+
+def _plain(value: Any) -> Any:
+    """Lists and tuples alike (a file's lists against the options' tuples), in mappings too."""
+    if isinstance(value, list | tuple):
+        return tuple(_plain(v) for v in value)
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
