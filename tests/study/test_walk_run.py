@@ -52,7 +52,7 @@ def row(branch: str, speed: float, cost: float | None, *, error: float = math.na
     if cost is None:
         return WalkRunRow(**common, success=False, status="failed at relaxed contact")
     return WalkRunRow(**common, success=True, status="Solve_Succeeded", cost_value=cost,
-                      cost_error=error, step_length=0.5, step_time=0.5, stance_share=0.9,
+                      cost_error=error, step_length=0.5, step_time=0.5, first_phase_share=0.9,
                       file=f"{model}/{cost_name}/{branch}/gaits/x/{speed:g}.gait.json")
 
 

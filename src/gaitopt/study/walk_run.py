@@ -67,8 +67,8 @@ COSTS = ("paper", "metabolic")
 #: 90-120 m/min and its run from 150 m/min (docs/running.md); a model with feet walks heel to
 #: toe at people's speeds. Chosen and timed in docs/running.md ("The walk-run study").
 DEFAULT_SPEEDS_M_MIN: dict[str, tuple[float, ...]] = {
-    "walk": (15.0, 30.0, 45.0, 60.0, 75.0, 90.0, 105.0, 120.0),
-    "heel-toe": (60.0, 90.0, 120.0, 150.0, 180.0),
+    "walk": (15.0, 30.0, 45.0, 60.0, 75.0, 90.0, 105.0, 120.0, 135.0, 150.0),
+    "heel-toe": (30.0, 60.0, 90.0, 120.0, 150.0),
 }
 
 
@@ -211,15 +211,17 @@ def write_settings(spec: WalkRunSpec, directory: str | os.PathLike[str]) -> Path
 
 TABLE_COLUMNS: tuple[str, ...] = (
     "model", "cost", "branch", "kind", "speed_m_min", "froude", "success", "status",
-    "cost_value", "cost_error", "step_length", "step_time", "stance_share", "cheapest", "file")
+    "cost_value", "cost_error", "step_length", "step_time", "first_phase_share", "cheapest",
+    "file")
 
 
 @dataclass(frozen=True, kw_only=True)
 class WalkRunRow:
     """One point of the study: speed (m/min), its Froude number, the cost's value and its
     grid error estimate (``solver.accuracy.cost_error``: ``J(grid) - J(limit)``, the cost's
-    unit; NaN when unknown), step length (m), step time (s), the share of the step on one
-    leg (single support, a run's stance; NaN if the gait has no such parameter), whether it
+    unit; NaN when unknown), step length (m), step time (s), the first phase's share of the
+    step (``single_support_time / step_time``: the walk's single support, the run's stance,
+    the heel-toe walk's foot-flat phase; NaN if the gait has no such parameter), whether it
     is the cheapest converged branch at its speed, and the gait file relative to the study
     directory (empty for a failed point). NaN where the solve failed."""
 
@@ -235,7 +237,7 @@ class WalkRunRow:
     cost_error: float = math.nan
     step_length: float = math.nan
     step_time: float = math.nan
-    stance_share: float = math.nan
+    first_phase_share: float = math.nan
     cheapest: bool = False
     file: str = ""
 
@@ -270,7 +272,7 @@ def point_row(model: RobotModel, cost: str, branch: Branch, speed: float, subdir
                       cost_value=gait.cost_value,
                       cost_error=_number(accuracy.get("cost_error")),
                       step_length=gait.step_length, step_time=gait.step_time,
-                      stance_share=single / gait.step_time, file=rel)
+                      first_phase_share=single / gait.step_time, file=rel)
 
 
 def mark_cheapest(rows: Sequence[WalkRunRow]) -> list[WalkRunRow]:
@@ -323,7 +325,7 @@ def read_table(path: str | os.PathLike[str]) -> list[WalkRunRow]:
         raise WalkRunStudyError(f"{path}: line 1: missing columns {', '.join(missing)}")
     rows = []
     floats = ("speed_m_min", "froude", "cost_value", "cost_error", "step_length", "step_time",
-              "stance_share")
+              "first_phase_share")
     for line, raw in enumerate(reader, start=2):
         fields: dict[str, Any] = {}
         for col in TABLE_COLUMNS:

@@ -123,11 +123,11 @@ def transitions_html(transitions: Sequence[TransitionRow]) -> str:
 
 
 def points_html(rows: Sequence[WalkRunRow]) -> str:
-    """Every point: model, cost, speed, branch, cost and its grid error, step, stance share,
+    """Every point: model, cost, speed, branch, cost and its grid error, step, first phase share,
     status; the cheapest at its speed in bold."""
     head = ("<table><thead><tr><th>model</th><th>cost</th><th>speed [m/min]</th>"
             "<th>Froude</th><th>branch</th><th>cost value</th><th>grid error</th>"
-            "<th>step [m]</th><th>step time [s]</th><th>stance share</th><th>status</th>"
+            "<th>step [m]</th><th>step time [s]</th><th>first phase share</th><th>status</th>"
             "</tr></thead><tbody>")
     body = []
     for r in sorted(rows, key=lambda r: (r.model, r.cost, r.speed_m_min, r.branch)):
@@ -138,7 +138,7 @@ def points_html(rows: Sequence[WalkRunRow]) -> str:
             f"<td>{_fmt(r.froude, '.2f')}</td><td>{html.escape(r.branch)}</td>"
             f"<td>{'<b>' + value + '</b>' if r.cheapest else value}</td>"
             f"<td>{_fmt(r.cost_error, '.2g')}</td><td>{_fmt(r.step_length, '.3f')}</td>"
-            f"<td>{_fmt(r.step_time, '.3f')}</td><td>{_fmt(r.stance_share, '.2f')}</td>"
+            f"<td>{_fmt(r.step_time, '.3f')}</td><td>{_fmt(r.first_phase_share, '.2f')}</td>"
             f"<td>{html.escape(r.status)}</td></tr>")
     return head + "".join(body) + "</tbody></table>"
 
