@@ -5,9 +5,9 @@
 
 * ``walk_run.png`` / ``.svg``: cost against speed, one panel per (model, cost), one line per
   branch (converged points with the grid error estimate as an error bar, the cheapest at
-  each speed ringed, failed points as crosses on the panel's bottom edge), the transition
-  (the crossing, its grid-error interval shaded, the bracket dotted) and people's transition
-  at the model's Froude number 0.5 (dashed grey);
+  each speed ringed, failed points as crosses near the panel's bottom edge, a row per
+  branch), the transition (the crossing, its grid-error interval shaded, the bracket
+  dotted) and people's transition at the model's Froude number 0.5 (dashed grey);
 * ``report.html``: the transitions, the figure, the table of every point and the findings of
   :mod:`gaitopt.study.walk_run_findings`; one self-contained file.
 """
@@ -51,12 +51,12 @@ def walk_run_figure(rows: Sequence[WalkRunRow], transitions: Sequence[Transition
     """Cost against speed (m/min), a panel per (model, cost): see the module docstring."""
     models = list(dict.fromkeys(t.model for t in transitions))
     costs = list(dict.fromkeys(t.cost for t in transitions))
-    fig = new_figure(5.0 * len(costs), 3.6 * len(models))
+    fig = new_figure(5.5 * len(costs), 4.6 * len(models))
     axes = fig.subplots(len(models), len(costs), squeeze=False)
     for t in transitions:
         ax = axes[models.index(t.model)][costs.index(t.cost)]
         mine = [r for r in rows if r.model == t.model and r.cost == t.cost]
-        for branch in dict.fromkeys(r.branch for r in mine):
+        for k, branch in enumerate(dict.fromkeys(r.branch for r in mine)):
             color, marker, line = BRANCH_STYLES.get(branch, ("C7", "o", "-"))
             pts = sorted((r for r in mine if r.branch == branch), key=lambda r: r.speed_m_min)
             ok = [r for r in pts if r.success and math.isfinite(r.cost_value)]
@@ -65,13 +65,13 @@ def walk_run_figure(rows: Sequence[WalkRunRow], transitions: Sequence[Transition
                         yerr=[abs(r.cost_error) if math.isfinite(r.cost_error) else 0.0
                               for r in ok],
                         color=color, marker=marker, linestyle=line, markersize=4, capsize=2,
-                        label=f"{branch} ({len(ok)}/{len(pts)} converged)")
+                        label=f"{branch} ({len(ok)}/{len(pts)} converged, x: failed)")
             best = [r for r in ok if r.cheapest]
             ax.plot([r.speed_m_min for r in best], [r.cost_value for r in best], linestyle="",
                     marker="o", markersize=11, markerfacecolor="none", markeredgecolor=color)
             if failed:
-                ax.plot([r.speed_m_min for r in failed], [0.02] * len(failed), linestyle="",
-                        marker="x", markersize=7, color=color, clip_on=False,
+                ax.plot([r.speed_m_min for r in failed], [0.03 + 0.05 * k] * len(failed),
+                        linestyle="", marker="x", markersize=7, color=color, clip_on=False,
                         transform=ax.get_xaxis_transform())
         if t.cost == "paper" and any(r.success and r.cost_value > 0 for r in mine):
             ax.set_yscale("log")
@@ -89,7 +89,7 @@ def walk_run_figure(rows: Sequence[WalkRunRow], transitions: Sequence[Transition
         ax.set_title(f"{t.model}: {t.cost} cost", fontsize=10)
         ax.set_xlabel("speed  [m/min]")
         ax.set_ylabel(COST_LABELS.get(t.cost, "cost"))
-        ax.legend(fontsize=7, loc="best")
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=2)
     return fig
 
 
