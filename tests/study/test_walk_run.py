@@ -44,7 +44,7 @@ def seven_link() -> RobotModel:
 
 
 def row(branch: str, speed: float, cost: float | None, *, error: float = math.nan,
-        model: str = "five-link", cost_name: str = "paper") -> WalkRunRow:
+        model: str = "five-link", cost_name: str = "paper", share: float = 0.9) -> WalkRunRow:
     kind = "run" if branch == "run" else "walk"
     common: dict[str, Any] = {"model": model, "cost": cost_name, "branch": branch, "kind": kind,
                               "speed_m_min": float(speed),
@@ -52,7 +52,7 @@ def row(branch: str, speed: float, cost: float | None, *, error: float = math.na
     if cost is None:
         return WalkRunRow(**common, success=False, status="failed at relaxed contact")
     return WalkRunRow(**common, success=True, status="Solve_Succeeded", cost_value=cost,
-                      cost_error=error, step_length=0.5, step_time=0.5, first_phase_share=0.9,
+                      cost_error=error, step_length=0.5, step_time=0.5, first_phase_share=share,
                       file=f"{model}/{cost_name}/{branch}/gaits/x/{speed:g}.gait.json")
 
 
@@ -68,7 +68,8 @@ def synthetic_rows() -> list[WalkRunRow]:
         row("walk-single-support", 120, 450.0, error=5.0),
         row("walk-single-support", 150, None),
         row("run", 60, 250.0, error=-5.0), row("run", 90, 350.0, error=-5.0),
-        row("run", 120, 400.0, error=10.0), row("run", 150, 800.0, error=10.0),
+        row("run", 120, 400.0, error=10.0, share=0.95),
+        row("run", 150, 800.0, error=10.0, share=0.8),
     ])
 
 
@@ -156,6 +157,9 @@ def test_transition_findings_table_and_report(five_link: RobotModel, tmp_path: P
     inside = HUMAN_FROUDE_BAND[0] <= t.froude <= HUMAN_FROUDE_BAND[1]
     assert findings["transition.people"].holds is inside
     assert "105.0 m/min" in findings["transition.people"].evidence
+    # the cheapest run at 120 m/min stands 0.95 of the step: on the bound
+    assert findings["run.flight"].holds is False
+    assert "on the bound at 120 m/min" in findings["run.flight"].evidence
 
     table = write_table(tmp_path, rows)
     back = read_table(table)
@@ -185,6 +189,7 @@ def test_findings_when_the_walk_is_cheaper_everywhere(five_link: RobotModel) -> 
     assert findings["run.high_speed"].holds is False
     assert findings["transition.people"].holds is False
     assert "no transition within the grid" in findings["transition.people"].evidence
+    assert findings["run.flight"].holds is None  # the run is never the cheapest
 
 
 def test_findings_cannot_tell_without_common_speeds(five_link: RobotModel) -> None:
@@ -192,7 +197,7 @@ def test_findings_cannot_tell_without_common_speeds(five_link: RobotModel) -> No
                           row("run", 90, 250.0), row("walk", 90, None)])
     (t,) = transitions(WalkRunSpec(models=(five_link,), costs=("paper",)), rows)
     findings = assess_walk_run(rows, [t])["five-link / paper"]
-    assert [f.holds for f in findings.items] == [None, None, None]
+    assert [f.holds for f in findings.items] == [None, None, None, None]
 
 
 def test_a_missing_sweep_gives_not_solved_rows(five_link: RobotModel, tmp_path: Path) -> None:

@@ -11,17 +11,25 @@ Each is a :class:`gaitopt.study.findings.Finding` with a stable id; the verdict 
 3. ``transition.people``: the transition lies near people's, about 2 m/s at a Froude number
    ``v^2 / (g l)`` of 0.5: the interpolated crossing's Froude number (on the model's leg
    length) lies within :data:`~gaitopt.study.transition.HUMAN_FROUDE_BAND`.
+4. ``run.flight``: where the run is the cheapest gait (and a walk converged too), it is a
+   run of its own, not a walk
+   with the shortest flight allowed: its stance share lies below the upper bound of
+   :data:`~gaitopt.gait.options.model_defaults.RUN_STANCE_BOUNDS` (0.95) by more than
+   :data:`AT_BOUND`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from gaitopt.gait.options.model_defaults import RUN_STANCE_BOUNDS
 from gaitopt.study.findings import Finding, Findings
 from gaitopt.study.transition import HUMAN_FROUDE_BAND, HUMAN_TRANSITION_FROUDE
 from gaitopt.study.walk_run import TransitionRow, WalkRunRow
 
-FINDING_IDS = ("walk.low_speed", "run.high_speed", "transition.people")
+FINDING_IDS = ("walk.low_speed", "run.high_speed", "transition.people", "run.flight")
+#: A run's stance share within this of its upper bound counts as on the bound.
+AT_BOUND = 0.005
 
 
 def _at(rows: Sequence[WalkRunRow], model: str, cost: str, speed_m_min: float,
@@ -76,11 +84,32 @@ def _people(t: TransitionRow) -> Finding:
                    {"speed_m_min": tr.speed * 60, "froude": fr})
 
 
+def _flight(rows: Sequence[WalkRunRow], t: TransitionRow) -> Finding:
+    claim = ("where running is cheapest, the optimal run has a flight of its own (its stance "
+             f"share below the bound {RUN_STANCE_BOUNDS[1]:g})")
+    both = {round(v * 60.0, 6) for v in t.transition.speeds}
+    runs = sorted((r for r in rows if r.model == t.model and r.cost == t.cost
+                   and r.kind == "run" and r.cheapest and round(r.speed_m_min, 6) in both),
+                  key=lambda r: r.speed_m_min)
+    if not runs:
+        return Finding("run.flight", claim, None, "the run is the cheapest gait at no speed "
+                                                  "where a walk converged too")
+    on = [r for r in runs if r.first_phase_share >= RUN_STANCE_BOUNDS[1] - AT_BOUND]
+    shares = ", ".join(f"{r.first_phase_share:.2f} at {r.speed_m_min:g}" for r in runs)
+    evidence = (f"stance share of the cheapest run: {shares} m/min"
+                + (f"; on the bound at {', '.join(f'{r.speed_m_min:g}' for r in on)} m/min: "
+                   "a walk without double support but for the shortest flight allowed"
+                   if on else ""))
+    return Finding("run.flight", claim, not on, evidence,
+                   {f"share.{r.speed_m_min:g}": r.first_phase_share for r in runs})
+
+
 def assess_walk_run(rows: Sequence[WalkRunRow],
                     transitions: Sequence[TransitionRow]) -> Mapping[str, Findings]:
     """The findings of each (model, cost), keyed ``"<model> / <cost>"``."""
     out = {}
     for t in transitions:
-        items = (_end(rows, t, low=True), _end(rows, t, low=False), _people(t))
+        items = (_end(rows, t, low=True), _end(rows, t, low=False), _people(t),
+                 _flight(rows, t))
         out[f"{t.model} / {t.cost}"] = Findings(optima={}, items=items)
     return out
