@@ -218,3 +218,14 @@ def test_bad_table_names_line_and_column(tmp_path: Path) -> None:
     path.write_text("model,cost\n")
     with pytest.raises(WalkRunStudyError, match="missing columns"):
         read_table(path)
+
+
+def test_check_grid_is_a_setting_of_the_sweep_only_when_on(five_link: RobotModel) -> None:
+    from dataclasses import replace
+
+    from gaitopt.study.plan import sweep_settings
+
+    sweep = WalkRunSpec(models=(five_link,), costs=("paper",)).sweeps()[0][4]
+    assert sweep_settings(sweep)["check_grid"] is True
+    # a sweep without it keeps the settings (and sweep.json) it always had
+    assert "check_grid" not in sweep_settings(replace(sweep, check_grid=False))
