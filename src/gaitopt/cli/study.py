@@ -226,7 +226,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     then the report (Figs. 3-8 with their grid and error estimate, findings) and an animation
     of the optimal walk. A model with feet (seven-link) walks heel to toe in full coordinates
     on 24+16 knots, 12-120 m/min; without ankle torques its ankles are passive (damped).
-    With --costs, the cost study (docs/costs.md). Rerunning resumes."""
+    With --costs, the cost study (docs/costs.md); with --walk-run, the walk-run study
+    (docs/running.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
     from gaitopt.study.summary import read_summary
 
