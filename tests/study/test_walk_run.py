@@ -15,6 +15,7 @@ from gaitopt.robot.model import RobotModel
 from gaitopt.study.transition import HUMAN_FROUDE_BAND
 from gaitopt.study.walk_run import (
     DEFAULT_SPEEDS_M_MIN,
+    DEFAULT_SPEEDS_M_MIN_BY_COST,
     TRANSITIONS_FILE,
     WalkRunRow,
     WalkRunSpec,
@@ -99,6 +100,13 @@ def test_sweeps_of_the_study(five_link: RobotModel, seven_link: RobotModel) -> N
     assert heel.base.gait == "heel-toe"
     assert [round(v * 60, 9) for v in heel.speeds] == list(DEFAULT_SPEEDS_M_MIN["heel-toe"])
     assert spec.settings()["models"][1]["leg_length_m"] == leg_length_of(seven_link)
+    # the metabolic cost on feet takes minutes a solve: its own, shorter default grid
+    both = WalkRunSpec(models=(five_link, seven_link))
+    assert [round(v * 60, 9) for v in both.speeds_of(seven_link, "metabolic")] == list(
+        DEFAULT_SPEEDS_M_MIN_BY_COST[("heel-toe", "metabolic")])
+    assert both.speeds_of(five_link, "metabolic") == both.speeds_of(five_link, "paper")
+    given = WalkRunSpec(models=(seven_link,), speeds=(0.5, 1.0))
+    assert given.speeds_of(seven_link, "metabolic") == (0.5, 1.0)
     knotted = WalkRunSpec(models=(five_link,), costs=("metabolic",), speeds=(0.5, 1.0),
                           knots=(8, 5)).sweeps()[0][4]
     assert knotted.knots == (8, 5) and knotted.base.cost == "metabolic"

@@ -70,6 +70,12 @@ DEFAULT_SPEEDS_M_MIN: dict[str, tuple[float, ...]] = {
     "walk": (15.0, 30.0, 45.0, 60.0, 75.0, 90.0, 105.0, 120.0, 135.0, 150.0),
     "heel-toe": (30.0, 60.0, 90.0, 120.0, 150.0),
 }
+#: ... and for the metabolic cost on feet: minutes per solve (measured: the heel-toe walk at
+#: 60 m/min, cold, 580 s and 3153 IPOPT iterations; a warm one with its check grid more than
+#: 10 min), so two speeds around the transition under the paper's cost and people's.
+DEFAULT_SPEEDS_M_MIN_BY_COST: dict[tuple[str, str], tuple[float, ...]] = {
+    ("heel-toe", "metabolic"): (60.0, 120.0),
+}
 
 
 class WalkRunStudyError(ValueError):
@@ -123,7 +129,8 @@ class WalkRunSpec:
 
     ``models``; ``costs`` a subset of :data:`COSTS` (the paper's ``int u'u dt / L`` and the
     metabolic cost of transport at the default resting power); ``speeds`` (m/s, ascending)
-    the grid of every model, or None: by each model's walk (:data:`DEFAULT_SPEEDS_M_MIN`);
+    the grid of every model and cost, or None: by each model's walk and the cost
+    (:meth:`speeds_of`);
     ``knots`` per phase of every branch (first phase, the others), or None: each branch's
     default (16 + 6 for two phases, 24 + 16 for the heel-toe walk); ``knot_spacing`` that of
     every solve.
@@ -165,18 +172,23 @@ class WalkRunSpec:
             raise WalkRunStudyError(f"knot_spacing = {self.knot_spacing!r}: must be one of "
                                     f"{', '.join(KNOT_SPACINGS)}")
 
-    def speeds_of(self, model: RobotModel) -> tuple[float, ...]:
-        """The speed grid (m/s) of ``model``: ``speeds``, or the default of its walk."""
+    def speeds_of(self, model: RobotModel, cost: str) -> tuple[float, ...]:
+        """The speed grid (m/s) of ``model`` under ``cost``: ``speeds``, or the default of its
+        walk and the cost (:data:`DEFAULT_SPEEDS_M_MIN_BY_COST`, else
+        :data:`DEFAULT_SPEEDS_M_MIN`)."""
         if self.speeds is not None:
             return self.speeds
-        return tuple(v / 60.0 for v in DEFAULT_SPEEDS_M_MIN[default_gait(model)])
+        gait = default_gait(model)
+        grid = DEFAULT_SPEEDS_M_MIN_BY_COST.get((gait, cost), DEFAULT_SPEEDS_M_MIN[gait])
+        return tuple(v / 60.0 for v in grid)
 
     def sweep_of(self, model: RobotModel, cost: str, branch: Branch) -> SweepSpec:
         """The sweep of one (model, cost, branch): every speed of the grid, step free."""
         extra: dict[str, Any] = {} if self.knots is None else {"knots": self.knots}
         base = GaitOptions(gait=branch.gait, cost=cost,  # type: ignore[arg-type]
                            knot_spacing=self.knot_spacing, max_iter=STUDY_MAX_ITER, **extra)
-        return SweepSpec(model=model, speeds=self.speeds_of(model), variants=(branch.variant,),
+        return SweepSpec(model=model, speeds=self.speeds_of(model, cost),
+                         variants=(branch.variant,),
                          free_speed=False, single_support=(branch.single_support,), base=base,
                          check_grid=True)
 
@@ -191,7 +203,9 @@ class WalkRunSpec:
         return {"format": WALK_RUN_FORMAT, "version": 1, "gaitopt_version": __version__,
                 "models": [{"name": m.name, "content_hash": m.content_hash(),
                             "leg_length_m": leg_length_of(m),
-                            "speeds_m_min": [round(v * 60.0, 9) for v in self.speeds_of(m)],
+                            "speeds_m_min": {c: [round(v * 60.0, 9)
+                                                 for v in self.speeds_of(m, c)]
+                                             for c in self.costs},
                             "branches": [b.name for b in branches_of(m)]}
                            for m in self.models],
                 "costs": list(self.costs),
