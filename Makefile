@@ -42,8 +42,9 @@ run: $(STAMP)
 costs: $(STAMP)
 	$(BIN)/gaitopt study --costs -o out/costs
 
-# The walk-run study (docs/running.md): the five-link and seven-link bipeds' walks and runs
-# at each speed under the paper's and the metabolic cost, and the walk-run transition.
+# The walk-run study (docs/running.md): the walks and runs of the five-link, seven-link and
+# adult-point-feet bipeds at each speed under the paper's and the metabolic cost, and the
+# walk-run transition (about an hour on one worker process).
 walk-run: $(STAMP)
 	$(BIN)/gaitopt study --walk-run -o out/walk-run
 

@@ -113,12 +113,15 @@ def test_too_few_common_speeds_cannot_tell() -> None:
     assert t.kind == "none" and t.speeds == () and t.skipped == (1.0, 2.0, 3.0)
 
 
-def test_several_changes_report_the_first_walk_to_run_one() -> None:
+def test_several_changes_report_the_last_walk_to_run_one() -> None:
     speeds = [1.0, 2.0, 3.0, 4.0, 5.0]
     d = np.array([1.0, -1.0, 1.0, -1.0, -2.0])  # walk, run, walk, run, run
     walk = [10.0] * 5
     t = walk_run_transition(speeds, walk, list(10.0 + d))
-    assert t.bracket == (1.0, 2.0) and t.changes == 3
+    assert t.bracket == (3.0, 4.0) and t.changes == 3
+    # a run cheaper at the top speed only after walks: still the last walk-to-run change
+    t = walk_run_transition(speeds, walk, list(10.0 + np.array([1.0, -1.0, 1.0, 1.0, -1.0])))
+    assert t.bracket == (4.0, 5.0) and t.changes == 3
 
 
 def test_bad_input_is_refused() -> None:

@@ -67,7 +67,7 @@ STUDY_DIR = Path("out/study")
 COSTS_DIR = Path("out/costs")
 #: Default directory and models of ``gaitopt study --walk-run`` (docs/running.md).
 WALK_RUN_DIR = Path("out/walk-run")
-WALK_RUN_MODELS = ("five-link", "seven-link")
+WALK_RUN_MODELS = ("five-link", "seven-link", "adult-point-feet")
 DEFAULT_RESTING_POWERS_TEXT = "0,0.6,1.2,2.4,4.8"
 
 

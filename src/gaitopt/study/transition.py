@@ -6,8 +6,11 @@ its grid error estimate ``e`` (``solver.accuracy.cost_error`` of the gait file: 
 of ``J(grid) - J(limit)``, the same unit; NaN when unknown). A point that failed has no cost
 (NaN) and plays no part: the transition is computed on the speeds where both converged.
 
-With ``D_i = R_i - W_i`` (positive: the walk is cheaper), the transition is the first pair of
-consecutive speeds of that set with ``D_i > 0 >= D_{i+1}`` (the walk cheaper, then the run):
+With ``D_i = R_i - W_i`` (positive: the walk is cheaper), the transition is the last pair of
+consecutive speeds of that set with ``D_i > 0 >= D_{i+1}`` (the walk cheaper, then the run;
+the last, so that a run cheaper at one low speed between walks, within the grid errors of
+two nearly equal costs, is not taken for the transition; :attr:`Transition.changes` counts
+every change of the cheaper gait):
 
 * the *bracket* ``[v_i, v_{i+1}]``;
 * the *crossing* of the two cost curves, each linear between the grid speeds::
@@ -120,7 +123,7 @@ def walk_run_transition(speeds: Sequence[float], walk: Sequence[float],
     d = [run[i] - walk[i] for i in both]
     walk_cheaper = [x > 0 for x in d]
     changes = sum(a != b for a, b in zip(walk_cheaper, walk_cheaper[1:], strict=False))
-    first = next((k for k in range(len(d) - 1) if d[k] > 0 >= d[k + 1]), None)
+    first = next((k for k in reversed(range(len(d) - 1)) if d[k] > 0 >= d[k + 1]), None)
     if first is None:
         kind: TransitionKind = ("walk" if all(walk_cheaper) else
                                 "run" if not any(walk_cheaper) else "run-to-walk")
