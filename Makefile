@@ -21,7 +21,7 @@ define run_pytest
 	exit $$status
 endef
 
-.PHONY: run costs test test-suite test-slow test-kernels lint docs bench clean
+.PHONY: run costs walk-run test test-suite test-slow test-kernels lint docs bench clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || { \
@@ -41,6 +41,12 @@ run: $(STAMP)
 # The cost study (docs/costs.md): a few minutes, so not part of `make run`.
 costs: $(STAMP)
 	$(BIN)/gaitopt study --costs -o out/costs
+
+# The walk-run study (docs/running.md): the walks and runs of the five-link, seven-link and
+# adult-point-feet bipeds at each speed under the paper's and the metabolic cost, and the
+# walk-run transition (about an hour on one worker process).
+walk-run: $(STAMP)
+	$(BIN)/gaitopt study --walk-run -o out/walk-run
 
 lint: $(STAMP)
 	$(BIN)/ruff check

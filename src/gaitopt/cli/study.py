@@ -36,6 +36,7 @@ from gaitopt.cli.cost_study import run_cost_study
 from gaitopt.cli.report import animate_file, write_reports
 from gaitopt.cli.sweep_grid import make_spec, parse_speeds, parse_variants
 from gaitopt.cli.sweep_progress import run_with_progress
+from gaitopt.cli.walk_run_study import run_walk_run_study
 from gaitopt.gait.formulations.select import default_formulation
 from gaitopt.gait.options.gait_options import GAITS, GaitOptions, GaitOptionsError
 from gaitopt.study.driver import default_workers
@@ -64,6 +65,9 @@ STUDY_SPEEDS_BY_GAIT = {"walk": STUDY_SPEEDS, "heel-toe": FEET_STUDY_SPEEDS}
 STUDY_DIR = Path("out/study")
 #: Default directory and resting powers (W/kg) of ``gaitopt study --costs``.
 COSTS_DIR = Path("out/costs")
+#: Default directory and models of ``gaitopt study --walk-run`` (docs/running.md).
+WALK_RUN_DIR = Path("out/walk-run")
+WALK_RUN_MODELS = ("five-link", "seven-link", "adult-point-feet")
 DEFAULT_RESTING_POWERS_TEXT = "0,0.6,1.2,2.4,4.8"
 
 
@@ -160,19 +164,27 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @cli.command("study")
 @click.option("-o", "--output", "directory", type=click.Path(file_okay=False, path_type=Path),
               default=None, help=f"Study directory (the sweep; the report goes to its report/ "
-                                 f"folder) [default: {STUDY_DIR}; with --costs {COSTS_DIR}].")
+                                 f"folder) [default: {STUDY_DIR}; with --costs {COSTS_DIR}; "
+                                 f"with --walk-run {WALK_RUN_DIR}].")
 @click.option("--model", "model_names", multiple=True,
               help="Built-in model name or model file [default: five-link]; with --costs "
-                   "repeat it to compare models.")
+                   "repeat it to compare models; with --walk-run [default: "
+                   f"{', '.join(WALK_RUN_MODELS)}].")
 @click.option("--speeds", default=None,
               help=f"Speeds in m/min: start:stop:step and/or a comma list [default: "
                    f"{STUDY_SPEEDS}; {FEET_STUDY_SPEEDS} for a model with feet].")
 @click.option("--costs", "cost_study", is_flag=True,
               help="The cost study instead (docs/costs.md): each model's speed-free optimum "
                    "of the paper's, the work and the metabolic cost at each resting power.")
+@click.option("--walk-run", "walk_run", is_flag=True,
+              help="The walk-run study instead (docs/running.md): at each speed each model's "
+                   "optimal walk, walk without double support (if it allows it) and run, the "
+                   "cheapest and the walk-run transition, under the paper's and the metabolic "
+                   "cost.")
 @click.option("--cost", "costs", multiple=True,
               type=click.Choice(["paper", "work", "metabolic"]),
-              help="The cost study of these costs only (repeat it; implies --costs).")
+              help="The cost study of these costs only (repeat it; implies --costs); with "
+                   "--walk-run its costs (paper, metabolic) [default: both].")
 @click.option("--resting-powers", default=DEFAULT_RESTING_POWERS_TEXT, show_default=True,
               help="With --costs: resting powers of the metabolic cost, W/kg (comma list).")
 @click.option("--regularization", type=float, default=0.0, show_default=True,
@@ -202,7 +214,7 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str | None,
                   paper_grid: bool, knots: str | None, knot_spacing: str | None,
-                  cost_study: bool,
+                  cost_study: bool, walk_run: bool,
                   costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, start_speed: str, clearance: float | None,
@@ -214,11 +226,25 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
     then the report (Figs. 3-8 with their grid and error estimate, findings) and an animation
     of the optimal walk. A model with feet (seven-link) walks heel to toe in full coordinates
     on 24+16 knots, 12-120 m/min; without ankle torques its ankles are passive (damped).
-    With --costs, the cost study (docs/costs.md). Rerunning resumes."""
+    With --costs, the cost study (docs/costs.md); with --walk-run, the walk-run study
+    (docs/running.md). Rerunning resumes."""
     from gaitopt.study.findings import optimal_row
     from gaitopt.study.summary import read_summary
 
     console = make_console()
+    if walk_run:
+        if cost_study:
+            raise UserError("--walk-run and --costs are two studies: give one of them")
+        if paper_grid:
+            raise UserError("--paper-grid: not with --walk-run (its grid is each gait's "
+                            "default, or --knots)")
+        if "work" in costs:
+            raise UserError("--cost work: not with --walk-run (its costs: paper, metabolic)")
+        run_walk_run_study(console, directory or WALK_RUN_DIR, model_names or WALK_RUN_MODELS,
+                           costs=costs or ("paper", "metabolic"), speeds=speeds, knots=knots,
+                           knot_spacing=knot_spacing or GaitOptions().knot_spacing,
+                           workers=workers, scheduler=scheduler)
+        return
     if cost_study or costs:
         run_cost_study(console, directory or COSTS_DIR, model_names or ("five-link",),
                        costs=costs or ("paper", "work", "metabolic"),

@@ -236,7 +236,8 @@ class _Driver:
         self.tasks[key] = PointTask(key=key, model=self.spec.model_of(p),
                                     options=self.spec.options(p), variant=p.variant,
                                     speed_mode=p.speed_mode, structure=p.structure, warm=warm,
-                                    relfile=p.relfile, force_fail=key in self.fail_points)
+                                    relfile=p.relfile, force_fail=key in self.fail_points,
+                                    check_grid=self.spec.check_grid)
         return self.tasks[key]
 
     def run(self) -> None:

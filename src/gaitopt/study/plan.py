@@ -75,6 +75,10 @@ class SweepSpec:
         continuation: points warm-start from their neighbours along the speed axis; with
             False every point starts alone (cold, or from a seed file: the refinement sweep
             of :mod:`gaitopt.study.grid_error`).
+        check_grid: every point solves its check grid after the answer, a warm-started one
+            too (``solve_walking(check_warm_start=True)``), so that every gait file carries
+            the cost's grid error estimate (``solver.accuracy.cost_error``); otherwise only
+            the cold starts do (the walk-run study, :mod:`gaitopt.study.walk_run`).
     """
 
     model: RobotModel
@@ -86,6 +90,7 @@ class SweepSpec:
     single_support: tuple[float, ...] = (0.85,)
     base: GaitOptions = field(default_factory=GaitOptions)
     continuation: bool = True
+    check_grid: bool = False
 
     def __post_init__(self) -> None:
         try:
@@ -328,7 +333,8 @@ def sweep_settings(spec: SweepSpec) -> dict[str, Any]:
         "single_support_fractions": list(spec.single_support),
         "options": shared,
     } | ({"step_times": list(spec.step_times)} if spec.step_times != (None,) else {}) | (
-        {} if spec.continuation else {"continuation": False})
+        {} if spec.continuation else {"continuation": False}) | (
+        {"check_grid": True} if spec.check_grid else {})
 
 
 def settings_document(spec: SweepSpec) -> dict[str, Any]:

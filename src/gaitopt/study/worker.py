@@ -70,7 +70,8 @@ class PointTask:
     text (a point kept from an earlier run), or None (cold start). ``relfile`` is the gait
     file's path relative to the sub-sweep folder (the summary row's ``file``).
     ``force_fail`` (a testing hook) solves with ``max_iter = 1`` so that the point fails
-    through the real solver path.
+    through the real solver path. ``check_grid``: a warm-started point also solves its
+    check grid (:attr:`gaitopt.study.plan.SweepSpec.check_grid`).
     """
 
     key: str
@@ -82,6 +83,7 @@ class PointTask:
     warm: Result | SavedGait | None
     relfile: str
     force_fail: bool = False
+    check_grid: bool = False
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -165,7 +167,8 @@ def solve_point(task: PointTask) -> PointOutcome:
     error = ""
     try:
         with _LOCK:
-            solution = solve_walking(task.model, options, warm_start=warm)
+            solution = solve_walking(task.model, options, warm_start=warm,
+                                     check_warm_start=task.check_grid)
             ipopt = sum(s.wall_time_s for s in solution.stages)
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt
