@@ -87,7 +87,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                      warm_start: Gait | None = None, progress: ProgressFn | None = None,
                      compiled: str | None = None,
                      refine: bool | None = None,
-                     speed_given: bool | None = None) -> StagedRun:
+                     speed_given: bool | None = None,
+                     check_warm_start: bool = False) -> StagedRun:
     """Internal: :func:`solve_gait` before the gait is recorded. Returns the
     :class:`~gaitopt.gait.solve.staged_run.StagedRun` (the engine's final result, every
     stage's record and result), which the command line, the study, the benches and the tests
@@ -112,7 +113,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     guess: Guess | WarmStart | None = None
     if warm_start is not None and warm_start_usable(warm_start, opts):
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
-    first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled)
+    first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled,
+                          check_warm_start=check_warm_start)
     if speed_given is None:
         speed_given = not follows_model(given.speed)
     slower = slower_default(robot, opts)
