@@ -12,16 +12,24 @@ other settings. The start speed is given, or by default each model's paper case 
 
 The problems have several local optima, and the speed-free optimum reached from the 12 m/min
 walk is not always the lowest (metabolic cost, 4.8 W/kg: 42.2 m/min with 0.39 m steps, 1.8 %
-above the 43.9 m/min, 0.26 m optimum of the staged solve). So each case is also solved
-*directly*, the staged solve of ``gaitopt solve --speed free`` (the paper's cost through its
-stages, then the case's cost), and the lower of the two optima is the case's result; the
-table keeps which start won and the other's cost::
+above the 43.9 m/min, 0.26 m optimum of the staged solve). So each case is reached at least
+two ways and the lowest optimum is the case's result, by the model's *strategy*
+(:meth:`CostStudySpec.strategy_of`): ``cold`` (the paper's walk), the sweep and the *direct*
+solve, the staged solve of ``gaitopt solve --speed free`` (the paper's cost through its
+stages, then the case's cost); ``continuation`` (a model with feet, whose cold solves of the
+costs of transport take minutes each), each case from the previous case's optimum
+(:mod:`gaitopt.study.cost_continuation`). The table keeps which start won and the next one's
+cost. Each case's lowest optimum is then refined until its error estimates are within
+``accuracy`` (1 %; :mod:`gaitopt.study.cost_accuracy`), and the table reports that gait::
 
     DIR/cost_study.json                      the study's settings (written first)
     DIR/costs.csv                            one row per (model, case): the speed-free optimum
     DIR/<model>/<case>/sweep.json, summary.csv, gaits/<variant>/...   each case's sweep
     DIR/<model>/<case>/direct.gait.json      the direct solve (written atomically; kept on a
                                              rerun when it matches the case's options)
+    DIR/<model>/<case>/from-<case>/...       the continuation's sweep from the previous case
+    DIR/<model>/<case>/accurate.gait.json    the optimum refined to the accuracy (and
+                                             accurate.json: what it started from)
     DIR/report/report.html                   figure, table, findings (gaitopt.viz.cost_report)
 
 ``<model>`` is the model's name, ``<case>`` ``paper``, ``work`` or ``metabolic-rest-1.2``
