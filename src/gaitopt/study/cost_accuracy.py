@@ -26,8 +26,10 @@ from pathlib import Path
 from typing import Any
 
 from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
+from gaitopt.gait.solve.record import gait_from_run
 from gaitopt.robot.model import RobotModel
 
 #: The accurate gait of a case and the note of what it started from, in the case's folder.
@@ -66,9 +68,6 @@ class AccuracyOutcome:
 
 def solve_accurate(task: AccuracyTask) -> AccuracyOutcome:
     """The accuracy pass of one case (module docstring); never raises for a failed solve."""
-    from gaitopt.gait.api import solve_staged_run
-    from gaitopt.gait.solve.record import gait_from_run
-
     start = time.perf_counter()
     try:
         gait = Gait.from_dict(json.loads(task.text), source=task.source)
