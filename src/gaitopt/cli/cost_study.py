@@ -62,6 +62,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
         CostStudyError,
         CostStudySpec,
         CostSweep,
+        accuracy_tasks,
         collect_rows,
         run_accuracy,
         run_direct_solves,
@@ -201,8 +202,11 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                               f"{sweep.case.tag}: {what}", soft_wrap=True)
 
             if spec.accuracy is not None:
+                todo = [sweep.case.tag for sweep, _ in accuracy_tasks(spec, directory)]
                 console.print(f"accuracy: each case's optimum refined until its estimates are "
-                              f"within {100 * spec.accuracy:g} %:", soft_wrap=True)
+                              f"within {100 * spec.accuracy:g} % (on its check grid, then "
+                              f"finer; {len(todo)} to solve: {', '.join(todo) or 'none'}):",
+                              soft_wrap=True)
                 try:
                     solved, failed = run_accuracy(spec, directory, backend, refined)
                 except KeyboardInterrupt:

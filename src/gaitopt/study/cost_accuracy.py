@@ -30,6 +30,7 @@ from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.record import gait_from_run
+from gaitopt.gait.solve.staged_run import StageRecord
 from gaitopt.robot.model import RobotModel
 
 #: The accurate gait of a case and the note of what it started from, in the case's folder.
@@ -50,6 +51,9 @@ class AccuracyTask:
     text: str
     source: str
     cost: float
+    #: Print a line per finished stage (the worker's standard output: the terminal for local
+    #: processes, a Dask worker's log).
+    echo: bool = True
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -71,8 +75,11 @@ def solve_accurate(task: AccuracyTask) -> AccuracyOutcome:
     start = time.perf_counter()
     try:
         gait = Gait.from_dict(json.loads(task.text), source=task.source)
+        def echo(stage: StageRecord) -> None:
+            print(f"  accuracy {task.key}: {stage.line()}", flush=True)
+
         run = solve_staged_run(task.model, task.options, warm_start=gait, refine=True,
-                               check_warm_start=True)
+                               check_warm_start=True, progress=echo if task.echo else None)
         data = gait_from_run(run).to_dict() if run.success else None
         return AccuracyOutcome(key=task.key, gait=data, status=run.result.status,
                                wall_time_s=time.perf_counter() - start,
