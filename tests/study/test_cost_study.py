@@ -7,6 +7,7 @@ collection, the findings and the report; one slow test runs the command end to e
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -18,6 +19,7 @@ from gaitopt.cli import cli
 from gaitopt.gait.record.file import Gait
 from gaitopt.robot import RobotModel, load_model
 from gaitopt.robot.loader import model_from_dict
+from gaitopt.study.cost_accuracy import ACCURATE_FILE, ACCURATE_NOTE
 from gaitopt.study.cost_findings import COST_FINDING_IDS, assess_cost_findings, ranked
 from gaitopt.study.cost_start import given_start
 from gaitopt.study.cost_study import (
@@ -328,7 +330,7 @@ def test_cli_cost_study_runs_and_resumes(tmp_path: Path) -> None:
     """``gaitopt study --cost paper``: the paper's cost alone (about 10 s): the table, the
     report and the findings; a rerun keeps both points."""
     out = tmp_path / "costs"
-    args = ["study", "--cost", "paper", "-o", str(out), "--workers", "0"]
+    args = ["study", "--cost", "paper", "--accuracy-pass", "-o", str(out), "--workers", "0"]
     first = CliRunner().invoke(cli, args)
     assert first.exit_code == 0, first.output
     rows = read_cost_table(out / COST_TABLE_FILE)
@@ -340,14 +342,23 @@ def test_cli_cost_study_runs_and_resumes(tmp_path: Path) -> None:
     costs = {start: Gait.load(case / name).cost_value for start, name in (
         ("from 12 m/min", "gaits/ankle+impulse/speed-free.gait.json"),
         ("direct", DIRECT_FILE))}
-    assert rows[0].cost_value == min(costs.values())
     assert rows[0].start == min(costs, key=lambda k: costs[k])
     assert rows[0].other_cost_value == max(costs.values())
+    # the row reports the lower optimum refined to 1 % (the accuracy pass), which started
+    # from the lower start's file and says its estimate and grid
+    note = json.loads((case / ACCURATE_NOTE).read_text(encoding="utf-8"))
+    assert note["from_cost"] == min(costs.values())
+    accurate = Gait.load(case / ACCURATE_FILE)
+    assert rows[0].file == f"five-link/paper/{ACCURATE_FILE}"
+    assert rows[0].cost_value == accurate.cost_value
+    assert rows[0].within_accuracy is True and rows[0].estimate <= 0.01
+    assert rows[0].knots == "+".join(str(k) for k in accurate.solver["accuracy"]["knots"].values())
     again = CliRunner().invoke(cli, args)
     assert again.exit_code == 0, again.output
     text = " ".join(again.output.split())
     assert "2 kept from an earlier run, 0 to solve" in text
     assert "direct solves: 0 solved, 0 failed, 1 kept" in text
+    assert "accuracy: 0 solved, 0 failed" in text
     assert read_cost_table(out / COST_TABLE_FILE)[0].as_csv_dict() == rows[0].as_csv_dict()
 
 

@@ -16,7 +16,7 @@ from gaitopt.cli.report import write_cost_reports
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.study.executors import BackendError
-from gaitopt.study.plan import START_SPEED, SweepSpecError
+from gaitopt.study.plan import START_SPEED, SweepSpec, SweepSpecError
 from gaitopt.study.worker import PointOutcome
 from gaitopt.units import parse_speed
 
@@ -40,19 +40,33 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                    formulation: str, start_speed: str = "auto",
                    clearance: float | None = None, gait: str = "auto",
                    knot_spacing: str = "cosine",
-                   knots: str | None = None, workers: int | None,
-                   scheduler: str | None) -> None:
+                   knots: str | None = None, strategy: str = "auto",
+                   accuracy_pass: bool = False,
+                   workers: int | None, scheduler: str | None) -> None:
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
     processes keep their built problems; with ``--start-speed auto`` each model's paper case
     first, whose optimum sets the start of the model's other cases), then the direct solves,
     ``costs.csv``, the report and the findings."""
     from gaitopt.gait.api import as_model
+    from gaitopt.study.cost_accuracy import AccuracyOutcome
+    from gaitopt.study.cost_continuation import (
+        best_free,
+        case_neighbour,
+        fixed_converged,
+        fixed_seeds,
+        neighbour_folder,
+        neighbour_spec,
+        resolve_neighbour,
+    )
     from gaitopt.study.cost_start import StartChoice
     from gaitopt.study.cost_study import (
+        ACCURACY,
         CostStudyError,
         CostStudySpec,
         CostSweep,
+        accuracy_tasks,
         collect_rows,
+        run_accuracy,
         run_direct_solves,
         start_choice,
         write_settings,
@@ -75,7 +89,9 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                              formulation=formulation,  # type: ignore[arg-type]
                              knots=None if knots is None else parse_knots(knots),
                              start_speed=parse_start_speed(start_speed),
-                             knot_spacing=knot_spacing)  # type: ignore[arg-type]
+                             knot_spacing=knot_spacing,  # type: ignore[arg-type]
+                             strategy=strategy,
+                             accuracy=ACCURACY if accuracy_pass else None)
         # Every sweep's settings checked before anything is solved (the automatic start's
         # speed is not known yet: 12 m/min stands in for it here).
         spec.sweeps({m.name: StartChoice(speed=START_SPEED, rule="auto", reason="")
@@ -92,17 +108,47 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
     backend = None
     counted = 0
 
-    def run_sweep(sweep: CostSweep, count: str) -> None:
+    def run_sweep(sweep: CostSweep, count: str, *, folder: Path | None = None,
+                  spec_: SweepSpec | None = None, seeds: dict[str, Path] | None = None,
+                  how: str = "") -> None:
         nonlocal backend
         console.print(f"{count} {sweep.model} ({sweep.formulation}): {sweep.case.label}, "
-                      f"from {sweep.spec.speeds[0] * 60.0:g} m/min", soft_wrap=True)
+                      f"{how or f'from {sweep.spec.speeds[0] * 60.0:g} m/min'}",
+                      soft_wrap=True)
         if backend is None:
             try:
                 backend = make_backend(workers=workers, scheduler=scheduler)
             except BackendError as exc:
                 raise UserError(str(exc)) from None
-        run_with_progress(console, sweep.spec, directory / sweep.subdir, workers=workers,
-                          scheduler=scheduler, backend=backend)
+        run_with_progress(console, spec_ or sweep.spec, folder or directory / sweep.subdir,
+                          workers=workers, scheduler=scheduler, backend=backend, seeds=seeds)
+
+    def continued(sweep: CostSweep, done: list[CostSweep], count: str) -> None:
+        """A case of the continuation strategy (gaitopt.study.cost_continuation): the first
+        case its sweep, cold; every other its speed-free optimum from its neighbour's, and
+        its sweep only if that failed (its fixed-speed walk from the nearest case's)."""
+        by_case = {d.case: d for d in done}
+        neighbour = case_neighbour(sweep.case, list(by_case))
+        best = (None if neighbour is None
+                else best_free(directory / by_case[neighbour].subdir, spec.variant))
+        if neighbour is not None and best is not None:
+            path, row = best
+            again = neighbour_spec(sweep.spec, row.speed_m_s)
+            run_sweep(sweep, count, folder=neighbour_folder(directory / sweep.subdir, neighbour),
+                      spec_=again, seeds={p.key: path for p in again.points},
+                      how=f"from {neighbour.tag}'s speed-free optimum "
+                          f"({row.speed_m_min:.2f} m/min)")
+            if best_free(directory / sweep.subdir, spec.variant) is not None:
+                return
+        converged = [d.case for d in done
+                     if fixed_converged(directory / d.subdir, d.spec) is not None]
+        near = resolve_neighbour(sweep.case, [d.case for d in done], converged)
+        seeds = ({} if near is None else
+                 fixed_seeds(sweep.spec, directory / by_case[near].subdir, by_case[near].spec))
+        run_sweep(sweep, count, seeds=seeds,
+                  how=(f"from {sweep.spec.speeds[0] * 60.0:g} m/min, "
+                       + (f"started from {near.tag}'s walk there" if seeds and near
+                          else "cold")))
 
     try:
         for model in spec.models:
@@ -114,12 +160,15 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                 write_settings(spec, directory, starts)
                 console.print(f"{model.name}: its other cases start at "
                               f"{starts[model.name].reason}", soft_wrap=True)
-            for case in spec.cases:
-                if spec.auto_start and case.cost == "paper":
-                    continue
+            solved_cases: list[CostSweep] = []
+            for case in spec.solve_order(model):
                 counted += 1
-                run_sweep(spec.sweep_of(model, case, spec.start_of(model, case, starts)),
-                          f"[{counted}/{n_cases}]")
+                sweep = spec.sweep_of(model, case, spec.start_of(model, case, starts))
+                if spec.strategy_of(model) == "continuation":
+                    continued(sweep, solved_cases, f"[{counted}/{n_cases}]")
+                else:
+                    run_sweep(sweep, f"[{counted}/{n_cases}]")
+                solved_cases.append(sweep)
         if backend is not None:
             def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
                 what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
@@ -140,6 +189,36 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                 sys.exit(130)
             console.print(f"direct solves: {solved} solved, {failed} failed, {kept} kept",
                           soft_wrap=True)
+
+            def refined(sweep: CostSweep, outcome: AccuracyOutcome | None,
+                        path: Path | None) -> None:
+                if path is None or outcome is None or outcome.gait is None:
+                    what = outcome.status if outcome else "the worker died"
+                else:
+                    acc = outcome.gait.get("solver", {}).get("accuracy", {})
+                    worst = acc.get("worst_estimate")
+                    knots = "+".join(str(k) for k in (acc.get("knots") or {}).values())
+                    what = (f"{knots} knots, {acc.get('worst_estimate_of', 'cost')} estimate "
+                            f"{'none' if worst is None else f'{100 * worst:.2g} %'}, "
+                            f"{outcome.wall_time_s:.0f} s")
+                console.print(f"{'ok  ' if path else 'FAIL'} accuracy {sweep.model} "
+                              f"{sweep.case.tag}: {what}", soft_wrap=True)
+
+            if spec.accuracy is not None:
+                todo = [sweep.case.tag for sweep, _ in accuracy_tasks(spec, directory)]
+                console.print(f"accuracy: each case's optimum refined until its estimates are "
+                              f"within {100 * spec.accuracy:g} % (on its check grid, then "
+                              f"finer; {len(todo)} to solve: {', '.join(todo) or 'none'}):",
+                              soft_wrap=True)
+                try:
+                    solved, failed = run_accuracy(spec, directory, backend, refined)
+                except KeyboardInterrupt:
+                    backend.close(wait=False)
+                    backend = None
+                    console.print("interrupted: every finished solve is saved; rerun the "
+                                  "same command to resume", soft_wrap=True)
+                    sys.exit(130)
+                console.print(f"accuracy: {solved} solved, {failed} failed", soft_wrap=True)
     except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
         if backend is not None:
             backend.close(wait=False)

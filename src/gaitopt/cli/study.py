@@ -185,6 +185,10 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
               type=click.Choice(["paper", "work", "metabolic"]),
               help="The cost study of these costs only (repeat it; implies --costs); with "
                    "--walk-run its costs (paper, metabolic) [default: both].")
+@click.option("--accuracy-pass", is_flag=True,
+              help="With --costs: refine each case's optimum until its estimates of cost, "
+                   "speed and step length are within 1 % (slow; off by default, "
+                   "docs/costs.md).")
 @click.option("--resting-powers", default=DEFAULT_RESTING_POWERS_TEXT, show_default=True,
               help="With --costs: resting powers of the metabolic cost, W/kg (comma list).")
 @click.option("--regularization", type=float, default=0.0, show_default=True,
@@ -214,7 +218,7 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str | None,
                   paper_grid: bool, knots: str | None, knot_spacing: str | None,
-                  cost_study: bool, walk_run: bool,
+                  cost_study: bool, walk_run: bool, accuracy_pass: bool,
                   costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, start_speed: str, clearance: float | None,
@@ -252,7 +256,8 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
                        start_speed=start_speed, clearance=clearance, gait=gait_kind,
                        formulation=formulation,
                        knot_spacing=knot_spacing or GaitOptions().knot_spacing,
-                       knots=knots, workers=workers, scheduler=scheduler)
+                       knots=knots, accuracy_pass=accuracy_pass, workers=workers,
+                       scheduler=scheduler)
         return
     if len(model_names) > 1:
         raise UserError("--model: the paper's study takes one model (several only with "

@@ -90,7 +90,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                      warm_start: Gait | None = None, progress: ProgressFn | None = None,
                      compiled: str | None = None,
                      refine: bool | None = None,
-                     speed_given: bool | None = None) -> StagedRun:
+                     speed_given: bool | None = None,
+                     check_warm_start: bool = False) -> StagedRun:
     """Internal: :func:`solve_gait` before the gait is recorded. Returns the
     :class:`~gaitopt.gait.solve.staged_run.StagedRun` (the engine's final result, every
     stage's record and result), which the command line, the study, the benches and the tests
@@ -102,6 +103,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     A warm start that refines starts on the grid its file was refined to and solves its check
     grid, unless it finds the file's own optimum again, whose estimate it then keeps
     (:mod:`gaitopt.gait.solve.warm_accuracy`).
+    ``check_warm_start``: a warm start always solves its check grid too (the cost study's
+    accuracy pass), whatever the file's estimate.
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
@@ -127,8 +130,9 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
     # A warm start that refines needs its estimate: its check grid (unless the file's holds).
     first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled,
-                          check_warm_start=refines and guess is not None and
-                          not _file_estimate_may_hold(warm_start, opts))
+                          check_warm_start=check_warm_start or (
+                              refines and guess is not None and
+                              not _file_estimate_may_hold(warm_start, opts)))
     carried = None
     if guess is not None and warm_start is not None and refines:
         carried = carried_estimate(warm_start, first, accuracy_record(first))

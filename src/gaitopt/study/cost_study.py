@@ -12,16 +12,24 @@ other settings. The start speed is given, or by default each model's paper case 
 
 The problems have several local optima, and the speed-free optimum reached from the 12 m/min
 walk is not always the lowest (metabolic cost, 4.8 W/kg: 42.2 m/min with 0.39 m steps, 1.8 %
-above the 43.9 m/min, 0.26 m optimum of the staged solve). So each case is also solved
-*directly*, the staged solve of ``gaitopt solve --speed free`` (the paper's cost through its
-stages, then the case's cost), and the lower of the two optima is the case's result; the
-table keeps which start won and the other's cost::
+above the 43.9 m/min, 0.26 m optimum of the staged solve). So each case is reached at least
+two ways and the lowest optimum is the case's result, by the model's *strategy*
+(:meth:`CostStudySpec.strategy_of`): ``cold`` (the paper's walk), the sweep and the *direct*
+solve, the staged solve of ``gaitopt solve --speed free`` (the paper's cost through its
+stages, then the case's cost); ``continuation`` (a model with feet, whose cold solves of the
+costs of transport take minutes each), each case from the previous case's optimum
+(:mod:`gaitopt.study.cost_continuation`). The table keeps which start won and the next one's
+cost. Each case's lowest optimum is then refined until its error estimates are within
+``accuracy`` (1 %; :mod:`gaitopt.study.cost_accuracy`), and the table reports that gait::
 
     DIR/cost_study.json                      the study's settings (written first)
     DIR/costs.csv                            one row per (model, case): the speed-free optimum
     DIR/<model>/<case>/sweep.json, summary.csv, gaits/<variant>/...   each case's sweep
     DIR/<model>/<case>/direct.gait.json      the direct solve (written atomically; kept on a
                                              rerun when it matches the case's options)
+    DIR/<model>/<case>/from-<case>/...       the continuation's sweep from the previous case
+    DIR/<model>/<case>/accurate.gait.json    the optimum refined to the accuracy (and
+                                             accurate.json: what it started from)
     DIR/report/report.html                   figure, table, findings (gaitopt.viz.cost_report)
 
 ``<model>`` is the model's name, ``<case>`` ``paper``, ``work`` or ``metabolic-rest-1.2``
@@ -60,6 +68,16 @@ from gaitopt.gait.options.gait_options import (
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
+from gaitopt.study.cost_accuracy import (
+    ACCURATE_FILE,
+    AccuracyOutcome,
+    AccuracyTask,
+    accurate_gait,
+    estimate_of,
+    save_accurate,
+    solve_accurate,
+)
+from gaitopt.study.cost_continuation import free_candidates
 from gaitopt.study.cost_start import AUTO_START, StartChoice, auto_start_speed, given_start
 from gaitopt.study.cost_table import CostRow
 from gaitopt.study.cost_table import CostStudyError as CostStudyError
@@ -93,6 +111,19 @@ DEFAULT_KNOTS: dict[str, tuple[int, int]] = {"walk": (8, 5), "heel-toe": (24, 16
 #: knots the metabolic cost's last stage stopped at 1000 and converged in 2071 (docs/feet.md).
 #: A solve that converges within 1000 iterations is the same with this limit.
 STUDY_MAX_ITER = 3000
+#: How each model's cases are started (``CostStudySpec.strategy``; ``auto`` chooses by the
+#: model's gait, :meth:`CostStudySpec.strategy_of`): ``cold``, each case's sweep from a cold
+#: start and its direct staged solve (cold); ``continuation``, each case started from the
+#: optima of the case solved before it (:func:`case_neighbour`), no direct solve.
+STRATEGIES = ("cold", "continuation")
+AUTO_STRATEGY = "auto"
+#: The relative accuracy each case's optimum is refined to by the accuracy pass
+#: (:mod:`gaitopt.study.cost_accuracy`; ``gaitopt study --costs --accuracy-pass``): 1 %, the
+#: accuracy of ``gaitopt solve`` (``GaitOptions.accuracy``). The pass is off by default
+#: (``CostStudySpec.accuracy`` None): measured 2026-12-03, it takes the five-link study from
+#: 43 s to 667 s, and on the seven-link model the check grids of the costs of transport stop at
+#: the iteration limit (docs/costs.md).
+ACCURACY = 0.01
 COST_STUDY_FILE = "cost_study.json"
 COST_STUDY_FORMAT = "gaitopt.cost-study"
 DIRECT_FILE = "direct.gait.json"
@@ -185,6 +216,8 @@ class CostStudySpec:
     knots: tuple[int, int] | None = None
     start_speed: float | str = AUTO_START
     knot_spacing: KnotSpacing = "cosine"
+    strategy: str = AUTO_STRATEGY
+    accuracy: float | None = None
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -230,6 +263,13 @@ class CostStudySpec:
             raise CostStudyError(f"gait: {self.gait!r}; allowed: auto, walk, heel-toe")
         if self.variant not in VARIANTS:
             raise CostStudyError(f"variant: {self.variant!r}; allowed: {', '.join(VARIANTS)}")
+        if self.strategy not in (AUTO_STRATEGY, *STRATEGIES):
+            raise CostStudyError(f"strategy: {self.strategy!r}; allowed: "
+                                 f"{', '.join((AUTO_STRATEGY, *STRATEGIES))}")
+        if self.accuracy is not None and not (math.isfinite(self.accuracy)
+                                              and 0.0 < self.accuracy < 1.0):
+            raise CostStudyError(f"accuracy: {self.accuracy!r}; allowed: in (0, 1) (0.01 for "
+                                 "1 %), or None for no accuracy pass")
 
     @property
     def cases(self) -> tuple[CostCase, ...]:
@@ -258,6 +298,28 @@ class CostStudySpec:
     def knots_of(self, model: RobotModel) -> tuple[int, int]:
         """The knots of ``model``'s cases: ``knots``, or by its gait (:data:`DEFAULT_KNOTS`)."""
         return self.knots if self.knots is not None else DEFAULT_KNOTS[self.gait_of(model)]
+
+    def strategy_of(self, model: RobotModel) -> str:
+        """``cold`` or ``continuation`` for ``model`` (:data:`STRATEGIES`): with
+        ``strategy="auto"``, ``continuation`` for the heel-toe walk (a model with feet, whose
+        cold staged solves of the costs of transport take 10-15 minutes each) and ``cold``
+        for the paper's walk."""
+        if self.strategy != AUTO_STRATEGY:
+            return self.strategy
+        return "continuation" if self.gait_of(model) == "heel-toe" else "cold"
+
+    def solve_order(self, model: RobotModel) -> tuple[CostCase, ...]:
+        """The cases of ``model`` in the order they are solved (with the automatic start the
+        paper case is solved first, as the reference, and is not among them): ``cold``, the
+        study order (:attr:`cases`); ``continuation``, the paper case, the metabolic cases
+        by descending resting power (the largest walks fastest, nearest the start speed, the
+        paper optimum's), then the work case (started from the metabolic case at the least
+        resting power, the nearest in form: both price positive work)."""
+        cases = [c for c in self.cases if not (self.auto_start and c.cost == "paper")]
+        if self.strategy_of(model) == "cold":
+            return tuple(cases)
+        rank = {"paper": 0, "metabolic": 1, "work": 2}
+        return tuple(sorted(cases, key=lambda c: (rank[c.cost], -(c.resting_power or 0.0))))
 
     @property
     def auto_start(self) -> bool:
@@ -320,6 +382,7 @@ class CostStudySpec:
             models.append({"name": m.name, "content_hash": m.content_hash(),
                            "formulation": self.formulation_of(m), "gait": self.gait_of(m),
                            "knots": list(self.knots_of(m)),
+                           "strategy": self.strategy_of(m),
                            "start": None if choice is None else choice.to_dict()})
         return {"format": COST_STUDY_FORMAT, "version": 1, "gaitopt_version": __version__,
                 "models": models,
@@ -331,6 +394,7 @@ class CostStudySpec:
                 "start_speed_m_min": (None if self.auto_start
                                       else float(self.start_speed) * 60.0),
                 "knot_spacing": self.knot_spacing,
+                "accuracy": self.accuracy,
                 "human": {"speed_m_min": HUMAN_OPTIMAL_SPEED_M_MIN,
                           "step_length": HUMAN_STEP_LENGTH,
                           "resting_power_w_kg": list(HUMAN_RESTING_POWER)}}
@@ -394,13 +458,108 @@ def save_direct(sweep: CostSweep, directory: str | os.PathLike[str],
 DirectFn = Callable[[CostSweep, "PointOutcome | None", "Path | None"], None]
 
 
+def direct_sweeps(spec: CostStudySpec, starts: Mapping[str, StartChoice] | None
+                  ) -> tuple[CostSweep, ...]:
+    """The cases that get a direct solve: those of the models of the ``cold`` strategy
+    (:meth:`CostStudySpec.strategy_of`; a ``continuation`` model's second start is its
+    neighbour's optimum instead, :mod:`gaitopt.study.cost_continuation`)."""
+    cold = {m.name for m in spec.models if spec.strategy_of(m) == "cold"}
+    return tuple(s for s in spec.sweeps(starts) if s.model in cold)
+
+
+def winner_of(sweep: CostSweep, directory: str | os.PathLike[str], variant: str
+              ) -> tuple[float, str, dict[str, Any], float] | None:
+    """The lowest converged speed-free optimum of one case over all its starts: the case's
+    sweep, its starts from neighbours (:func:`~gaitopt.study.cost_continuation.
+    free_candidates`) and its direct solve; ``(cost, start, fields, other cost)`` with
+    ``fields`` the row's status, speed (m/min), step (m), step time (s) and ``file``
+    (relative to the study folder), ``other`` the next lowest cost (NaN if none); None
+    when no start converged."""
+    top = Path(directory)
+    case_folder = top / sweep.subdir
+    candidates: list[tuple[float, str, dict[str, Any]]] = []
+    for cost, where, r in free_candidates(case_folder, variant):
+        start = (STARTS[0].format(speed=round(sweep.spec.speeds[0] * 60.0, 2)) if not where
+                 else f"from {where.removeprefix('from-')}")
+        sub = f"{sweep.subdir}/{where}" if where else sweep.subdir
+        candidates.append((cost, start, {
+            "status": r.status, "speed_m_min": r.speed_m_min, "step_length": r.step_length,
+            "step_time": r.step_time, "file": f"{sub}/{r.file}"}))
+    gait = direct_gait(sweep, top)
+    if gait is not None:
+        candidates.append((gait.cost_value, STARTS[1], {
+            "status": gait.status, "speed_m_min": gait.speed * 60.0,
+            "step_length": gait.step_length, "step_time": gait.step_time,
+            "file": f"{sweep.subdir}/{DIRECT_FILE}"}))
+    if not candidates:
+        return None
+    candidates.sort(key=lambda c: c[0])
+    value, start, fields = candidates[0]
+    other = candidates[1][0] if len(candidates) > 1 else math.nan
+    return value, start, fields, other
+
+
+AccuracyFn = Callable[[CostSweep, "AccuracyOutcome | None", "Path | None"], None]
+
+
+def accuracy_tasks(spec: CostStudySpec, directory: str | os.PathLike[str]
+                   ) -> list[tuple[CostSweep, AccuracyTask]]:
+    """The accuracy pass of every case whose optimum has no accurate gait yet
+    (:mod:`gaitopt.study.cost_accuracy`); none without ``spec.accuracy``."""
+    if spec.accuracy is None:
+        return []
+    top = Path(directory)
+    out = []
+    for sweep in spec.sweeps(start_choices(spec, top)):
+        found = winner_of(sweep, top, spec.variant)
+        if found is None:
+            continue
+        value, _, fields, _ = found
+        if accurate_gait(top / sweep.subdir, fields["file"], value) is not None:
+            continue
+        try:
+            text = (top / fields["file"]).read_text(encoding="utf-8")
+        except OSError:
+            continue
+        options = sweep.spec.options(sweep.free_point).replace(accuracy=spec.accuracy)
+        out.append((sweep, AccuracyTask(key=sweep.subdir, model=sweep.spec.model_of(
+            sweep.free_point), options=options, text=text, source=fields["file"],
+            cost=value)))
+    return out
+
+
+def run_accuracy(spec: CostStudySpec, directory: str | os.PathLike[str], backend: Backend,
+                 on_done: AccuracyFn | None = None) -> tuple[int, int]:
+    """Run the accuracy pass of every case that needs one, all at once on ``backend`` (each
+    gait written here, atomically, as it arrives); ``on_done(sweep, outcome, path)`` after
+    each. Returns ``(solved, failed)``."""
+    top = Path(directory)
+    tasks = accuracy_tasks(spec, top)
+    pending = {backend.submit(solve_accurate, task): (sweep, task) for sweep, task in tasks}
+    solved = failed = 0
+    while pending:
+        future = backend.next_finished()
+        if future is None or future not in pending:
+            continue
+        sweep, task = pending.pop(future)
+        try:
+            outcome: AccuracyOutcome | None = future.result()
+        except Exception:  # noqa: BLE001  (a dead worker: the case keeps its grid's optimum)
+            outcome = None
+        path = save_accurate(top / sweep.subdir, task, outcome) if outcome else None
+        solved, failed = (solved + 1, failed) if path is not None else (solved, failed + 1)
+        if on_done is not None:
+            on_done(sweep, outcome, path)
+    return solved, failed
+
+
 def run_direct_solves(spec: CostStudySpec, directory: str | os.PathLike[str],
                       backend: Backend, on_done: DirectFn | None = None) -> tuple[int, int, int]:
     """Solve every case's direct optimum not kept from an earlier run, all at once on
     ``backend`` (its workers write nothing; each gait file is written here, atomically, as it
     arrives). ``on_done(sweep, outcome, path)`` after each (``outcome`` None if the worker
     raised; ``path`` None if nothing was written). Returns ``(kept, solved, failed)``."""
-    sweeps = spec.sweeps(start_choices(spec, directory))
+    sweeps = direct_sweeps(spec, start_choices(spec, directory))
     todo = [s for s in sweeps if direct_gait(s, directory) is None]
     pending = {backend.submit(solve_point, s.direct_task()): s for s in todo}
     solved = failed = 0
@@ -436,9 +595,10 @@ def speed_bound_reached(speed_m_min: float, bounds: tuple[float, float], *,
 
 
 def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list[CostRow]:
-    """The speed-free optimum of every (model, case): the lower of the sweep's speed-free point
-    (its ``summary.csv``) and the direct solve (``direct.gait.json``); a case with neither
-    gives a failed row."""
+    """The speed-free optimum of every (model, case): the lowest over its starts
+    (:func:`winner_of`), reported with the values of its accurate gait where the accuracy
+    pass converged (:mod:`gaitopt.study.cost_accuracy`; ``other_cost_value`` stays the next
+    start's cost on the study's grid); a case with no converged start gives a failed row."""
     top = Path(directory)
     rows = []
     for sweep in spec.sweeps(start_choices(spec, top)):
@@ -446,38 +606,38 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
         common: dict[str, Any] = {"model": sweep.model, "formulation": sweep.formulation,
                                   "case": sweep.case.tag, "cost": sweep.case.cost,
                                   "resting_power": rest}
-        try:
-            summary = read_summary(top / sweep.subdir / SUMMARY_FILE)
-        except SummaryError:
-            summary = []
-        free = rows_of(summary, spec.variant, speed_mode="free", success=None)
-        candidates: list[tuple[float, str, dict[str, Any]]] = []
-        if free and free[0].success:
-            r = free[0]
-            start = STARTS[0].format(speed=round(sweep.spec.speeds[0] * 60.0, 2))
-            candidates.append((r.cost, start, {
-                "status": r.status, "speed_m_min": r.speed_m_min, "step_length": r.step_length,
-                "step_time": r.step_time, "file": f"{sweep.subdir}/{r.file}"}))
-        gait = direct_gait(sweep, top)
-        if gait is not None:
-            candidates.append((gait.cost_value, STARTS[1], {
-                "status": gait.status, "speed_m_min": gait.speed * 60.0,
-                "step_length": gait.step_length, "step_time": gait.step_time,
-                "file": f"{sweep.subdir}/{DIRECT_FILE}"}))
-        if not candidates:
+        found = winner_of(sweep, top, spec.variant)
+        if found is None:
+            try:
+                summary = read_summary(top / sweep.subdir / SUMMARY_FILE)
+            except SummaryError:
+                summary = []
+            free = rows_of(summary, spec.variant, speed_mode="free", success=None)
             status = free[0].status if free else "not solved"
             rows.append(CostRow(**common, success=False, status=status, speed_m_min=math.nan,
                                 step_length=math.nan, step_time=math.nan,
                                 cost_value=math.nan, file=""))
             continue
-        candidates.sort(key=lambda c: c[0])
-        value, start, fields = candidates[0]
-        other = candidates[1][0] if len(candidates) > 1 else math.nan
+        value, start, fields, other = found
+        accuracy: dict[str, Any] = {}
+        accurate = (accurate_gait(top / sweep.subdir, fields["file"], value)
+                    if spec.accuracy is not None else None)
+        if accurate is not None:
+            worst, worst_of, within, knots = estimate_of(accurate)
+            value = accurate.cost_value
+            fields = {"status": accurate.status, "speed_m_min": accurate.speed * 60.0,
+                      "step_length": accurate.step_length, "step_time": accurate.step_time,
+                      "file": f"{sweep.subdir}/{ACCURATE_FILE}"}
+            accuracy = {"estimate": worst, "estimate_of": worst_of, "knots": knots,
+                        "within_accuracy": within}
+            if within is False:
+                fields["status"] += (f"; {worst_of.replace('_', ' ')} estimate "
+                                     f"{100 * worst:.2g} % > {100 * spec.accuracy:g} %"
+                                     if spec.accuracy is not None and math.isfinite(worst)
+                                     else "; not within the accuracy")
         bound = speed_bound_reached(fields["speed_m_min"], sweep.spec.base.speed_bounds)
         if bound is not None:
             fields["status"] = f"{fields['status']}; {SPEED_BOUND_NOTE.format(bound=bound)}"
         rows.append(CostRow(**common, success=True, cost_value=value, start=start,
-                            other_cost_value=other, **fields))
+                            other_cost_value=other, **accuracy, **fields))
     return rows
-
-

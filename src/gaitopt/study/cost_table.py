@@ -6,8 +6,11 @@ Columns (:data:`COST_COLUMNS`): the model, its formulation, the case (``paper``,
 ``metabolic-rest-<P>``), the cost and resting power (W/kg), whether the solve converged and
 its status, speed (m/min), step length (m), step time (s), the cost's value (its own units,
 docs/costs.md), the distance from human walking (:func:`human_distance`), which start won and
-the other start's cost, and the gait file relative to the study directory. NaN is written as
-an empty cell.
+the other start's cost, the gait file relative to the study directory, and the accuracy pass's
+outcome (:mod:`gaitopt.study.cost_accuracy`): the largest relative error estimate, what it
+estimates (``cost``, ``speed``, ``step_length``), the knots of the reported grid (``24+16``
+for two phases, by phase) and whether the estimate is within the study's accuracy. NaN and
+None are written as empty cells.
 """
 
 from __future__ import annotations
@@ -28,7 +31,9 @@ COST_TABLE_FILE = "costs.csv"
 COST_COLUMNS: tuple[str, ...] = (
     "model", "formulation", "case", "cost", "resting_power", "success", "status",
     "speed_m_min", "step_length", "step_time", "cost_value", "human_distance", "start",
-    "other_cost_value", "file")
+    "other_cost_value", "file", "estimate", "estimate_of", "knots", "within_accuracy")
+#: Columns added later (2026-12-03): a table without them reads with them empty.
+OPTIONAL_COLUMNS: tuple[str, ...] = ("estimate", "estimate_of", "knots", "within_accuracy")
 
 
 class CostStudyError(ValueError):
@@ -62,6 +67,10 @@ class CostRow:
     file: str
     start: str = ""
     other_cost_value: float = math.nan
+    estimate: float = math.nan
+    estimate_of: str = ""
+    knots: str = ""
+    within_accuracy: bool | None = None
     human_distance: float = field(init=False)
 
     def __post_init__(self) -> None:
@@ -70,7 +79,10 @@ class CostRow:
                            if self.success else math.nan)
 
     def as_csv_dict(self) -> dict[str, str]:
-        return csv_cells(self, COST_COLUMNS)
+        cells = csv_cells(self, COST_COLUMNS)
+        if self.within_accuracy is None:
+            cells["within_accuracy"] = ""
+        return cells
 
 
 def cost_table_csv(rows: Sequence[CostRow]) -> str:
@@ -93,7 +105,8 @@ def read_cost_table(path: str | os.PathLike[str]) -> list[CostRow]:
     except OSError as exc:
         raise CostStudyError(f"{source}: cannot read the cost table ({exc})") from None
     reader = csv.DictReader(io.StringIO(text))
-    missing = [c for c in COST_COLUMNS if c not in (reader.fieldnames or [])]
+    missing = [c for c in COST_COLUMNS
+               if c not in (reader.fieldnames or []) and c not in OPTIONAL_COLUMNS]
     if missing:
         raise CostStudyError(f"{source}: line 1: missing columns {', '.join(missing)}")
     rows = []
@@ -106,16 +119,27 @@ def read_cost_table(path: str | os.PathLike[str]) -> list[CostRow]:
                 raise CostStudyError(f"{source}: line {line}: column {col}: expected a "
                                      f"number, got {value!r}") from None
 
-        success = (raw["success"] or "").strip().lower()
-        if success not in ("true", "false"):
-            raise CostStudyError(f"{source}: line {line}: column success: expected true or "
-                                 f"false, got {success!r}")
+        def flag(col: str, raw: dict[str, str] = raw, line: int = line,
+                 empty: bool = False) -> bool | None:
+            value = (raw.get(col) or "").strip().lower()
+            if value in ("true", "false"):
+                return value == "true"
+            if empty and not value:
+                return None
+            raise CostStudyError(f"{source}: line {line}: column {col}: expected true or "
+                                 f"false{' or empty' if empty else ''}, got {value!r}")
+
+        success = flag("success")
         rows.append(CostRow(model=raw["model"], formulation=raw["formulation"],
                             case=raw["case"], cost=raw["cost"],
-                            resting_power=number("resting_power"), success=success == "true",
+                            resting_power=number("resting_power"), success=bool(success),
                             status=raw["status"] or "", speed_m_min=number("speed_m_min"),
                             step_length=number("step_length"), step_time=number("step_time"),
                             cost_value=number("cost_value"), file=raw["file"] or "",
                             start=raw["start"] or "",
-                            other_cost_value=number("other_cost_value")))
+                            other_cost_value=number("other_cost_value"),
+                            estimate=number("estimate") if "estimate" in raw else math.nan,
+                            estimate_of=raw.get("estimate_of") or "",
+                            knots=raw.get("knots") or "",
+                            within_accuracy=flag("within_accuracy", empty=True)))
     return rows

@@ -29,12 +29,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gaitopt.gait.api import guess_from_gait
+from gaitopt.gait.api import guess_from_gait, restart_point
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.staged import StagedRun, solve_walking
-from gaitopt.ocp import Guess, Result
+from gaitopt.ocp import Guess, Result, WarmStart
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 
@@ -94,7 +94,8 @@ class PointOutcome:
     the solved gait as plain data in the gait-file schema (``Gait.to_dict()``) for the driver
     to write, None for a failed point (and once written); ``result`` the final engine result
     when the point succeeded (for its neighbours), else None;
-    ``warm`` how it started (``result``, ``file``, ``none``, or ``file unreadable``);
+    ``warm`` how it started (``result``, ``file`` (its NLP point and multipliers), ``file,
+    values`` (its trajectories), ``none``, or ``file unreadable``);
     ``fell_back`` whether a warm start failed and the cold path was taken;
     ``iterations`` the IPOPT iterations over all stages; ``worker`` host:pid; ``timings``
     where the time went (s): ``warm_start_s`` (reading a gait file), ``build_and_setup_s``
@@ -126,13 +127,19 @@ def worker_name() -> str:
     return f"{socket.gethostname()}:{os.getpid()}"
 
 
-def _warm_start(task: PointTask) -> tuple[Guess | Result | None, str]:
+def _warm_start(task: PointTask) -> tuple[Guess | Result | WarmStart | None, str]:
+    """The start of ``task``: its Result; from a gait file the NLP point and multipliers the
+    file keeps when they fit the point's transcription (the same grid and problem structure:
+    :func:`gaitopt.gait.api.restart_point`; ``file``), else the file's trajectories (``file,
+    values``); None (``none``) for a cold start."""
     if isinstance(task.warm, Result):
         return task.warm, "result"
     if isinstance(task.warm, SavedGait):
         try:
             gait = Gait.from_dict(json.loads(task.warm.text), source=task.warm.source)
-            return guess_from_gait(gait), "file"
+            point = restart_point(task.model, task.options, gait)
+            return (point, "file") if point is not None else (guess_from_gait(gait),
+                                                              "file, values")
         except (GaitFileError, KeyError, ValueError):
             return None, "file unreadable"
     return None, "none"
@@ -158,7 +165,8 @@ def solve_point(task: PointTask) -> PointOutcome:
     error inside it: the outcome's row says failed and why."""
     clock = time.perf_counter
     start = clock()
-    warm, how = _warm_start(task)
+    with _LOCK:  # a start from a file's NLP point builds (or reuses) the process's transcription
+        warm, how = _warm_start(task)
     timings = {"warm_start_s": clock() - start}
     options = task.options.replace(max_iter=1) if task.force_fail else task.options
     solution: StagedRun | None = None
