@@ -265,8 +265,10 @@ def report(runs: dict[str, dict[str, Any]], seed_s: float | None,
           "process, or of the one process)")
     for name, s in sums.items():
         starts = ", ".join(f"{v:.1f}" for v in s["starts"])
+        driver = runs[name].get("driver_peak_rss_mb")
         print(f"  {name}: seeded starts {starts} s; warm points median {s['warm_median']:.2f} "
-              f"s, mean {s['warm_mean']:.2f} s; builds and setup {s['build']:.1f} s in all")
+              f"s, mean {s['warm_mean']:.2f} s; builds and setup {s['build']:.1f} s in all"
+              + (f"; the driver process's peak RSS {driver:.0f} MB" if driver else ""))
     if seed_s is not None:
         print(f"seed (cold solve of the unloaded body at the start speed, one grid): "
               f"{seed_s:.1f} s")
