@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from gaitopt.robot import RobotModel, load_model
+from gaitopt.robot import RobotModel
 from gaitopt.study.cost_continuation import (
     NEIGHBOUR_DIR,
     case_neighbour,
@@ -24,16 +24,6 @@ from gaitopt.study.cost_table import (
     read_cost_table,
 )
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, write_summary
-
-
-@pytest.fixture(scope="module")
-def five_link() -> RobotModel:
-    return load_model("five-link")
-
-
-@pytest.fixture(scope="module")
-def seven_link() -> RobotModel:
-    return load_model("seven-link")
 
 
 def M(p: float) -> CostCase:  # noqa: N802  (a case, as the docs write it)

@@ -45,11 +45,6 @@ from gaitopt.viz.cost_report import answer_text, write_cost_report
 COMPASS = Path(__file__).parents[1] / "analysis" / "data" / "compass.yaml"
 
 
-@pytest.fixture(scope="module")
-def five_link() -> RobotModel:
-    return load_model("five-link")
-
-
 def _row(case: str, cost: str, speed: float, step: float, *, rest: float = math.nan,
          model: str = "five-link", success: bool = True) -> CostRow:
     return CostRow(model=model, formulation="reduced", case=case, cost=cost,

@@ -17,7 +17,7 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import cli
-from gaitopt.robot import RobotModel, load_model
+from gaitopt.robot import RobotModel
 from gaitopt.study.cost_start import (
     AUTO_START,
     AUTO_START_STEP_M_MIN,
@@ -40,16 +40,6 @@ from gaitopt.study.plan import START_SPEED, SweepSpec
 from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, write_summary
 
 VARIANT = "ankle+impulse"
-
-
-@pytest.fixture(scope="module")
-def five_link() -> RobotModel:
-    return load_model("five-link")
-
-
-@pytest.fixture(scope="module")
-def seven_link() -> RobotModel:
-    return load_model("seven-link")
 
 
 def _rows(start_m_min: float, free_m_min: float | None, step: float = 0.3) -> list[SummaryRow]:

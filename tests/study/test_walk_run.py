@@ -10,7 +10,6 @@ from typing import Any
 
 import pytest
 
-from gaitopt.robot import load_model
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.transition import HUMAN_FROUDE_BAND
 from gaitopt.study.walk_run import (
@@ -32,16 +31,6 @@ from gaitopt.study.walk_run import (
 )
 from gaitopt.study.walk_run_findings import FINDING_IDS, assess_walk_run
 from gaitopt.viz.walk_run_report import write_walk_run_report
-
-
-@pytest.fixture(scope="module")
-def five_link() -> RobotModel:
-    return load_model("five-link")
-
-
-@pytest.fixture(scope="module")
-def seven_link() -> RobotModel:
-    return load_model("seven-link")
 
 
 def row(branch: str, speed: float, cost: float | None, *, error: float = math.nan,
