@@ -1,7 +1,7 @@
 """A warm start's gait file and accuracy (gait.solve.warm_accuracy): the grid a file was refined
 to, and its estimate carried over when the warm start finds the file's own optimum again (no
-check grid solved); at another speed the check grid is solved and no refinement round is
-spent on a missing estimate."""
+check grid solved); at another speed the check grid is solved, restarted from the file's own
+check-grid point, and no refinement round is spent on a missing estimate."""
 
 from __future__ import annotations
 
@@ -11,9 +11,16 @@ import pytest
 
 from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.options.model_defaults import options_for_model
 from gaitopt.gait.record.file import Gait
 from gaitopt.gait.solve.record import gait_from_run
-from gaitopt.gait.solve.warm_accuracy import ESTIMATE_KEYS, refined_knots
+from gaitopt.gait.solve.warm_accuracy import (
+    ESTIMATE_KEYS,
+    check_point,
+    refined_grid,
+    refined_knots,
+)
+from gaitopt.robot import load_model
 from tests.gait.conftest import SolveFn
 
 PHASES = ("single_support", "double_support")
@@ -78,3 +85,52 @@ def test_the_warm_start_solves_on_the_grid_the_file_was_refined_to(
     record = gait_from_run(run).solver["accuracy"]
     assert record["knots"] == {"single_support": 24, "double_support": 8}
     assert "estimate_from" not in record and record["cost_error"] is not None
+
+
+def test_the_file_keeps_its_check_grid_point(refined_file: Gait) -> None:
+    point = check_point(refined_file)
+    assert point is not None
+    check, answer = refined_file.solver["accuracy"]["check_knots"], refined_file.solver[
+        "accuracy"]["knots"]
+    assert sum(check.values()) > sum(answer.values())
+    assert point.w.size > len(refined_file.solver["warm_start"]["w"])   # the finer grid's NLP
+    data = refined_file.to_dict()
+    del data["solver"]["warm_start_check"]  # a file written before it existed
+    assert check_point(Gait.from_dict(data)) is None
+
+
+def test_the_check_grid_restarts_from_the_file_check_point(refined_file: Gait) -> None:
+    # At another speed the check grid is solved either way, to the same optimum; from the
+    # file's check point (values and multipliers of that very NLP at the file's speed) in
+    # fewer iterations than from the warm start's answer mapped onto the check grid.
+    data = refined_file.to_dict()
+    del data["solver"]["warm_start_check"]
+    without = Gait.from_dict(data)
+    runs = [solve_staged_run("five-link", GaitOptions(speed=0.21), warm_start=g)
+            for g in (refined_file, without)]
+    assert all(run.success for run in runs)
+    records = [gait_from_run(run).solver["accuracy"] for run in runs]
+    assert records[0]["check_cost"] == pytest.approx(records[1]["check_cost"], rel=1e-5)
+    assert records[0]["cost_error"] == pytest.approx(records[1]["cost_error"], rel=1e-2,
+                                                     abs=1e-5 * abs(records[1]["check_cost"]))
+    checks = [next(s for s in run.stages if s.name == "check grid") for run in runs]
+    assert checks[0].iterations <= checks[1].iterations + 3
+
+
+def test_the_warm_start_keeps_the_form_of_the_file_grid(refined_file: Gait) -> None:
+    # A heel-toe file solved with the knots option (24, 16): four phases of 24 + 18 + 16 + 16
+    # knots. The warm start states the grid as the file did (its check grid is then the
+    # file's: 36 + 26 + 24 + 24, not 36 + 27 + 24 + 24 from the counts per phase).
+    model = load_model("seven-link")
+    options = options_for_model(model, GaitOptions())
+    counts = {"foot_flat": 24, "heel_off": 18, "double_support": 16, "heel_rocker": 16}
+    file = dataclasses.replace(
+        with_accuracy(refined_file, knots=counts),
+        options={**refined_file.options, "knots": [24, 16], "phase_shares": None})
+    stated = refined_grid(file, model, options)
+    assert stated is not None and tuple(stated.knots) == (24, 16)
+    # counts the stated form does not give: the counts per phase
+    other = {**counts, "heel_off": 19}
+    by_counts = refined_grid(with_accuracy(file, knots=other), model, options)
+    assert by_counts is not None and tuple(by_counts.knots) == tuple(other.values())
+    assert refined_grid(with_accuracy(file, within_target=False), model, options) is None

@@ -32,7 +32,6 @@ from typing import Any
 import numpy as np
 
 from gaitopt.gait.formulations.full.physics import actuator_names
-from gaitopt.gait.formulations.select import contact_sequence
 from gaitopt.gait.options.gait_options import GaitOptions, follows_model
 from gaitopt.gait.options.model_defaults import default_speed, options_for_model
 from gaitopt.gait.options.preflight import refuse_unwalkable
@@ -48,8 +47,16 @@ from gaitopt.gait.solve.staged import (
     solve_walking,
     transcription_for,
 )
-from gaitopt.gait.solve.warm_accuracy import carried_estimate, refined_knots, same_problem
-from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
+from gaitopt.gait.solve.staged_run import check_result as check_result
+from gaitopt.gait.solve.transcriptions import target_grid
+from gaitopt.gait.solve.warm_accuracy import (
+    carried_estimate,
+    check_point,
+    refined_grid,
+    same_problem,
+    stored_point,
+)
+from gaitopt.ocp import Guess, PhaseGuess, WarmStart
 from gaitopt.robot import RobotModel, load_model
 
 
@@ -124,12 +131,11 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     guess: Guess | WarmStart | None = None
     if warm_start is not None and warm_start_usable(warm_start, opts):
         if refines:  # start on the grid the file was refined to (gait/solve/warm_accuracy.py)
-            phases = tuple(ph.name for ph in contact_sequence(robot, opts).phases)
-            knots = refined_knots(warm_start, phases)
-            opts = opts if knots is None else opts.replace(knots=knots)
+            opts = refined_grid(warm_start, robot, opts) or opts
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
     # A warm start that refines needs its estimate: its check grid (unless the file's holds).
     first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled,
+                          check_start=check_point(warm_start) if guess is not None else None,
                           check_warm_start=check_warm_start or (
                               refines and guess is not None and
                               not _file_estimate_may_hold(warm_start, opts)))
@@ -186,15 +192,6 @@ def _file_estimate_may_hold(gait: Gait | None, options: GaitOptions) -> bool:
             and same_problem(gait.options, options))
 
 
-def check_result(run: StagedRun) -> Result | None:
-    """The converged result of the solve's last ``check grid`` stage (the problem on the
-    check grid of its knots, :meth:`gaitopt.gait.solve.staged._Run.check`), or None."""
-    for name, result in reversed(run.stage_results):
-        if name.endswith("check grid"):
-            return result if result.success else None
-    return None
-
-
 def slower_default(model: RobotModel, options: GaitOptions) -> float | None:
     """The speed (m/s) a failed solve at the model's default speed tries next: the walk's
     default at equal Froude number (:func:`gaitopt.gait.options.model_defaults.default_speed`: 12
@@ -213,18 +210,12 @@ def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
     the transcription ``options`` solve on (same layout, method and constraints; a fixed
     grid): IPOPT then restarts from them as from a result in the same process. None
     otherwise (older files keep none; the trajectories are the fallback guess)."""
-    data = gait.solver.get("warm_start")
-    if not isinstance(data, dict) or options.mesh_tol is not None:
+    point = stored_point(gait.solver.get("warm_start"))
+    if point is None or options.mesh_tol is not None:
         return None
-
-    try:
-        point = WarmStart(w=np.asarray(data["w"], dtype=float),
-                          lam_x=np.asarray(data["lam_x"], dtype=float),
-                          lam_g=np.asarray(data["lam_g"], dtype=float),
-                          layout=str(data["layout"]), method=str(data["method"]))
-    except (KeyError, TypeError, ValueError):
-        return None
-    tr = transcription_for(model, options, options.knots, compiled=compiled)
+    # The grid the warm start solves on (cosine-spaced knots are a mesh: another cache entry
+    # than their counts, which would build the same NLP twice).
+    tr = transcription_for(model, options, target_grid(model, options), compiled=compiled)
     return point if point.fits(tr.layout, tr.method, tr.nlp.lbg.size) else None
 
 

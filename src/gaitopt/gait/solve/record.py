@@ -23,6 +23,7 @@ from gaitopt.gait.solve.accuracy import accuracy_record
 from gaitopt.gait.solve.costates import solution_costates
 from gaitopt.gait.solve.diagnose import diagnose
 from gaitopt.gait.solve.staged import StagedRun
+from gaitopt.gait.solve.staged_run import check_result
 from gaitopt.ocp import Result, warm_start_of
 
 
@@ -54,6 +55,7 @@ def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
         "max_violation": float(res.constraint_violation),
         "time_in_evaluations_s": float(res.times.get("evaluations", 0.0)),
         **({"warm_start": _warm_start_data(res)} if res.success else {}),
+        **_check_point(run),
         "stages": [{"name": s.name, "knots": list(s.knots), "status": s.status,
                     "success": s.success, "iterations": s.iterations,
                     "objective": s.objective, "violation": s.violation,
@@ -78,6 +80,18 @@ def _warm_start_data(res: Result) -> dict[str, Any]:
     point = warm_start_of(res)
     return {"w": point.w.tolist(), "lam_x": point.lam_x.tolist(),
             "lam_g": point.lam_g.tolist(), "layout": point.layout, "method": point.method}
+
+
+def _check_point(run: StagedRun) -> dict[str, Any]:
+    """``{"warm_start_check": ...}``: the NLP point and multipliers of the answer's check grid
+    (:func:`_warm_start_data`), where the run solved it and it converged to the cost the
+    accuracy record names (``check_cost``); else nothing. A warm start from the file restarts
+    its check grid there (:mod:`gaitopt.gait.solve.warm_accuracy`)."""
+    check = check_result(run)
+    cost = accuracy_record(run).get("check_cost")
+    if not run.success or check is None or cost is None or check.objective != cost:
+        return {}
+    return {"warm_start_check": _warm_start_data(check)}
 
 
 def _solved_sequence(run: StagedRun) -> dict[str, Any]:

@@ -373,16 +373,25 @@ class _Run:
             self.check(fine)
         return fine
 
-    def check(self, result: Result) -> None:
+    def check(self, result: Result, start: WarmStart | None = None) -> None:
         """Stage ``check grid``: the problem on :func:`~gaitopt.gait.solve.check_grid.check_knots`
         of the requested knots (same spacing), everything free, from ``result``'s values and
         multipliers, with the target grid's Hessian (quasi-Newton in the compressed form, whose
         exact Hessian takes seconds to build). Its cost (kept in ``grid_costs`` after the
         answer's) is what the cost error estimate compares with
         (:mod:`gaitopt.gait.solve.accuracy`); a check that fails leaves the answer without that
-        estimate, never changes it."""
+        estimate, never changes it. ``start``: a solution of this check grid's NLP (a gait
+        file's, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) to restart from instead,
+        with its multipliers and the warm-start options of the transcription, where it
+        fits."""
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
+        if start is not None:
+            tr = transcription_for(self.model, o, grid, compiled=self.compiled)
+            if start.fits(tr.layout, tr.method, tr.nlp.lbg.size):
+                self.stage("check grid", grid, Relaxation(), start, parameter_bounds(o),
+                           solver_options=check_grid_options(o))
+                return
         self.stage("check grid", grid, Relaxation(), self.grid_start(grid, result, "check"),
                    parameter_bounds(o), solver_options=check_grid_options(o),
                    warm_start_options=REGRID_OPTIONS)
@@ -532,14 +541,16 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   warm_start: Guess | Result | WarmStart | None = None,
                   progress: ProgressFn | None = None,
                   compiled: str | None = None,
-                  check_warm_start: bool = False) -> StagedRun:
+                  check_warm_start: bool = False,
+                  check_start: WarmStart | None = None) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
     succeeded and which stage failed.
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
-    (:mod:`gaitopt.gait.solve.refinement` solves each finer grid so).
+    (:mod:`gaitopt.gait.solve.refinement` solves each finer grid so), restarted from
+    ``check_start`` where it fits (:meth:`_Run.check`).
 
     Raises:
         GaitOptionsError: invalid options, or a step so long that no naive start can place
@@ -559,7 +570,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         if not result.success:
             result = None
         elif check_warm_start and options.mesh_tol is None:
-            run.check(result)
+            run.check(result, check_start)
     outcome: Result | None = result
     if result is None and (options.cost != "paper" or options.cost_regularization > 0.0):
         outcome = run.other_cost()

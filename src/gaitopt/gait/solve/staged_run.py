@@ -129,3 +129,12 @@ def as_failed(result: Result, failed: Result) -> Result:
     """``result``'s values with the failed stage's status (never reported as converged)."""
     return dataclasses.replace(result, success=False, status=failed.status,
                                message=f"{failed.message} (values of an earlier stage)")
+
+
+def check_result(run: StagedRun) -> Result | None:
+    """The converged result of the run's last ``check grid`` stage (the problem on the check
+    grid of its knots, :meth:`gaitopt.gait.solve.staged._Run.check`), or None."""
+    for name, result in reversed(run.stage_results):
+        if name.endswith("check grid"):
+            return result if result.success else None
+    return None

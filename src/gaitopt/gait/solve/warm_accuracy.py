@@ -15,7 +15,17 @@ A solve that refines itself (:mod:`gaitopt.gait.solve.refinement`: the knots lef
   grid) and the warm start converged to the file's optimum (cost, step length and speed
   within :data:`SAME_OPTIMUM`, relative), the file's check grid has the same optimum too, so its
   estimate holds as it is and no check grid is solved again. The gait file says so
-  (``solver.accuracy.estimate_from``: ``"warm start"``).
+  (``solver.accuracy.estimate_from``: ``"warm start"``);
+* **the check grid's point** (:func:`check_point`): a file keeps the NLP point and multipliers
+  of its check grid's solution (``solver.warm_start_check``) beside its answer's
+  (``solver.warm_start``). A warm start that must solve its check grid (at another speed, say)
+  restarts it from that point, on the same check grid, as it restarts the answer's grid from
+  the answer's: the check grid is still solved to IPOPT's tolerance, so the estimate is the
+  warm start's own; only its start comes from the file. For that the warm start solves on the
+  file's grid in the form the file stated it (:func:`refined_grid`: the ``knots`` option and
+  phase shares, whose check grid is the file's), not on its per-phase counts, whose check
+  grid can differ by a knot (the seven-link's 24 + 16 gives 24 + 18 + 16 + 16 knots and the
+  check grid 36 + 26 + 24 + 24; 24 + 18 + 16 + 16 gives 36 + 27 + 24 + 24).
 """
 
 from __future__ import annotations
@@ -24,9 +34,15 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from gaitopt.gait.options.gait_options import GaitOptions
+import numpy as np
+
+from gaitopt.gait.formulations.select import contact_sequence
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.gait.record.file import Gait
+from gaitopt.gait.sequence.contact_sequence import phase_knots
 from gaitopt.gait.solve.staged_run import StagedRun
+from gaitopt.ocp import WarmStart
+from gaitopt.robot.model import RobotModel
 
 #: Two converged solves of one NLP are the same optimum when their costs and parameters agree
 #: within this (relative): IPOPT's tolerance (1e-7 on the scaled problem) leaves about 1e-9
@@ -55,6 +71,50 @@ def refined_knots(gait: Gait, phases: tuple[str, ...]) -> dict[str, int] | None:
     if tuple(knots) != phases:
         return None
     return {str(name): int(count) for name, count in knots.items()}
+
+
+def refined_grid(gait: Gait, model: RobotModel, options: GaitOptions) -> GaitOptions | None:
+    """``options`` on the grid ``gait`` refined itself to (:func:`refined_knots`, for the
+    phases of ``model`` under ``options``): with the file's ``knots`` option and phase shares
+    where they give the file's knots per phase (then the check grid is the file's too), else
+    with the file's counts per phase; None where :func:`refined_knots` is None."""
+    phases = tuple(ph.name for ph in contact_sequence(model, options).phases)
+    knots = refined_knots(gait, phases)
+    if knots is None:
+        return None
+    saved, shares = gait.options.get("knots") or (), gait.options.get("phase_shares")
+    try:
+        stated = options.replace(knots=tuple(int(k) for k in saved),
+                                 phase_shares=None if shares is None else
+                                 tuple(float(v) for v in shares))
+        counts = phase_knots(contact_sequence(model, stated), stated.knots)
+    except (GaitOptionsError, TypeError, ValueError):
+        counts = ()
+    if tuple(counts) == tuple(knots.values()):
+        return stated
+    return options.replace(knots=knots)
+
+
+def stored_point(data: Any) -> WarmStart | None:
+    """A :class:`~gaitopt.ocp.WarmStart` from its record in a gait file (``solver.warm_start``
+    or ``solver.warm_start_check``: ``w``, ``lam_x``, ``lam_g``, ``layout``, ``method``), or
+    None (none kept, or unreadable)."""
+    if not isinstance(data, Mapping):
+        return None
+    try:
+        return WarmStart(w=np.asarray(data["w"], dtype=float),
+                         lam_x=np.asarray(data["lam_x"], dtype=float),
+                         lam_g=np.asarray(data["lam_g"], dtype=float),
+                         layout=str(data["layout"]), method=str(data["method"]))
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+def check_point(gait: Gait | None) -> WarmStart | None:
+    """The NLP point and multipliers of the file's check grid (``solver.warm_start_check``,
+    written with a converged check grid), or None. It fits only the transcription of that
+    check grid (:meth:`gaitopt.ocp.WarmStart.fits`), which the solve checks before using it."""
+    return None if gait is None else stored_point(gait.solver.get("warm_start_check"))
 
 
 def _same(a: float, b: float) -> bool:
