@@ -23,7 +23,18 @@ in a folder of the temporary directory, as an installed package keeps its ``.pyc
 The function cache on disk (``gaitopt.gait.solve.function_cache``) is whatever the machine
 holds; ``--warmup`` runs each cold solve once first, unmeasured.
 
-    PYTHONPATH=src python bench/general.py [--repeat 1] [--warmup] [--only cold|warm|refine]
+4. **the warm start through the Python API, broken down** (``--only api``): one process per
+   model that imports gaitopt, loads the 60 m/min gait file and calls ``solve_gait`` at 63 m/min
+   with it as ``warm_start`` (the knots left to the model): the imports, the whole call (CPU
+   and wall), each stage's iterations and seconds, and the rest of the call (building the
+   transcriptions from the function cache, the record).
+
+With ``--reference SRC`` (a source folder, e.g. a worktree of the previous main's ``src``)
+every row is measured for both sources, alternately, each side warm-starting from its own
+cold solve's file: the table then has a "before" column beside each figure.
+
+    PYTHONPATH=src python bench/general.py [--repeat 1] [--warmup] [--only cold|warm|refine|api]
+        [--reference /path/to/main/src]
 """
 
 from __future__ import annotations
@@ -47,8 +58,8 @@ def load() -> str:
     return ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
-def child_env(bytecode: Path | None) -> dict[str, str]:
-    env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
+def child_env(bytecode: Path | None, src: Path = REPO / "src") -> dict[str, str]:
+    env = dict(os.environ, PYTHONPATH=str(src), OPENBLAS_NUM_THREADS="1")
     if bytecode is not None:
         env.pop("PYTHONDONTWRITEBYTECODE", None)
         env["PYTHONPYCACHEPREFIX"] = str(bytecode)
@@ -82,6 +93,55 @@ def solve(args: list[str], out: Path, env: dict[str, str]) -> dict[str, Any]:
     return row
 
 
+#: The child of the API rows: prints one JSON line (times in s).
+API_CHILD = """
+import json, os, sys, time
+c0, t0 = time.process_time(), time.perf_counter()
+from gaitopt import Gait, GaitOptions, solve_gait
+c1, t1 = time.process_time(), time.perf_counter()
+gait = Gait.load(sys.argv[2])
+out = solve_gait(sys.argv[1], GaitOptions(speed=float(sys.argv[3])), warm_start=gait)
+c2, t2 = time.process_time(), time.perf_counter()
+stages = [(s["name"], "+".join(str(k) for k in s["knots"]), s["iterations"], s["wall_time_s"])
+          for s in out.solver["stages"]]
+print(json.dumps(dict(ok=bool(out.success), import_cpu=c1 - c0, import_wall=t1 - t0,
+                      call_cpu=c2 - c1, call_wall=t2 - t1, solve_wall=out.solver["wall_time_s"],
+                      stages=stages, cost=out.cost_value,
+                      check_cost=out.solver["accuracy"].get("check_cost"),
+                      cost_error=out.solver["accuracy"].get("cost_error"))))
+"""
+
+
+def api_warm(model: str, file: Path, speed: float, env: dict[str, str]) -> dict[str, Any]:
+    """One process: ``solve_gait(model, GaitOptions(speed=speed), warm_start=Gait.load(file))``
+    (:data:`API_CHILD`), with its peak RSS and CPU from ``os.wait4``."""
+    proc = subprocess.Popen([sys.executable, "-c", API_CHILD, model, str(file), str(speed)],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    out = proc.stdout.read().decode() if proc.stdout else ""
+    err = proc.stderr.read().decode() if proc.stderr else ""
+    try:
+        row: dict[str, Any] = json.loads(out.strip().splitlines()[-1])
+    except (IndexError, ValueError):
+        return {"ok": False, "exit": os.waitstatus_to_exitcode(status), "error": err[-2000:]}
+    stage_s = sum(s[3] for s in row["stages"])
+    row.update(cpu_s=usage.ru_utime + usage.ru_stime, peak_rss_mb=usage.ru_maxrss / 1024,
+               exit=0, solve_s=row["call_wall"], rest_wall=row["call_wall"] - stage_s)
+    return row
+
+
+def show_api(name: str, row: dict[str, Any]) -> None:
+    if not row.get("ok"):
+        print(f"  {name}: FAILED {row.get('error', '')}", flush=True)
+        return
+    stages = ", ".join(f"{n} {k} {i} it {t:.2f} s" for n, k, i, t in row["stages"])
+    print(f"  {name}: imports {row['import_wall']:.2f} s ({row['import_cpu']:.2f} CPU); "
+          f"solve_gait {row['call_wall']:.2f} s ({row['call_cpu']:.2f} CPU): {stages}; "
+          f"the rest (builds, record) {row['rest_wall']:.2f} s; process CPU "
+          f"{row['cpu_s']:.2f} s, peak RSS {row['peak_rss_mb']:.0f} MB, J {row['cost']:.9g}, "
+          f"check J {row['check_cost']}; load {load()}", flush=True)
+
+
 def show(name: str, row: dict[str, Any]) -> None:
     if not row.get("ok"):
         print(f"  {name}: FAILED (exit {row['exit']}) {row.get('error', '')}", flush=True)
@@ -105,88 +165,142 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--warmup", action="store_true",
                     help="run each cold solve once first, unmeasured")
-    ap.add_argument("--only", choices=["cold", "warm", "refine"], action="append")
+    ap.add_argument("--only", choices=["cold", "warm", "refine", "api"], action="append")
     ap.add_argument("--no-bytecode", action="store_true")
     ap.add_argument("--keep", type=Path, help="keep the gait files in this folder")
+    ap.add_argument("--reference", type=Path,
+                    help="a source folder measured beside this one (the 'before' column)")
     args = ap.parse_args(argv)
-    only = set(args.only or ["cold", "warm", "refine"])
+    only = set(args.only or ["cold", "warm", "refine", "api"])
     print(f"load average before: {load()} ({os.cpu_count()} cores)")
+    sides = {"this": REPO / "src"}
+    if args.reference is not None:
+        sides["before"] = args.reference.resolve()
     with tempfile.TemporaryDirectory(prefix="gaitopt-general-") as tmp_name:
         tmp = args.keep or Path(tmp_name)
         tmp.mkdir(parents=True, exist_ok=True)
-        env = child_env(None if args.no_bytecode
-                        else Path(tempfile.gettempdir()) / "gaitopt-bench-pyc")
+        pyc = Path(tempfile.gettempdir()) / "gaitopt-bench-pyc"
+        envs = {side: child_env(None if args.no_bytecode else pyc / side, src)
+                for side, src in sides.items()}
         if not args.no_bytecode:  # byte code written once, unmeasured
-            subprocess.run([sys.executable, "-c", "import gaitopt.cli, gaitopt.gait.api"],
-                           env=env, check=True)
+            for env in envs.values():
+                subprocess.run([sys.executable, "-c", "import gaitopt.cli, gaitopt.gait.api"],
+                               env=env, check=True)
         models = {"five-link": ["--speed", "60m/min"],
                   "seven-link": ["--model", "seven-link", "--speed", "60m/min"]}
-        files = {m: tmp / f"{m}-60.gait.json" for m in models}
-        results: dict[str, dict[str, list[dict[str, Any]]]] = {}
+        files = {(side, m): tmp / f"{side}-{m}-60.gait.json" for side in sides for m in models}
+        results: dict[tuple[str, str], dict[str, list[dict[str, Any]]]] = {}
 
-        def record(kind: str, model: str, row: dict[str, Any]) -> None:
-            results.setdefault(kind, {}).setdefault(model, []).append(row)
-            show(f"{kind:7s} {model}", row)
+        def record(side: str, kind: str, model: str, row: dict[str, Any]) -> None:
+            results.setdefault((side, kind), {}).setdefault(model, []).append(row)
+            (show_api if kind == "api" else show)(f"{side:6s} {kind:10s} {model}", row)
 
-        for model, cli in models.items():  # the files the warm starts need, or a warm-up
-            if args.warmup or ("cold" not in only and not files[model].exists()):
-                show(f"warm-up {model}", solve(cli, files[model], env))
+        def each_side(i: int) -> list[str]:
+            return list(sides) if i % 2 == 0 else list(reversed(sides))
+
+        for side, env in envs.items():  # the files the warm starts need, or a warm-up
+            for model, cli in models.items():
+                if args.warmup or ("cold" not in only and not files[side, model].exists()):
+                    show(f"{side} warm-up {model}", solve(cli, files[side, model], env))
         if "cold" in only:
             for i in range(args.repeat):
                 order = list(models) if i % 2 == 0 else list(reversed(models))
                 for model in order:
-                    record("cold", model, solve(models[model], files[model], env))
+                    for side in each_side(i):
+                        record(side, "cold", model,
+                               solve(models[model], files[side, model], envs[side]))
         if "warm" in only:
-            for _ in range(args.repeat):
+            for i in range(args.repeat):
                 for model, cli in models.items():
-                    faster = [a if a != "60m/min" else "63m/min" for a in cli]
-                    start = [*faster, "--warm-start", str(files[model])]
-                    grid = json.loads(files[model].read_text())["solver"]["accuracy"]["knots"]
-                    record("warm", model, solve(start, tmp / f"{model}-63.gait.json", env))
-                    record("warm-knots", model, solve([*start, "--knots", knots_arg(grid)],
-                                                      tmp / f"{model}-63k.gait.json", env))
+                    for side in each_side(i):
+                        file, env = files[side, model], envs[side]
+                        faster = [a if a != "60m/min" else "63m/min" for a in cli]
+                        start = [*faster, "--warm-start", str(file)]
+                        grid = json.loads(file.read_text())["solver"]["accuracy"]["knots"]
+                        record(side, "warm", model,
+                               solve(start, tmp / f"{side}-{model}-63.gait.json", env))
+                        record(side, "warm-knots", model,
+                               solve([*start, "--knots", knots_arg(grid)],
+                                     tmp / f"{side}-{model}-63k.gait.json", env))
         if "refine" in only:
-            for _ in range(args.repeat):
+            for i in range(args.repeat):
                 for model, cli in models.items():
-                    grid = json.loads(files[model].read_text())["solver"]["accuracy"]["knots"]
-                    record("refine", model, solve([*cli, "--warm-start", str(files[model])],
-                                                  tmp / f"{model}-again.gait.json", env))
-                    record("fixed", model, solve([*cli, "--warm-start", str(files[model]),
-                                                  "--knots", knots_arg(grid)],
-                                                 tmp / f"{model}-fixed.gait.json", env))
-    print(f"\n| figure (median of {args.repeat}) | value | reference | ratio | target | met | "
-          "peak RSS MB |")
-    print("| --- | ---: | ---: | ---: | ---: | :---: | ---: |")
-    if "cold" in results and all(m in results["cold"] for m in models):
-        for key, unit in (("wall_s", "wall"), ("cpu_s", "CPU")):
-            seven, five = median(results["cold"]["seven-link"], key), \
-                median(results["cold"]["five-link"], key)
-            print(f"| cold seven-link / five-link process, {unit} s | {seven:.2f} | {five:.2f} | "
-                  f"{seven / five:.2f} | {TARGETS['cold']:g} | "
-                  f"{'yes' if seven / five <= TARGETS['cold'] else 'no'} | "
-                  f"{median(results['cold']['seven-link'], 'peak_rss_mb'):.0f}, "
-                  f"{median(results['cold']['five-link'], 'peak_rss_mb'):.0f} |")
-    for kind, label in (("warm-knots", "the file's knots given (one grid)"),
-                        ("warm", "knots left to the model (refines: check grid)")):
-        if kind not in results:
-            continue
-        seven = median(results[kind]["seven-link"], "solve_s")
-        five = median(results[kind]["five-link"], "solve_s")
-        print(f"| warm start of the seven-link from its gait file (+5 % speed), {label}, "
-              f"solve s | {seven:.3f} | {five:.3f} (five-link) | {seven / five:.2f} | "
-              f"{TARGETS['warm']:g} s | {'yes' if seven <= TARGETS['warm'] else 'no'} | "
-              f"{median(results[kind]['seven-link'], 'peak_rss_mb'):.0f} |")
-    if "refine" in results:
-        for model in models:
-            on = median(results["refine"][model], "solve_s")
-            off = median(results["fixed"][model], "solve_s")
-            extra = on / off - 1
-            print(f"| automatic refinement on a converged {model} solve, solve s | {on:.3f} | "
-                  f"{off:.3f} (knots given) | {extra:+.0%} | +{TARGETS['refine']:.0%} | "
-                  f"{'yes' if extra <= TARGETS['refine'] else 'no'} | "
-                  f"{median(results['refine'][model], 'peak_rss_mb'):.0f} |")
+                    for side in each_side(i):
+                        file, env = files[side, model], envs[side]
+                        grid = json.loads(file.read_text())["solver"]["accuracy"]["knots"]
+                        record(side, "refine", model,
+                               solve([*cli, "--warm-start", str(file)],
+                                     tmp / f"{side}-{model}-again.gait.json", env))
+                        record(side, "fixed", model,
+                               solve([*cli, "--warm-start", str(file), "--knots",
+                                      knots_arg(grid)],
+                                     tmp / f"{side}-{model}-fixed.gait.json", env))
+        if "api" in only:
+            for i in range(args.repeat):
+                for model in models:
+                    for side in each_side(i):
+                        record(side, "api", model,
+                               api_warm(model, files[side, model], 1.05, envs[side]))
+    table(results, sides, models, args.repeat)
     print(f"load average after: {load()}")
     return 0
+
+
+def table(results: dict[tuple[str, str], dict[str, list[dict[str, Any]]]],
+          sides: dict[str, Path], models: dict[str, list[str]], repeat: int) -> None:
+    """The targets' table: one row per figure, this side's value, its reference (the
+    five-link, or the solve without refinement), ratio, target and whether met; with a
+    reference source the same figures of the "before" side beside them."""
+    before = "before" in sides
+    print(f"\n| figure (median of {repeat}) | value | reference | ratio | target | met | "
+          + ("before: value | reference | ratio | " if before else "") + "peak RSS MB |")
+    print("| --- | ---: | ---: | ---: | ---: | :---: | " + ("---: | ---: | ---: | " if before
+                                                           else "") + "---: |")
+
+    def have(side: str, kind: str, model: str) -> bool:
+        return any(r.get("ok") for r in results.get((side, kind), {}).get(model, []))
+
+    def cells(side: str, kinds: tuple[str, str], mods: tuple[str, str], key: str
+              ) -> tuple[float, float] | None:
+        if not (have(side, kinds[0], mods[0]) and have(side, kinds[1], mods[1])):
+            return None
+        return (median(results[side, kinds[0]][mods[0]], key),
+                median(results[side, kinds[1]][mods[1]], key))
+
+    def line(label: str, kinds: tuple[str, str], mods: tuple[str, str], key: str,
+             fmt: str, ratio: str, target: str, met: Any) -> None:
+        now = cells("this", kinds, mods, key)
+        if now is None:
+            return
+        value, ref = now
+
+        def rat(v: float, r: float) -> str:
+            return f"{v / r:.2f}" if ratio == "x" else f"{v / r - 1:+.0%}"
+
+        row = (f"| {label} | {value:{fmt}} | {ref:{fmt}} | {rat(value, ref)} | {target} | "
+               f"{'yes' if met(value, ref) else 'no'} | ")
+        if before:
+            old = cells("before", kinds, mods, key)
+            row += ("| | | " if old is None else
+                    f"{old[0]:{fmt}} | {old[1]:{fmt}} | {rat(*old)} | ")
+        rss = median(results["this", kinds[0]][mods[0]], "peak_rss_mb")
+        print(row + f"{rss:.0f} |")
+
+    for key, unit in (("wall_s", "wall"), ("cpu_s", "CPU")):
+        line(f"cold seven-link / five-link process, {unit} s", ("cold", "cold"),
+             ("seven-link", "five-link"), key, ".2f", "x", f"{TARGETS['cold']:g}x",
+             lambda v, r: v / r <= TARGETS["cold"])
+    for kind, label in (("warm-knots", "the file's knots given (one grid)"),
+                        ("warm", "knots left to the model (refines: check grid)"),
+                        ("api", "solve_gait, knots left to the model, whole call")):
+        key = "solve_s"
+        line(f"warm start of the seven-link from its gait file (+5 % speed), {label}, s "
+             "(reference: five-link)", (kind, kind), ("seven-link", "five-link"), key,
+             ".3f", "x", f"{TARGETS['warm']:g} s", lambda v, r: v <= TARGETS["warm"])
+    for model in models:
+        line(f"automatic refinement on a converged {model} solve, solve s (reference: knots "
+             "given)", ("refine", "fixed"), (model, model), "solve_s", ".3f", "%",
+             f"+{TARGETS['refine']:.0%}", lambda v, r: v / r - 1 <= TARGETS["refine"])
 
 
 if __name__ == "__main__":

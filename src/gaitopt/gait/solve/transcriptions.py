@@ -195,7 +195,23 @@ def target_grid(model: RobotModel, options: GaitOptions) -> Grid:
     sequences: :func:`gaitopt.gait.sequence.contact_sequence.phase_knots`)."""
     if options.knot_spacing == "uniform":
         return options.knots
-    return tuple(cosine_knots(ph.intervals + 1) for ph in problem_for(model, options).phases)
+    return tuple(cosine_knots(n) for n in _phase_knots(model, options))
+
+
+#: The knots per phase of the problems :func:`target_grid` was asked for in this process, by
+#: model hash and ``repr`` of the options: building a problem only to count its knots took
+#: a quarter of a second for the seven-link, three times in a warm start.
+_PHASE_KNOTS: dict[tuple[str, str], tuple[int, ...]] = {}
+
+
+def _phase_knots(model: RobotModel, options: GaitOptions) -> tuple[int, ...]:
+    """The knots of each phase of the problem of ``options`` (its intervals + 1), memoised."""
+    key = (model.content_hash(), repr(options))
+    if key not in _PHASE_KNOTS:
+        if len(_PHASE_KNOTS) > 256:
+            _PHASE_KNOTS.clear()
+        _PHASE_KNOTS[key] = tuple(ph.intervals + 1 for ph in problem_for(model, options).phases)
+    return _PHASE_KNOTS[key]
 
 
 def warm_start_grid(model: RobotModel, options: GaitOptions,
