@@ -290,12 +290,15 @@ def table(results: dict[tuple[str, str], dict[str, list[dict[str, Any]]]],
         line(f"cold seven-link / five-link process, {unit} s", ("cold", "cold"),
              ("seven-link", "five-link"), key, ".2f", "x", f"{TARGETS['cold']:g}x",
              lambda v, r: v / r <= TARGETS["cold"])
-    for kind, label in (("warm-knots", "the file's knots given (one grid)"),
-                        ("warm", "knots left to the model (refines: check grid)"),
-                        ("api", "solve_gait, knots left to the model, whole call")):
-        key = "solve_s"
-        line(f"warm start of the seven-link from its gait file (+5 % speed), {label}, s "
-             "(reference: five-link)", (kind, kind), ("seven-link", "five-link"), key,
+    for kind, label, key, unit in (
+            ("warm-knots", "the file's knots given (one grid)", "solve_s", "solve wall"),
+            ("warm-knots", "the file's knots given (one grid)", "cpu_s", "process CPU"),
+            ("warm", "knots left to the model (refines: check grid)", "solve_s", "solve wall"),
+            ("warm", "knots left to the model (refines: check grid)", "cpu_s", "process CPU"),
+            ("api", "solve_gait, knots left to the model", "call_wall", "call wall"),
+            ("api", "solve_gait, knots left to the model", "call_cpu", "call CPU")):
+        line(f"warm start of the seven-link from its gait file (+5 % speed), {label}, {unit} "
+             "s (reference: five-link)", (kind, kind), ("seven-link", "five-link"), key,
              ".3f", "x", f"{TARGETS['warm']:g} s", lambda v, r: v <= TARGETS["warm"])
     for model in models:
         line(f"automatic refinement on a converged {model} solve, solve s (reference: knots "
