@@ -60,6 +60,8 @@ def test_a_warm_start_that_finds_the_file_optimum_keeps_its_estimate(
     assert {k: record[k] for k in ESTIMATE_KEYS} == {k: old[k] for k in ESTIMATE_KEYS}
     assert record["within_target"] is True
     assert gait.cost_value == pytest.approx(refined_file.cost_value, rel=1e-5)
+    # the file's check-grid point goes on with its estimate (a chain of warm starts keeps it)
+    assert gait.solver["warm_start_check"] == refined_file.solver["warm_start_check"]
 
 
 def test_a_warm_start_at_another_speed_solves_its_check_grid(refined_file: Gait) -> None:

@@ -177,7 +177,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     run, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
                                     accuracy_of=accuracy_of)
     if carried is not None and run.result is first.result:
-        run = dataclasses.replace(run, accuracy_extra={**carried, **extra})
+        run = dataclasses.replace(run, accuracy_extra={**carried, **extra},
+                                  carried_check=check_point(warm_start))
     return run
 
 

@@ -24,7 +24,7 @@ from gaitopt.gait.solve.costates import solution_costates
 from gaitopt.gait.solve.diagnose import diagnose
 from gaitopt.gait.solve.staged import StagedRun
 from gaitopt.gait.solve.staged_run import check_result
-from gaitopt.ocp import Result, warm_start_of
+from gaitopt.ocp import Result, WarmStart, warm_start_of
 
 
 def gait_from_run(run: StagedRun) -> Gait:
@@ -77,7 +77,11 @@ def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
 def _warm_start_data(res: Result) -> dict[str, Any]:
     """What a warm start from the file needs (:class:`gaitopt.ocp.WarmStart`): the NLP point
     and its multipliers, with the layout and method they belong to."""
-    point = warm_start_of(res)
+    return _point_data(warm_start_of(res))
+
+
+def _point_data(point: WarmStart) -> dict[str, Any]:
+    """A :class:`gaitopt.ocp.WarmStart` as plain JSON data."""
     return {"w": point.w.tolist(), "lam_x": point.lam_x.tolist(),
             "lam_g": point.lam_g.tolist(), "layout": point.layout, "method": point.method}
 
@@ -85,13 +89,18 @@ def _warm_start_data(res: Result) -> dict[str, Any]:
 def _check_point(run: StagedRun) -> dict[str, Any]:
     """``{"warm_start_check": ...}``: the NLP point and multipliers of the answer's check grid
     (:func:`_warm_start_data`), where the run solved it and it converged to the cost the
-    accuracy record names (``check_cost``); else nothing. A warm start from the file restarts
-    its check grid there (:mod:`gaitopt.gait.solve.warm_accuracy`)."""
+    accuracy record names (``check_cost``), or the file's point whose estimate the run carries
+    over (``StagedRun.carried_check``: no check grid solved); else nothing. A warm start
+    from the file restarts its check grid there (:mod:`gaitopt.gait.solve.warm_accuracy`)."""
+    if not run.success:
+        return {}
     check = check_result(run)
     cost = accuracy_record(run).get("check_cost")
-    if not run.success or check is None or cost is None or check.objective != cost:
-        return {}
-    return {"warm_start_check": _warm_start_data(check)}
+    if check is not None and cost is not None and check.objective == cost:
+        return {"warm_start_check": _warm_start_data(check)}
+    if check is None and run.carried_check is not None:
+        return {"warm_start_check": _point_data(run.carried_check)}
+    return {}
 
 
 def _solved_sequence(run: StagedRun) -> dict[str, Any]:

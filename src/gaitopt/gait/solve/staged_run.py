@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from gaitopt.gait.options.gait_options import GaitOptions
-from gaitopt.ocp import Guess, PhaseGuess, Result
+from gaitopt.ocp import Guess, PhaseGuess, Result, WarmStart
 from gaitopt.robot.model import RobotModel
 
 #: Largest constraint violation (in the constraints' own units) of a solution that IPOPT
@@ -83,6 +83,11 @@ class StagedRun:
     #: What the refinement to an accuracy adds to the gait file's ``solver.accuracy``
     #: (:func:`gaitopt.gait.solve.refinement.refine_to_accuracy`); None before it ran.
     accuracy_extra: Mapping[str, Any] | None = None
+    #: The check grid's NLP point of the gait file whose estimate this run carries over
+    #: (:func:`gaitopt.gait.solve.warm_accuracy.carried_estimate`: the same optimum on the same
+    #: grid, so the same check grid optimum); written again with the new gait file. None
+    #: otherwise.
+    carried_check: WarmStart | None = None
 
     @property
     def success(self) -> bool:
