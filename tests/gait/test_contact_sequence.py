@@ -8,7 +8,7 @@ import pytest
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.gait.formulations.full.physics import per_point, projection_names
 from gaitopt.gait.formulations.select import checked_sequence, default_formulation
-from gaitopt.gait.guess.sequence import sequence_guess
+from gaitopt.gait.guess.sequence import contact_positions, sequence_guess
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.gait.sequence.builtin import heel_toe_sequence, walking_sequence
 from gaitopt.gait.sequence.contact_sequence import (
@@ -109,6 +109,20 @@ def test_heel_toe_sequence_of_the_seven_link_model(seven: RobotModel) -> None:
     forces = per_point(("heel_1", "toe_1:y"), [1.0, 2.0, 3.0])
     assert {c: list(np.asarray(v, dtype=float).ravel()) for c, v in forces.items()} == {
         "heel_1": [1.0, 2.0], "toe_1": [0.0, 3.0]}
+
+
+def test_the_guess_kinematics_are_the_model_kinematics(seven: RobotModel) -> None:
+    # The inverse kinematics of the guess evaluates the contact points as one CasADi
+    # function: the same expressions as the Python-float kinematics, so the same numbers.
+    names = [c.name for c in seven.contacts]
+    positions = contact_positions(seven, names)
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        q = rng.uniform(-1.5, 1.5, seven.nq)
+        got = positions(q)
+        for c in names:
+            want = np.asarray(contact_position(seven, q, c), dtype=float).ravel()
+            np.testing.assert_allclose(got[c], want, rtol=1e-12, atol=1e-12)
 
 
 def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> None:
