@@ -10,6 +10,7 @@ import pytest
 
 from gaitopt.gait.formulations import cost
 from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.options.model_defaults import cost_smoothing_for, options_for_model
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.record.file import Gait
 from gaitopt.gait.solve.cost_continuation import (
@@ -17,6 +18,7 @@ from gaitopt.gait.solve.cost_continuation import (
     continues_from_paper,
     smoothing_ladder,
 )
+from gaitopt.gait.solve.transcriptions import NlpStructure
 from gaitopt.ocp import Guess, Result
 from gaitopt.robot import load_model
 from tests.gait.conftest import SolveFn
@@ -94,3 +96,36 @@ def test_the_continuation_lowers_the_requested_cost_on_a_small_grid(solved: Solv
     paper_as_work = cost.recompute_cost(Gait.from_dict(data))
     assert work.gait.cost_value <= paper_as_work * (1.0 + 1e-5)
     assert work.gait.cost_value < 0.9 * paper_as_work  # the paper's optimum is not the work's
+
+
+def test_the_default_smoothing_follows_the_speed_in_powers_of_ten() -> None:
+    """The reference 0.01 W up to sqrt(10) times 12 m/min on the five-link biped, 0.1 W
+    above; the seven-link model's 0.01 W carried over as a power, ten times that at 80 m/min;
+    a free speed takes the gait's default speed; a given smoothing is kept."""
+    five, seven = load_model("five-link"), load_model("seven-link")
+    scale = model_scale(five)
+    assert cost_smoothing_for(scale, 0.01, 0.2) == 0.01
+    assert cost_smoothing_for(scale, 0.01, 0.05) == 0.01
+    assert cost_smoothing_for(scale, 0.01, 0.2 * 10**0.5 * 0.99) == 0.01
+    assert cost_smoothing_for(scale, 0.01, 0.2 * 10**0.5 * 1.01) == pytest.approx(0.1, rel=1e-12)
+    assert options_for_model(five, GaitOptions(speed=None)).cost_smoothing == 0.01
+    power = model_scale(seven).power(0.01)
+    at_80 = options_for_model(seven, GaitOptions(speed=80 / 60)).cost_smoothing
+    assert at_80 == pytest.approx(10 * power, rel=1e-12)
+    assert options_for_model(seven, GaitOptions(speed=0.2)).cost_smoothing == pytest.approx(
+        power, rel=1e-12)
+    assert options_for_model(seven, GaitOptions(speed=80 / 60, cost_smoothing=0.02)
+                             ).cost_smoothing == 0.02
+
+
+def test_a_smooth_costs_nlp_does_not_depend_on_the_smoothing() -> None:
+    """The paper cost has no positive parts: its NLP structure (the transcription cache's
+    key) is the same at any smoothing, so a sweep over speeds builds it once; a cost of
+    transport's differs."""
+    five = load_model("five-link")
+    paper = GaitOptions.paper()
+    assert NlpStructure.of(five, paper, (8, 5), None) == NlpStructure.of(
+        five, paper.replace(cost_smoothing=0.1), (8, 5), None)
+    work = GaitOptions.paper(cost="work")
+    assert NlpStructure.of(five, work, (8, 5), None) != NlpStructure.of(
+        five, work.replace(cost_smoothing=0.1), (8, 5), None)
