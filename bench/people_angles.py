@@ -64,20 +64,20 @@ def solve_api(path: Path, cost: str, speed: str, clearance: float | None, max_it
     [--clearance C]`` through the Python API, with IPOPT's limit per stage ``max_iter``
     (the CLI has 1000; the cost study 3000, ``gaitopt.study.cost_study.STUDY_MAX_ITER``):
     :class:`GaitOptions` left to the model's defaults otherwise, as the CLI leaves them."""
-    from gaitopt.gait.api import solve_gait_solution
+    from gaitopt.gait.api import solve_staged_run
     from gaitopt.gait.options.gait_options import GaitOptions
-    from gaitopt.gait.solve.record import gait_from_solution
+    from gaitopt.gait.solve.record import gait_from_run
     from gaitopt.units import parse_speed
 
     start = time.perf_counter()
     options = GaitOptions(speed=parse_speed(speed), cost=cost,  # type: ignore[arg-type]
                           swing_clearance=clearance, max_iter=max_iter)
-    solution = solve_gait_solution("seven-link", options)
+    solution = solve_staged_run("seven-link", options)
     wall = time.perf_counter() - start
     lines = [f"stage {st.line()}" for st in solution.stages]
     if not solution.success:
         return 1, wall, "\n".join(lines[-2:])
-    gait_from_solution(solution).save(path)
+    gait_from_run(solution).save(path)
     return 0, wall, "\n".join(lines[-2:])
 
 
