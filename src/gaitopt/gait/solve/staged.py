@@ -470,8 +470,10 @@ class _Run:
         """A cost other than the paper's, by continuation: the whole solve with the paper's
         cost first (its stages reported with the prefix ``paper cost:``), then the cost
         asked for from that optimum, first with coarser smoothings of the positive parts
-        (:func:`~gaitopt.gait.solve.cost_continuation.climb_ladder`). None if
-        the paper solve fails."""
+        (:func:`~gaitopt.gait.solve.cost_continuation.climb_ladder`), then (without
+        ``mesh_tol``, on a grid other than the coarse one) :meth:`check`, for the cost error
+        estimate: without it the accuracy rule solved the check grid's knots, then their
+        own check grid (docs/feet.md). None if the paper solve fails."""
         o = self.options
         paper = o.replace(cost="paper", cost_regularization=0.0)
 
@@ -492,7 +494,11 @@ class _Run:
                               parameter_bounds(o), solver_options=solver_options,
                               problem=problem)
 
-        return climb_ladder(o, result_guess(start.result), self.scale, stage)
+        result = climb_ladder(o, result_guess(start.result), self.scale, stage)
+        uniform_coarse = tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform"
+        if result.success and o.mesh_tol is None and not uniform_coarse:
+            self.check(result)  # the cost error estimate, as the paper cost's refine() has
+        return result
 
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
