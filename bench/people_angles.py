@@ -116,7 +116,11 @@ def measure_rows(gaits: list[tuple[str, Gait]]) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
     for label, gait in gaits:
         m = people_measures(joint_angle_stride(gait))
+        accuracy = gait.solver.get("accuracy") or {}
         rows.append({"label": label, "success": gait.success, "step_length": gait.step_length,
+                     "estimate": accuracy.get("worst_estimate"),
+                     "within_target": accuracy.get("within_target"),
+                     "cost_smoothing": gait.options.get("cost_smoothing"),
                      "speed_m_min": 60 * gait.speed, "cost_value": gait.cost_value,
                      **m, "relative_errors": relative_errors(m),
                      "distance": distance_from_people(m)})
@@ -126,17 +130,19 @@ def measure_rows(gaits: list[tuple[str, Gait]]) -> list[dict[str, Any]]:
 def markdown(rows: list[dict[str, Any]]) -> str:
     head = ("| cost | stance knee flexion [deg] (at % of stride) | swing knee flexion [deg] "
             "| hip excursion [deg] | ankle excursion [deg] | distance | step | stance [% of "
-            "stride] |")
-    lines = [head, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+            "stride] | largest estimate |")
+    lines = [head, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
     for r in rows:
         cells = [f"{r[n]:.1f}" for n in MEASURES]
         cells[0] += f" ({r['stance_knee_flexion_percent']:.0f} %)"
         lines.append(f"| {r['label']} | " + " | ".join(cells) + f" | {r['distance']:.2f} | "
-                     f"{r['step_length']:.3f} m | {r['stance_percent']:.1f} |")
+                     f"{r['step_length']:.3f} m | {r['stance_percent']:.1f} | "
+                     + ("none" if r["estimate"] is None else f"{100 * r['estimate']:.2g} %")
+                     + " |")
     people = [f"{lo:g}-{hi:g}" if hi > lo else f"about {lo:g}" for lo, hi in
               (PEOPLE[n] for n in MEASURES)]
     lines.append("| people (Winter 2009; Perry and Burnfield 2010) | " + " | ".join(people)
-                 + " | 0 | | |")
+                 + " | 0 | | | |")
     return "\n".join(lines)
 
 
