@@ -238,7 +238,7 @@ def cost_smoothing_for(scale: ModelScale, reference: float, speed: float) -> flo
     ``W v`` smooths the same share of that dimensionless integrand at every speed. A fixed
     ``eps`` sharpens the kinks against the powers as the speed grows: on the seven-link
     model at 80 m/min IPOPT did not converge with 0.016 W within 1000 iterations, and did
-    with 0.16 W (docs/feet.md, "Costs of transport that converge by default"). Why powers of
+    with 0.16 W (docs/feet.md, "Costs of transport at people's speed"). Why powers of
     ten: ``eps`` shapes the NLP, so every value is another NLP to build; these are the
     rungs of the smoothing ladder (:mod:`gaitopt.gait.solve.cost_continuation`), which a
     solve builds anyway, and a sweep over speeds needs one or two of them. Below the
