@@ -64,20 +64,20 @@ def solve_api(path: Path, cost: str, speed: str, clearance: float | None, max_it
     [--clearance C]`` through the Python API, with IPOPT's limit per stage ``max_iter``
     (the CLI has 1000; the cost study 3000, ``gaitopt.study.cost_study.STUDY_MAX_ITER``):
     :class:`GaitOptions` left to the model's defaults otherwise, as the CLI leaves them."""
-    from gaitopt.gait.api import solve_gait_solution
+    from gaitopt.gait.api import solve_staged_run
     from gaitopt.gait.options.gait_options import GaitOptions
-    from gaitopt.gait.solve.record import gait_from_solution
+    from gaitopt.gait.solve.record import gait_from_run
     from gaitopt.units import parse_speed
 
     start = time.perf_counter()
     options = GaitOptions(speed=parse_speed(speed), cost=cost,  # type: ignore[arg-type]
                           swing_clearance=clearance, max_iter=max_iter)
-    solution = solve_gait_solution("seven-link", options)
+    solution = solve_staged_run("seven-link", options)
     wall = time.perf_counter() - start
     lines = [f"stage {st.line()}" for st in solution.stages]
     if not solution.success:
         return 1, wall, "\n".join(lines[-2:])
-    gait_from_solution(solution).save(path)
+    gait_from_run(solution).save(path)
     return 0, wall, "\n".join(lines[-2:])
 
 
@@ -116,7 +116,11 @@ def measure_rows(gaits: list[tuple[str, Gait]]) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
     for label, gait in gaits:
         m = people_measures(joint_angle_stride(gait))
+        accuracy = gait.solver.get("accuracy") or {}
         rows.append({"label": label, "success": gait.success, "step_length": gait.step_length,
+                     "estimate": accuracy.get("worst_estimate"),
+                     "within_target": accuracy.get("within_target"),
+                     "cost_smoothing": gait.options.get("cost_smoothing"),
                      "speed_m_min": 60 * gait.speed, "cost_value": gait.cost_value,
                      **m, "relative_errors": relative_errors(m),
                      "distance": distance_from_people(m)})
@@ -126,17 +130,19 @@ def measure_rows(gaits: list[tuple[str, Gait]]) -> list[dict[str, Any]]:
 def markdown(rows: list[dict[str, Any]]) -> str:
     head = ("| cost | stance knee flexion [deg] (at % of stride) | swing knee flexion [deg] "
             "| hip excursion [deg] | ankle excursion [deg] | distance | step | stance [% of "
-            "stride] |")
-    lines = [head, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+            "stride] | largest estimate |")
+    lines = [head, "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
     for r in rows:
         cells = [f"{r[n]:.1f}" for n in MEASURES]
         cells[0] += f" ({r['stance_knee_flexion_percent']:.0f} %)"
         lines.append(f"| {r['label']} | " + " | ".join(cells) + f" | {r['distance']:.2f} | "
-                     f"{r['step_length']:.3f} m | {r['stance_percent']:.1f} |")
+                     f"{r['step_length']:.3f} m | {r['stance_percent']:.1f} | "
+                     + ("none" if r["estimate"] is None else f"{100 * r['estimate']:.2g} %")
+                     + " |")
     people = [f"{lo:g}-{hi:g}" if hi > lo else f"about {lo:g}" for lo, hi in
               (PEOPLE[n] for n in MEASURES)]
     lines.append("| people (Winter 2009; Perry and Burnfield 2010) | " + " | ".join(people)
-                 + " | 0 | | |")
+                 + " | 0 | | | |")
     return "\n".join(lines)
 
 

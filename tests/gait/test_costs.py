@@ -13,7 +13,7 @@ from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.formulations import cost
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.record.file import Gait
-from gaitopt.gait.solve.staged import smoothing_ladder
+from gaitopt.gait.solve.cost_continuation import smoothing_ladder
 from gaitopt.robot import load_model
 from gaitopt.robot.biped import biped_of
 from tests.gait.conftest import Solved

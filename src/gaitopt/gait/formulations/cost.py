@@ -30,6 +30,7 @@ Everything here runs on numbers and CasADi symbols alike.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -49,6 +50,32 @@ if TYPE_CHECKING:
     from gaitopt.gait.record.parts import GaitEvent
 
 COSTS: tuple[str, ...] = ("paper", "work", "metabolic")
+
+
+@dataclass(frozen=True)
+class CostTraits:
+    """What a cost declares about itself, as data (the staged solve reads this, never the
+    cost's name).
+
+    Attributes:
+        name: ``GaitOptions.cost``'s value for it.
+        smooth: its integrand is smooth in the NLP's variables (``u'u``). False where it
+            takes positive parts of actuator powers, ``max(0, u_a w_a)``, which the NLP
+            smooths with ``cost_smoothing`` (:func:`smooth_positive`): such a cost is reached
+            from the paper's optimum through coarser smoothings
+            (:mod:`gaitopt.gait.solve.cost_continuation`).
+    """
+
+    name: str
+    smooth: bool
+
+
+#: Every cost's traits by name (:data:`COSTS`).
+COST_TRAITS: dict[str, CostTraits] = {
+    "paper": CostTraits("paper", smooth=True),
+    "work": CostTraits("work", smooth=False),
+    "metabolic": CostTraits("metabolic", smooth=False),
+}
 
 FORMULAS = {
     "paper": ("energy per metre (paper eq. 5): (integral over the step of u'u dt + "

@@ -14,8 +14,10 @@ still marked with the model's value, so ``GaitOptions()`` means the same problem
 * ``knots``: 16 + 6 for two phases, :data:`MULTI_PHASE_KNOTS` for more (the heel-toe walk
   passes ``verify`` from 24 + 16 on; docs/feet.md).
 * ``speed``: :data:`DEFAULT_SPEEDS` of the gait at equal Froude number (:func:`default_speed`).
-* ``speed_bounds``, ``step_length_bounds``, ``rate_bound``, ``max_impulse``,
-  ``cost_smoothing``: the reference biped's values carried over by
+* ``cost_smoothing``: the reference biped's 0.01 W carried over as a power, times the power of
+  ten nearest to the speed's ratio to 12 m/min at equal Froude number (:func:`cost_smoothing_for`).
+* ``speed_bounds``, ``step_length_bounds``, ``rate_bound``, ``max_impulse``: the reference
+  biped's values carried over by
   :class:`~gaitopt.gait.options.model_scale.ModelScale` (speeds by ``sqrt(g l)``, lengths by ``l``,
   rates by ``sqrt(g / l)``, impulses by ``m sqrt(g l)``, powers by ``m g sqrt(g l)``).
 * a run's stance share, free within :data:`RUN_STANCE_BOUNDS`, and its step length bounds,
@@ -26,11 +28,12 @@ For the five-link biped every resolved value equals the marked one exactly.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from gaitopt.gait.formulations.select import default_formulation
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, follows_model
-from gaitopt.gait.options.model_scale import model_scale
+from gaitopt.gait.options.model_scale import ModelScale, model_scale
 from gaitopt.gait.sequence.builtin import legs_contacts
 from gaitopt.gait.sequence.contact_sequence import ContactSequenceError, sequence_from_dict
 from gaitopt.robot.model import RobotModel
@@ -211,5 +214,35 @@ def options_for_model(model: RobotModel, options: GaitOptions) -> GaitOptions:
     if follows_model(o.max_impulse):
         changes["max_impulse"] = scale.impulse(o.max_impulse)
     if follows_model(o.cost_smoothing):
-        changes["cost_smoothing"] = scale.power(o.cost_smoothing)
+        speed = changes.get("speed", o.speed)
+        if speed is None:  # a free speed: the one its solve starts from, the gait's default
+            speed = default_speed(model, str(changes.get("gait", gait)))
+        changes["cost_smoothing"] = cost_smoothing_for(scale, o.cost_smoothing, speed)
     return o.replace(**changes)
+
+
+#: The speed (m/s) of the reference biped at which its ``cost_smoothing`` (0.01 W) applies:
+#: the paper's optimal 12 m/min, where the five-link costs of transport were measured.
+SMOOTHING_SPEED = 0.2
+
+
+def cost_smoothing_for(scale: ModelScale, reference: float, speed: float) -> float:
+    """The smoothing ``eps`` (W) of the costs of transport's positive parts for a model of
+    ``scale`` walking at ``speed`` (m/s), from the reference biped's ``reference`` (W) at
+    :data:`SMOOTHING_SPEED`: carried over as a power, then times the power of ten nearest to
+    the speed's ratio to the reference speed at equal Froude number, never below 1:
+    ``eps = power(reference) 10^k``, ``k = round(log10(max(1, v / speed(SMOOTHING_SPEED))))``.
+
+    Why it grows with the speed: the costs of transport divide the work by ``W L``, so their
+    integrand is the actuator power over ``W v`` (``W`` the weight); an ``eps`` that follows
+    ``W v`` smooths the same share of that dimensionless integrand at every speed. A fixed
+    ``eps`` sharpens the kinks against the powers as the speed grows: on the seven-link
+    model at 80 m/min IPOPT did not converge with 0.016 W within 1000 iterations, and did
+    with 0.16 W (docs/feet.md, "Costs of transport at people's speed"). Why powers of
+    ten: ``eps`` shapes the NLP, so every value is another NLP to build; these are the
+    rungs of the smoothing ladder (:mod:`gaitopt.gait.solve.cost_continuation`), which a
+    solve builds anyway, and a sweep over speeds needs one or two of them. Below the
+    reference speed it stays at the reference value, where the five-link studies were
+    measured: 0.01 W exactly on the five-link biped up to 37.9 m/min (ratio sqrt(10))."""
+    ratio = max(1.0, speed / scale.speed(SMOOTHING_SPEED))
+    return scale.power(reference) * 10.0 ** round(math.log10(ratio))

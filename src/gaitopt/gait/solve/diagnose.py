@@ -280,8 +280,8 @@ def _kind(name: str) -> str:
 
 
 ADVICE = {
-    "torque": "the torques saturate: looser torque bounds (actuators[].limits in the model "
-              "file) or a lower speed",
+    "torque": "the torques saturate: looser torque bounds (actuators[].limits in a model "
+              "file: gaitopt model export MODEL -o my.yaml) or a lower speed",
     "reach": "the legs cannot reach where the step asks: a shorter step (--step-length) or "
              "leave it free; a lower speed",
     "force": "the ground would have to pull on a held point: a lower speed or a shorter "

@@ -89,8 +89,9 @@ from gaitopt.gait.guess.naive import (
 )
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, validate_options
 from gaitopt.gait.options.model_defaults import default_gait, default_speed, options_for_model
-from gaitopt.gait.options.model_scale import REFERENCE, ModelScale, model_scale
+from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.solve.check_grid import check_knots
+from gaitopt.gait.solve.cost_continuation import climb_ladder, continues_from_paper
 from gaitopt.gait.solve.staged_run import (
     ProgressFn,
     StagedRun,
@@ -138,13 +139,6 @@ REFERENCE_SPEED = 0.2
 #: Largest speed change (m/s) between two continuation steps on the reference biped; a model's
 #: is this at equal Froude number (:meth:`~gaitopt.gait.options.model_scale.ModelScale.speed`).
 SPEED_STEP = 0.1
-#: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
-#: cost's optimum, when the requested one is finer (the reference biped's; a model's is
-#: carried over as a power, :meth:`~gaitopt.gait.options.model_scale.ModelScale.power`); each
-#: further stage divides it by :data:`COST_SMOOTHING_STEP` until the requested one
-#: (:func:`smoothing_ladder`).
-COST_SMOOTHING_START = 1.0
-COST_SMOOTHING_STEP = 10.0
 #: Most refinement rounds after the fixed-grid stages, and most knots per phase they may make
 #: (the bound of ``GaitOptions.knots``).
 MAX_REFINEMENTS = 6
@@ -485,8 +479,10 @@ class _Run:
         """A cost other than the paper's, by continuation: the whole solve with the paper's
         cost first (its stages reported with the prefix ``paper cost:``), then the cost
         asked for from that optimum, first with coarser smoothings of the positive parts
-        (:func:`smoothing_ladder`), each stage from the last with its multipliers. None if
-        the paper solve fails."""
+        (:func:`~gaitopt.gait.solve.cost_continuation.climb_ladder`), then (without
+        ``mesh_tol``, on a grid other than the coarse one) :meth:`check`, for the cost error
+        estimate: without it the accuracy rule solved the check grid's knots, then their
+        own check grid (docs/feet.md). None if the paper solve fails."""
         o = self.options
         paper = o.replace(cost="paper", cost_regularization=0.0)
 
@@ -500,19 +496,18 @@ class _Run:
         if not start.success:
             self.results.append(start.result)
             return None
-        guess: Guess | Result = result_guess(start.result)
-        options = PRIMAL_WARM_OPTIONS
-        for eps in smoothing_ladder(o.cost_smoothing, self.scale):
-            stage = self.stage(f"{o.cost} cost, eps {eps:g} W", target_grid(self.model, o),
-                               Relaxation(), guess, parameter_bounds(o),
-                               solver_options=options, problem=o.replace(cost_smoothing=eps))
-            if not stage.success:
-                return stage
-            # The next smoothing starts from this optimum with its multipliers: the
-            # constraints are the same, only the kinks of the cost sharpen.
-            guess, options = stage, {}
-        return self.stage(f"{o.cost} cost", target_grid(self.model, o), Relaxation(), guess,
-                          parameter_bounds(o), solver_options=options)
+
+        def stage(name: str, problem: GaitOptions, guess: Guess | Result,
+                  solver_options: dict[str, Any]) -> Result:
+            return self.stage(name, target_grid(self.model, o), Relaxation(), guess,
+                              parameter_bounds(o), solver_options=solver_options,
+                              problem=problem)
+
+        result = climb_ladder(o, result_guess(start.result), self.scale, stage)
+        uniform_coarse = tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform"
+        if result.success and o.mesh_tol is None and not uniform_coarse:
+            self.check(result)  # the cost error estimate, as the paper cost's refine() has
+        return result
 
     def final(self) -> Result:
         """The last stage's outcome, or, if its values are not finite (a diverged solve),
@@ -523,18 +518,6 @@ class _Run:
                     return as_failed(result, self.results[-1])
                 return result
         return self.results[-1]
-
-
-def smoothing_ladder(target: float, scale: ModelScale = REFERENCE) -> list[float]:
-    """The smoothings (W) solved before ``target``: :data:`COST_SMOOTHING_START` (carried
-    over to the model of ``scale`` as a power) divided by :data:`COST_SMOOTHING_STEP` while
-    still coarser than ``target`` (``[1, 0.1]`` for 0.01 on the reference biped; ``[]`` when
-    ``target`` is at least the start)."""
-    out, eps = [], scale.power(COST_SMOOTHING_START)
-    while eps > target * (1 + 1e-9):
-        out.append(eps)
-        eps /= COST_SMOOTHING_STEP
-    return out
 
 
 def solve_walking(model: RobotModel, options: GaitOptions, *,
@@ -572,7 +555,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
         elif check_warm_start and options.mesh_tol is None:
             run.check(result, check_start)
     outcome: Result | None = result
-    if result is None and (options.cost != "paper" or options.cost_regularization > 0.0):
+    if result is None and continues_from_paper(options):
         outcome = run.other_cost()
         result = outcome if outcome is not None and outcome.success else None
     elif result is None:

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from gaitopt.gait.formulations.cost import COST_TRAITS
 from gaitopt.gait.formulations.select import problem_for
 from gaitopt.gait.options.gait_options import FIELD_GROUPS, GaitOptions, GaitOptionsError
 from gaitopt.gait.solve.function_cache import cached_functions as cached_functions
@@ -74,9 +75,12 @@ class NlpStructure:
     @classmethod
     def of(cls, model: RobotModel, options: GaitOptions, grid: Grid,
            compiled: str | None) -> NlpStructure:
+        # A smooth cost has no positive parts to smooth: its NLP is the same at any
+        # cost_smoothing (which follows the speed, gaitopt.gait.options.model_defaults).
+        unused = {"cost_smoothing"} if COST_TRAITS[options.cost].smooth else set()
         shaping = sorted((name, repr(getattr(getattr(options, group), name)))
                          for name, group in FIELD_GROUPS.items()
-                         if name not in BOUNDS_ONLY_OPTIONS)
+                         if name not in BOUNDS_ONLY_OPTIONS and name not in unused)
         if is_mesh(grid):
             key: tuple[Any, ...] = tuple(tuple(float(v) for v in np.asarray(m)) for m in grid)
         else:
