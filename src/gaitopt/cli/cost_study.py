@@ -41,7 +41,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                    clearance: float | None = None, gait: str = "auto",
                    knot_spacing: str = "cosine",
                    knots: str | None = None, strategy: str = "auto",
-                   accuracy_pass: bool = False,
+                   accuracy_pass: bool | None = None,
                    workers: int | None, scheduler: str | None) -> None:
     """``gaitopt study --costs``: each (model, case) sweep in turn on one backend (its
     processes keep their built problems; with ``--start-speed auto`` each model's paper case
@@ -90,8 +90,9 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                              knots=None if knots is None else parse_knots(knots),
                              start_speed=parse_start_speed(start_speed),
                              knot_spacing=knot_spacing,  # type: ignore[arg-type]
-                             strategy=strategy,
-                             accuracy=ACCURACY if accuracy_pass else None)
+                             strategy=strategy, accuracy=ACCURACY,
+                             accuracy_pass=("auto" if accuracy_pass is None
+                                            else "on" if accuracy_pass else "off"))
         # Every sweep's settings checked before anything is solved (the automatic start's
         # speed is not known yet: 12 m/min stands in for it here).
         spec.sweeps({m.name: StartChoice(speed=START_SPEED, rule="auto", reason="")
@@ -199,15 +200,18 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                     worst = acc.get("worst_estimate")
                     knots = "+".join(str(k) for k in (acc.get("knots") or {}).values())
                     what = (f"{knots} knots, {acc.get('worst_estimate_of', 'cost')} estimate "
-                            f"{'none' if worst is None else f'{100 * worst:.2g} %'}, "
+                            f"{'none' if worst is None else f'{100 * worst:.2g} %'} "
+                            f"({'within' if acc.get('within_target') else 'NOT within'} "
+                            f"{100 * ACCURACY:g} %), {outcome.iterations} iterations, "
                             f"{outcome.wall_time_s:.0f} s")
                 console.print(f"{'ok  ' if path else 'FAIL'} accuracy {sweep.model} "
                               f"{sweep.case.tag}: {what}", soft_wrap=True)
 
-            if spec.accuracy is not None:
-                todo = [sweep.case.tag for sweep, _ in accuracy_tasks(spec, directory)]
+            if spec.refines:
+                todo = [f"{sweep.model} {sweep.case.tag}"
+                        for sweep, _ in accuracy_tasks(spec, directory)]
                 console.print(f"accuracy: each case's optimum refined until its estimates are "
-                              f"within {100 * spec.accuracy:g} % (on its check grid, then "
+                              f"within {100 * ACCURACY:g} % (on its check grid, then "
                               f"finer; {len(todo)} to solve: {', '.join(todo) or 'none'}):",
                               soft_wrap=True)
                 try:
@@ -227,8 +231,15 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
     finally:
         if backend is not None:
             backend.close()
-    table = write_cost_table(directory, collect_rows(spec, directory))
+    rows = collect_rows(spec, directory)
+    table = write_cost_table(directory, rows)
     console.print(f"table: {table}", soft_wrap=True)
+    checked = [r for r in rows if r.within_accuracy is not None]
+    if checked:
+        missed = [r for r in checked if not r.within_accuracy]
+        console.print(f"accuracy: {len(checked) - len(missed)} of {len(checked)} cases within "
+                      f"{100 * ACCURACY:g} %" + ("" if not missed else "; not within: " + "; ".join(
+                          f"{r.model} {r.case} ({r.status})" for r in missed)), soft_wrap=True)
 
     page = write_cost_reports(console, directory, directory / "report")
     console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",

@@ -185,10 +185,11 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
               type=click.Choice(["paper", "work", "metabolic"]),
               help="The cost study of these costs only (repeat it; implies --costs); with "
                    "--walk-run its costs (paper, metabolic) [default: both].")
-@click.option("--accuracy-pass", is_flag=True,
+@click.option("--accuracy-pass/--no-accuracy-pass", default=None,
               help="With --costs: refine each case's optimum until its estimates of cost, "
-                   "speed and step length are within 1 % (slow; off by default, "
-                   "docs/costs.md).")
+                   "speed and step length are within 1 % (its check grid, then finer); a "
+                   "case that does not get there is marked so [default: on for models with "
+                   "feet (the heel-toe walk), off for the paper's walk; docs/costs.md].")
 @click.option("--resting-powers", default=DEFAULT_RESTING_POWERS_TEXT, show_default=True,
               help="With --costs: resting powers of the metabolic cost, W/kg (comma list).")
 @click.option("--regularization", type=float, default=0.0, show_default=True,
@@ -218,7 +219,7 @@ def sweep_command(directory: Path, model_name: str, speeds: str, variants: str, 
 @_workers_option
 def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: str | None,
                   paper_grid: bool, knots: str | None, knot_spacing: str | None,
-                  cost_study: bool, walk_run: bool, accuracy_pass: bool,
+                  cost_study: bool, walk_run: bool, accuracy_pass: bool | None,
                   costs: tuple[str, ...],
                   resting_powers: str,
                   regularization: float, start_speed: str, clearance: float | None,

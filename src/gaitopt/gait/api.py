@@ -142,9 +142,12 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     carried = None
     if guess is not None and warm_start is not None and refines:
         carried = carried_estimate(warm_start, first, accuracy_record(first))
-        if carried is None and first.success and \
+        checked = any(s.name.startswith("check grid") for s in first.stages)
+        if carried is None and first.success and not checked and \
                 accuracy_record(first).get("cost_error") is None:
-            # The file's estimate does not hold (another optimum): the check grid now.
+            # The file's estimate does not hold (another optimum): the check grid now (not
+            # again after a check grid that failed: the same solve, 32 minutes for nothing
+            # in the seven-link's work case).
             again = solve_walking(robot, opts, warm_start=first.result, progress=progress,
                                   compiled=compiled, check_warm_start=True)
             first = dataclasses.replace(again, stages=first.stages + again.stages,

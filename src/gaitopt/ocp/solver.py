@@ -16,13 +16,17 @@ Modes (``compiled``):
   (:mod:`gaitopt.ocp.pointwise`; :func:`solver_from_functions`), for transcriptions that
   evaluate the dynamics at single grid points (the separated Hermite-Simpson form).
 
-A solve never raises: :func:`call_solver` returns the solution or an error message.
+A solve never raises: :func:`call_solver` returns the solution or an error message, except
+for Ctrl-C, which it raises as :class:`KeyboardInterrupt` (:func:`interrupt_watch`).
 """
 
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Mapping
+import signal
+import threading
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -192,14 +196,51 @@ class SolverOutput:
     error: str | None
 
 
-def call_solver(solver: ca.Function, args: dict[str, Any]) -> SolverOutput:
-    """Run ``solver(**args)``; any exception becomes ``error`` (with x = x0)."""
+@contextmanager
+def interrupt_watch() -> Iterator[Callable[[], bool]]:
+    """Watch for Ctrl-C (SIGINT) during a solver call: yields a function that says whether
+    one came.
+
+    CasADi checks for Ctrl-C between IPOPT's iterations, stops the solve and returns it as
+    a failed one (status ``NonIpopt_Exception_Thrown``, the KeyboardInterrupt only logged as
+    a warning), so a staged solve went on with its next stage and Ctrl-C never stopped it.
+    Here Python's SIGINT handler is replaced, for the call, by one that notes the signal and
+    raises KeyboardInterrupt as before (so IPOPT still stops at once); :func:`call_solver`
+    then raises it. Only in the main thread, and only where SIGINT has Python's default
+    handler (a process that ignores it, or handles it itself, keeps its handler)."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield lambda: False
+        return
+    seen: list[int] = []
+
+    def note(signum: int, frame: Any) -> None:
+        seen.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, note)
     try:
-        sol = solver(**args)
-        error = None
-    except Exception as exc:  # noqa: BLE001 - the solver may raise anything; report it
-        sol = None
-        error = f"{type(exc).__name__}: {str(exc).strip().splitlines()[-1] if str(exc) else ''}"
+        yield lambda: bool(seen)
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def call_solver(solver: ca.Function, args: dict[str, Any]) -> SolverOutput:
+    """Run ``solver(**args)``; any exception becomes ``error`` (with x = x0).
+
+    Raises:
+        KeyboardInterrupt: Ctrl-C during the call (:func:`interrupt_watch`).
+    """
+    with interrupt_watch() as interrupted:
+        try:
+            sol = solver(**args)
+            error = None
+        except Exception as exc:  # noqa: BLE001 - the solver may raise anything; report it
+            sol = None
+            error = (f"{type(exc).__name__}: "
+                     f"{str(exc).strip().splitlines()[-1] if str(exc) else ''}")
+    if interrupted():
+        raise KeyboardInterrupt
     try:
         stats = dict(solver.stats())
     except Exception:  # noqa: BLE001

@@ -107,16 +107,30 @@ def accurate_gait(case_folder: Path, source: str, cost: float) -> Gait | None:
 
 def save_accurate(case_folder: Path, task: AccuracyTask, outcome: AccuracyOutcome) -> Path | None:
     """Write the accurate gait (if the solve converged) and its note atomically; the path of
-    the gait file, or None."""
+    the gait file, or None. A failed pass writes its note only (``"failed": true``, its
+    status), which the table reports (:func:`accuracy_failure`); a rerun solves it again."""
+    note = {"from": task.source, "from_cost": task.cost, "status": outcome.status,
+            "iterations": outcome.iterations, "wall_time_s": outcome.wall_time_s,
+            "failed": outcome.gait is None}
     if outcome.gait is None:
+        write_text_atomic(case_folder / ACCURATE_NOTE, json.dumps(note, indent=2) + "\n")
         return None
     path = case_folder / ACCURATE_FILE
     Gait.from_dict(outcome.gait, source=str(path)).save(path)
-    write_text_atomic(case_folder / ACCURATE_NOTE, json.dumps(
-        {"from": task.source, "from_cost": task.cost, "status": outcome.status,
-         "iterations": outcome.iterations, "wall_time_s": outcome.wall_time_s},
-        indent=2) + "\n")
+    write_text_atomic(case_folder / ACCURATE_NOTE, json.dumps(note, indent=2) + "\n")
     return path
+
+
+def accuracy_failure(case_folder: Path, source: str, cost: float) -> str | None:
+    """The status of the case's failed accuracy pass from ``source`` of cost ``cost`` (its
+    note, :func:`save_accurate`), or None when there is no such failure."""
+    try:
+        note = json.loads((case_folder / ACCURATE_NOTE).read_text(encoding="utf-8"))
+        same = note.get("from") == source and math.isclose(float(note.get("from_cost")), cost,
+                                                           rel_tol=1e-12)
+    except (OSError, ValueError, TypeError):
+        return None
+    return str(note.get("status") or "failed") if same and note.get("failed") else None
 
 
 def estimate_of(gait: Gait) -> tuple[float, str, bool | None, str]:
@@ -133,4 +147,4 @@ def estimate_of(gait: Gait) -> tuple[float, str, bool | None, str]:
 
 
 __all__ = ["ACCURATE_FILE", "ACCURATE_NOTE", "AccuracyOutcome", "AccuracyTask",
-           "accurate_gait", "estimate_of", "save_accurate", "solve_accurate"]
+           "accuracy_failure", "accurate_gait", "estimate_of", "save_accurate", "solve_accurate"]

@@ -72,6 +72,7 @@ from gaitopt.study.cost_accuracy import (
     ACCURATE_FILE,
     AccuracyOutcome,
     AccuracyTask,
+    accuracy_failure,
     accurate_gait,
     estimate_of,
     save_accurate,
@@ -118,12 +119,17 @@ STUDY_MAX_ITER = 3000
 STRATEGIES = ("cold", "continuation")
 AUTO_STRATEGY = "auto"
 #: The relative accuracy each case's optimum is refined to by the accuracy pass
-#: (:mod:`gaitopt.study.cost_accuracy`; ``gaitopt study --costs --accuracy-pass``): 1 %, the
-#: accuracy of ``gaitopt solve`` (``GaitOptions.accuracy``). The pass is off by default
-#: (``CostStudySpec.accuracy`` None): measured 2026-12-03, it takes the five-link study from
-#: 43 s to 667 s, and on the seven-link model the check grids of the costs of transport stop at
-#: the iteration limit (docs/costs.md).
+#: (:mod:`gaitopt.study.cost_accuracy`): 1 %, the accuracy of ``gaitopt solve``
+#: (``GaitOptions.accuracy``).
 ACCURACY = 0.01
+#: Whether the accuracy pass runs (``CostStudySpec.accuracy_pass``): ``auto`` for the models
+#: whose gait is in :data:`AUTO_ACCURACY_GAITS`, ``on`` for every model, ``off`` for none.
+ACCURACY_PASSES = ("auto", "on", "off")
+#: The gaits whose cases the accuracy pass refines by default: the heel-toe walk (a model with
+#: feet; measured 2026-12-03 with the check grid's smoothing ladder, docs/costs.md). Not the
+#: paper's walk: on the five-link biped the pass took the study from 43 s to 667 s and its
+#: costs of transport still ended 2.4-34 % off at 36 + 12 knots (``--accuracy-pass`` runs it).
+AUTO_ACCURACY_GAITS = frozenset({"heel-toe"})
 COST_STUDY_FILE = "cost_study.json"
 COST_STUDY_FORMAT = "gaitopt.cost-study"
 DIRECT_FILE = "direct.gait.json"
@@ -217,7 +223,8 @@ class CostStudySpec:
     start_speed: float | str = AUTO_START
     knot_spacing: KnotSpacing = "cosine"
     strategy: str = AUTO_STRATEGY
-    accuracy: float | None = None
+    accuracy: float | None = ACCURACY
+    accuracy_pass: str = "auto"
 
     def __post_init__(self) -> None:
         if not self.models:
@@ -270,6 +277,26 @@ class CostStudySpec:
                                               and 0.0 < self.accuracy < 1.0):
             raise CostStudyError(f"accuracy: {self.accuracy!r}; allowed: in (0, 1) (0.01 for "
                                  "1 %), or None for no accuracy pass")
+        if self.accuracy_pass not in ACCURACY_PASSES:
+            raise CostStudyError(f"accuracy_pass: {self.accuracy_pass!r}; allowed: "
+                                 f"{', '.join(ACCURACY_PASSES)}")
+
+    def accuracy_of(self, model: RobotModel | str) -> float | None:
+        """The accuracy ``model``'s cases are refined to (by name or model), or None where
+        the accuracy pass does not run: ``accuracy`` with ``accuracy_pass`` ``on``, or
+        ``auto`` and the model's gait in :data:`AUTO_ACCURACY_GAITS`."""
+        if isinstance(model, str):
+            model = next(m for m in self.models if m.name == model)
+        if self.accuracy is None or self.accuracy_pass == "off":
+            return None
+        if self.accuracy_pass == "auto" and self.gait_of(model) not in AUTO_ACCURACY_GAITS:
+            return None
+        return self.accuracy
+
+    @property
+    def refines(self) -> bool:
+        """Whether the accuracy pass runs for any model."""
+        return any(self.accuracy_of(m) is not None for m in self.models)
 
     @property
     def cases(self) -> tuple[CostCase, ...]:
@@ -383,6 +410,7 @@ class CostStudySpec:
                            "formulation": self.formulation_of(m), "gait": self.gait_of(m),
                            "knots": list(self.knots_of(m)),
                            "strategy": self.strategy_of(m),
+                           "accuracy": self.accuracy_of(m),
                            "start": None if choice is None else choice.to_dict()})
         return {"format": COST_STUDY_FORMAT, "version": 1, "gaitopt_version": __version__,
                 "models": models,
@@ -394,7 +422,7 @@ class CostStudySpec:
                 "start_speed_m_min": (None if self.auto_start
                                       else float(self.start_speed) * 60.0),
                 "knot_spacing": self.knot_spacing,
-                "accuracy": self.accuracy,
+                "accuracy": self.accuracy, "accuracy_pass": self.accuracy_pass,
                 "human": {"speed_m_min": HUMAN_OPTIMAL_SPEED_M_MIN,
                           "step_length": HUMAN_STEP_LENGTH,
                           "resting_power_w_kg": list(HUMAN_RESTING_POWER)}}
@@ -505,12 +533,14 @@ AccuracyFn = Callable[[CostSweep, "AccuracyOutcome | None", "Path | None"], None
 def accuracy_tasks(spec: CostStudySpec, directory: str | os.PathLike[str]
                    ) -> list[tuple[CostSweep, AccuracyTask]]:
     """The accuracy pass of every case whose optimum has no accurate gait yet
-    (:mod:`gaitopt.study.cost_accuracy`); none without ``spec.accuracy``."""
-    if spec.accuracy is None:
-        return []
+    (:mod:`gaitopt.study.cost_accuracy`) of the models it runs for
+    (:meth:`CostStudySpec.accuracy_of`)."""
     top = Path(directory)
     out = []
     for sweep in spec.sweeps(start_choices(spec, top)):
+        accuracy = spec.accuracy_of(sweep.model)
+        if accuracy is None:
+            continue
         found = winner_of(sweep, top, spec.variant)
         if found is None:
             continue
@@ -521,7 +551,7 @@ def accuracy_tasks(spec: CostStudySpec, directory: str | os.PathLike[str]
             text = (top / fields["file"]).read_text(encoding="utf-8")
         except OSError:
             continue
-        options = sweep.spec.options(sweep.free_point).replace(accuracy=spec.accuracy)
+        options = sweep.spec.options(sweep.free_point).replace(accuracy=accuracy)
         out.append((sweep, AccuracyTask(key=sweep.subdir, model=sweep.spec.model_of(
             sweep.free_point), options=options, text=text, source=fields["file"],
             cost=value)))
@@ -620,8 +650,16 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
             continue
         value, start, fields, other = found
         accuracy: dict[str, Any] = {}
+        target = spec.accuracy_of(sweep.model)
         accurate = (accurate_gait(top / sweep.subdir, fields["file"], value)
-                    if spec.accuracy is not None else None)
+                    if target is not None else None)
+        if accurate is None and target is not None:
+            # Never passed silently: the grid's optimum, marked as not within the accuracy.
+            failure = accuracy_failure(top / sweep.subdir, fields["file"], value)
+            fields["status"] += (f"; not within {100 * target:g} %: "
+                                 + (f"the accuracy pass failed ({failure})" if failure
+                                    else "no accuracy pass"))
+            accuracy = {"within_accuracy": False}
         if accurate is not None:
             worst, worst_of, within, knots = estimate_of(accurate)
             value = accurate.cost_value
@@ -632,8 +670,8 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
                         "within_accuracy": within}
             if within is False:
                 fields["status"] += (f"; {worst_of.replace('_', ' ')} estimate "
-                                     f"{100 * worst:.2g} % > {100 * spec.accuracy:g} %"
-                                     if spec.accuracy is not None and math.isfinite(worst)
+                                     f"{100 * worst:.2g} % > {100 * target:g} %"
+                                     if target is not None and math.isfinite(worst)
                                      else "; not within the accuracy")
         bound = speed_bound_reached(fields["speed_m_min"], sweep.spec.base.speed_bounds)
         if bound is not None:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import multiprocessing
 import queue
+import time
 from collections.abc import Callable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -70,7 +71,8 @@ class Backend:
         self.restart_fn()
 
     def close(self, *, wait: bool = True) -> None:
-        """Stop the executor; ``wait=False`` (after Ctrl-C) does not wait for running points."""
+        """Stop the executor; ``wait=False`` (after Ctrl-C) does not wait for running points:
+        local worker processes are ended (:func:`stop_workers`), a Dask client is closed."""
         self.close_fn(wait)
 
 
@@ -103,13 +105,42 @@ def local_backend(workers: int, *, start_method: str | None = None) -> Backend:
         start()
 
     def close(wait: bool) -> None:
-        state["pool"].shutdown(wait=wait, cancel_futures=True)
+        if wait:
+            state["pool"].shutdown(wait=True, cancel_futures=True)
+        else:
+            stop_workers(state["pool"])
 
     start()
     return Backend(name=f"{workers} local process{'es' if workers > 1 else ''} "
                         f"({ctx.get_start_method()})",
                    slots=workers, submit_fn=lambda fn, arg: state["pool"].submit(fn, arg),
                    close_fn=close, restart_fn=restart)
+
+
+#: Seconds a stopped worker process is given to end after SIGTERM, before SIGKILL.
+STOP_GRACE_S = 5.0
+
+
+def stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Shut ``pool`` down without waiting for its running points: cancel the queued ones and
+    end its processes (SIGTERM, then SIGKILL after :data:`STOP_GRACE_S`).
+
+    ``shutdown(wait=False)`` alone leaves every running point running, and the interpreter
+    joins the pool's processes at exit, so after Ctrl-C the command went on until each
+    running solve ended. A worker does not stop by itself either: the terminal's SIGINT
+    reaches it, but CasADi turns a KeyboardInterrupt inside IPOPT into a failed solve
+    (``NonIpopt_Exception_Thrown``) and the staged solve goes on with its next stage."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    deadline = time.monotonic() + STOP_GRACE_S
+    for process in processes:
+        process.join(timeout=max(0.0, deadline - time.monotonic()))
+        if process.is_alive():
+            process.kill()
+            process.join(timeout=STOP_GRACE_S)
 
 
 class InlineExecutor(Executor):

@@ -29,7 +29,7 @@ from typing import Any
 from gaitopt.gait.formulations.cost import COST_TRAITS
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_scale import REFERENCE, ModelScale
-from gaitopt.gait.solve.stages import PRIMAL_WARM_OPTIONS
+from gaitopt.gait.solve.stages import PRIMAL_WARM_OPTIONS, sequence_kind
 from gaitopt.ocp import Guess, Result
 
 #: Smoothing (W) of the positive parts of the work costs in the first stage after the paper
@@ -79,3 +79,27 @@ def climb_ladder(options: GaitOptions, start: Guess, scale: ModelScale,
             return result
         guess, solver_options = result, {}
     return stage(f"{options.cost} cost", options, guess, solver_options)
+
+
+#: The contact sequences (by kind, :func:`~gaitopt.gait.solve.stages.sequence_kind`) whose
+#: check grid climbs the :func:`smoothing_ladder` of a cost with kinks
+#: (:func:`check_smoothings`): where it was measured to be needed. The five-link walk's
+#: check grids of the costs of transport converge in one stage (docs/costs.md).
+CHECK_LADDER_KINDS = frozenset({"heel-toe"})
+
+
+def check_smoothings(options: GaitOptions, scale: ModelScale = REFERENCE) -> list[float]:
+    """The smoothings (W) the check grid solves before the requested one: the
+    :func:`smoothing_ladder` for a cost that is not smooth
+    (:data:`~gaitopt.gait.formulations.cost.COST_TRAITS`) on a contact sequence of
+    :data:`CHECK_LADDER_KINDS`, each from the last with its multipliers (the first from the
+    target grid's optimum mapped onto the check grid); else none.
+    Measured 2026-12-03 (docs/costs.md, "The accuracy pass"), the seven-link's metabolic
+    walk at 4.8 W/kg and 78 m/min, check grid 36 + 24 knots from the optimum on 24 + 16: at
+    the requested 0.016 W directly, IPOPT left the optimum and stopped at the iteration limit
+    (600: cost 0.598 against 0.535, violation 1.5e-3; the study's 1.2 W/kg case stopped so at
+    3000); the ladder 1.6, 0.16, 0.016 W converged in 131 + 243 + 83 iterations with the
+    warm-start barrier 1e-6, and its last stage stopped at the limit with 1e-4."""
+    if COST_TRAITS[options.cost].smooth or sequence_kind(options) not in CHECK_LADDER_KINDS:
+        return []
+    return smoothing_ladder(options.cost_smoothing, scale)

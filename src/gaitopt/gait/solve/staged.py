@@ -91,7 +91,11 @@ from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, val
 from gaitopt.gait.options.model_defaults import default_gait, default_speed, options_for_model
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.solve.check_grid import check_knots
-from gaitopt.gait.solve.cost_continuation import climb_ladder, continues_from_paper
+from gaitopt.gait.solve.cost_continuation import (
+    check_smoothings,
+    climb_ladder,
+    continues_from_paper,
+)
 from gaitopt.gait.solve.staged_run import (
     ProgressFn,
     StagedRun,
@@ -377,7 +381,10 @@ class _Run:
         estimate, never changes it. ``start``: a solution of this check grid's NLP (a gait
         file's, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) to restart from instead,
         with its multipliers and the warm-start options of the transcription, where it
-        fits."""
+        fits. Otherwise a cost with kinks first climbs
+        :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` (stages ``check grid,
+        eps E W``), each stage from the last with its multipliers, every one with the
+        transcription's warm-start barrier (1e-6) instead of :data:`REGRID_OPTIONS`."""
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
         if start is not None:
@@ -386,9 +393,17 @@ class _Run:
                 self.stage("check grid", grid, Relaxation(), start, parameter_bounds(o),
                            solver_options=check_grid_options(o))
                 return
-        self.stage("check grid", grid, Relaxation(), self.grid_start(grid, result, "check"),
-                   parameter_bounds(o), solver_options=check_grid_options(o),
-                   warm_start_options=REGRID_OPTIONS)
+        point: Result | WarmStart = self.grid_start(grid, result, "check")
+        ladder = check_smoothings(o, self.scale)
+        warm = None if ladder else REGRID_OPTIONS
+        for eps in ladder:
+            point = self.stage(f"check grid, eps {eps:.3g} W", grid, Relaxation(), point,
+                               parameter_bounds(o), solver_options=check_grid_options(o),
+                               problem=o.replace(cost_smoothing=eps), warm_start_options=warm)
+            if not point.success:
+                return
+        self.stage("check grid", grid, Relaxation(), point, parameter_bounds(o),
+                   solver_options=check_grid_options(o), warm_start_options=warm)
 
     def grid_start(self, grid: Grid, result: Result, move: str) -> Result | WarmStart:
         """The start on ``grid`` from ``result`` (another grid): for a ``move`` in

@@ -1,0 +1,56 @@
+"""Ctrl-C during an IPOPT solve raises KeyboardInterrupt (CasADi alone returns a failed solve,
+and the staged solve went on with its next stage)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from gaitopt.ocp.solver import call_solver
+
+
+def slow_solver() -> ca.Function:
+    """A problem IPOPT works on for many seconds (an unreachable tolerance, a CPU-time cap)."""
+    n = 2000
+    x = ca.MX.sym("x", n)
+    f = 100 * ca.sumsqr(x[1:] - x[:-1] ** 2) + ca.sumsqr(1 - x[:-1])
+    g = ca.sin(x[1:]) * ca.cos(x[:-1])
+    return ca.nlpsol("slow", "ipopt", {"x": x, "f": f, "g": g},
+                     {"ipopt.max_iter": 10**6, "ipopt.tol": 1e-30, "ipopt.max_cpu_time": 60.0,
+                      "ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
+                      "ipopt.hessian_approximation": "limited-memory"})
+
+
+def test_ctrl_c_during_a_solve_raises_and_restores_the_handler() -> None:
+    solver = slow_solver()
+    args = {"x0": np.full(2000, 0.5), "lbg": -0.1, "ubg": 0.1}
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call_solver(solver, args)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 30.0  # stopped at the signal, not at the CPU-time cap
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_process_that_ignores_sigint_keeps_ignoring_it() -> None:
+    x = ca.MX.sym("x")
+    solver = ca.nlpsol("quick", "ipopt", {"x": x, "f": (x - 2.0) ** 2},
+                       {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False})
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        out = call_solver(solver, {"x0": 1.0})
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert out.error is None
+    assert abs(out.x[0] - 2.0) < 1e-6

@@ -1,0 +1,83 @@
+"""The cost study's accuracy pass by default: on for models with feet (the heel-toe walk), off
+for the paper's walk; a case whose pass failed or did not run is marked as not within the
+accuracy in the table, never passed silently. No solve: fake summaries and notes."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from gaitopt.robot import RobotModel
+from gaitopt.study.cost_accuracy import (
+    ACCURATE_NOTE,
+    AccuracyOutcome,
+    AccuracyTask,
+    accuracy_failure,
+    save_accurate,
+)
+from gaitopt.study.cost_study import ACCURACY, CostStudyError, CostStudySpec, collect_rows
+from gaitopt.study.summary import SUMMARY_FILE, SummaryRow, write_summary
+
+
+def test_the_pass_runs_by_default_for_feet_only(five_link: RobotModel,
+                                                 seven_link: RobotModel) -> None:
+    auto = CostStudySpec(models=(five_link, seven_link))
+    assert auto.accuracy_of(five_link) is None
+    assert auto.accuracy_of(seven_link) == ACCURACY
+    assert auto.accuracy_of("seven-link") == ACCURACY  # by name, as the sweeps name it
+    assert auto.refines and not CostStudySpec(models=(five_link,)).refines
+    on = CostStudySpec(models=(five_link, seven_link), accuracy_pass="on")
+    assert on.accuracy_of(five_link) == on.accuracy_of(seven_link) == ACCURACY
+    off = CostStudySpec(models=(five_link, seven_link), accuracy_pass="off")
+    assert off.accuracy_of(five_link) is None and off.accuracy_of(seven_link) is None
+    assert not off.refines
+    assert CostStudySpec(models=(seven_link,), accuracy=None).accuracy_of(seven_link) is None
+    with pytest.raises(CostStudyError, match="accuracy_pass: 'sometimes'; allowed: auto, on"):
+        CostStudySpec(models=(five_link,), accuracy_pass="sometimes")
+    models = {m["name"]: m for m in auto.settings()["models"]}
+    assert models["five-link"]["accuracy"] is None
+    assert models["seven-link"]["accuracy"] == ACCURACY
+
+
+def _case(folder: Path, cost: float) -> str:
+    """A converged speed-free optimum in ``folder``'s summary; its gait file's path."""
+    folder.mkdir(parents=True, exist_ok=True)
+    row = SummaryRow(variant="ankle+impulse", ankle=True, impulse=True, speed_mode="free",
+                     speed_m_s=0.9, speed_m_min=54.0, step_length=0.53, step_time=0.59,
+                     cost=cost, status="Solve_Succeeded", success=True, iterations=10,
+                     wall_time_s=1.0, file="gaits/ankle+impulse/speed-free.gait.json")
+    write_summary(folder / SUMMARY_FILE, [row])
+    return row.file
+
+
+def test_a_case_without_its_accurate_gait_is_marked(tmp_path: Path,
+                                                     seven_link: RobotModel) -> None:
+    spec = CostStudySpec(models=(seven_link,), costs=("metabolic",), resting_powers=(1.2,),
+                         start_speed=1.25)
+    case = tmp_path / "seven-link" / "metabolic-rest-1.2"
+    file = _case(case, 0.22)
+    (row,) = collect_rows(spec, tmp_path)
+    assert row.success and row.within_accuracy is False
+    assert "not within 1 %: no accuracy pass" in row.status
+
+    source = f"seven-link/metabolic-rest-1.2/{file}"
+    task = AccuracyTask(key="seven-link/metabolic-rest-1.2", model=seven_link,
+                        options=spec.sweeps({})[0].spec.base, text="{}", source=source,
+                        cost=0.22)
+    failed = AccuracyOutcome(key=task.key, gait=None, status="Maximum_Iterations_Exceeded",
+                             wall_time_s=1.0, iterations=3000)
+    assert save_accurate(case, task, failed) is None
+    assert json.loads((case / ACCURATE_NOTE).read_text())["failed"] is True
+    assert accuracy_failure(case, source, 0.22) == "Maximum_Iterations_Exceeded"
+    assert accuracy_failure(case, source, 0.23) is None  # another optimum: not its failure
+    (row,) = collect_rows(spec, tmp_path)
+    assert row.within_accuracy is False and math.isfinite(row.cost_value)
+    assert "the accuracy pass failed (Maximum_Iterations_Exceeded)" in row.status
+
+    off = CostStudySpec(models=(seven_link,), costs=("metabolic",), resting_powers=(1.2,),
+                        start_speed=1.25, accuracy_pass="off")
+    (row,) = collect_rows(off, tmp_path)
+    assert row.within_accuracy is None and "within" not in row.status
