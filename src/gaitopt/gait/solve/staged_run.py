@@ -83,6 +83,10 @@ class StagedRun:
     #: What the refinement to an accuracy adds to the gait file's ``solver.accuracy``
     #: (:func:`gaitopt.gait.solve.refinement.refine_to_accuracy`); None before it ran.
     accuracy_extra: Mapping[str, Any] | None = None
+    #: Where the phase shares were released after the fixed-share solve, which optimum was
+    #: kept and why (:func:`gaitopt.gait.solve.share_release.decision`, the gait file's
+    #: ``solver.phase_shares``); None where they were not.
+    share_release: Mapping[str, Any] | None = None
 
     @property
     def success(self) -> bool:
