@@ -200,6 +200,33 @@ def test_without_a_plausibility_check_the_shares_stay_fixed(monkeypatch: pytest.
     assert len(calls) == 1
 
 
+@pytest.mark.parametrize(("flag", "value"), [([], None), (["--fixed-fractions"], False),
+                                              (["--free-fractions"], True)])
+def test_the_command_line_passes_the_choice_and_the_verify_check(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Any, flag: list[str],
+        value: bool | None) -> None:
+    """``gaitopt solve``: no flag leaves the shares to the sequence (released where they are
+    guesses), ``--fixed-fractions`` / ``--free-fractions`` decide; the solve gets
+    ``verified`` as its plausibility check."""
+    from click.testing import CliRunner
+
+    import gaitopt.gait.api as api
+    from gaitopt.cli import cli
+
+    seen: dict[str, Any] = {}
+
+    def capture(model: Any, options: GaitOptions, **kwargs: Any) -> Any:
+        seen.update(options=options, **kwargs)
+        raise SystemExit(0)
+
+    monkeypatch.setattr(api, "solve_staged_run", capture)
+    result = CliRunner().invoke(cli, ["solve", "--model", "seven-link", "--speed", "30m/min",
+                                      *flag, "-o", str(tmp_path / "g.gait.json")])
+    assert result.exit_code == 0, result.output
+    assert seen["options"].free_phase_fractions is value
+    assert seen["plausible"] is verified
+
+
 # -- the seven-link default solves (slow: minutes each) -------------------------------------
 
 @pytest.mark.slow
