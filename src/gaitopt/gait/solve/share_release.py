@@ -21,8 +21,11 @@ above this layer); otherwise the fixed-share optimum, and the gait file says whi
 (``solver.phase_shares``, :func:`decision`).
 
 Why released last rather than free from the first stage (``free_phase_fractions=True``): the
-cold stages then look for the shares too and, at slow speeds on the seven-link model, ended
-in a flapping optimum (docs/feet.md, "Free phase shares by default").
+fixed-share optimum is the fallback, so it is solved anyway, and the release starts from it:
+at 12 and 30 m/min it reached the optima of the shares freed from the first stage, and with
+the speed free it stays near the fixed-share optimum's speed, where a cold speed-free solve
+with free shares ended at 12.9 m/min, a poor local optimum (docs/feet.md, "Free phase shares
+by default").
 
 A two-phase walk's single-support share is the problem's own datum (the paper's 0.85, the
 user's ``single_support_fraction``): it stays fixed, and so do shares the caller gave (a
@@ -129,8 +132,3 @@ def release_shares(fixed: StagedRun, solve_free: Callable[[GaitOptions, StagedRu
                                wall_time_s=fixed.wall_time_s + free.wall_time_s,
                                share_release=chosen)
 
-
-def prefixed(stage: Any) -> Any:
-    """A :class:`~gaitopt.gait.solve.staged_run.StageRecord` with :data:`PREFIX` before its
-    name."""
-    return dataclasses.replace(stage, name=PREFIX + stage.name)
