@@ -50,6 +50,13 @@ PREFIX = "shares free: "
 #: than this (relative): within it the two are the same optimum, and the fixed shares (the
 #: sequence's, as documented) are kept.
 SAME_COST = 1e-6
+#: IPOPT's iteration limit per stage of the released solve (or the caller's, if lower). The
+#: release is an offer, not the answer: the fixed-share optimum stands. Its stages took 34-114
+#: iterations where they converged (seven-link, 30 and 60 m/min), but at 80 m/min and with
+#: the speed free the released check grid (36 + 26 knots) ran to the 1000-iteration limit
+#: for over half an hour; with this limit such a release fails in minutes and the fixed
+#: shares are kept, with the failure in ``solver.phase_shares``.
+RELEASE_MAX_ITER = 300
 
 #: A plausibility check of a converged solve: None when plausible, else why not (a line).
 Plausibility = Callable[[StagedRun], str | None]
@@ -124,7 +131,8 @@ def release_shares(fixed: StagedRun, solve_free: Callable[[GaitOptions, StagedRu
         The run kept (:func:`decision`), with every stage of both solves, their wall times
         added, and the decision in ``share_release``.
     """
-    options = fixed.options.replace(free_phase_fractions=True, phase_shares=None)
+    options = fixed.options.replace(free_phase_fractions=True, phase_shares=None,
+                                    max_iter=min(fixed.options.max_iter, RELEASE_MAX_ITER))
     free = solve_free(options, fixed)
     chosen = decision(fixed, free, plausible)
     kept = free if chosen["released"] else fixed
