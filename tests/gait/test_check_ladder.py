@@ -20,7 +20,7 @@ def test_the_ladder_for_costs_of_transport_with_feet_only() -> None:
         options = options_for_model(seven, GaitOptions(gait="heel-toe", cost=cost))
         steps = check_smoothings(options, scale)
         assert steps == smoothing_ladder(options.cost_smoothing, scale)
-        assert steps and all(a > b for a, b in zip(steps, steps[1:]))
+        assert steps and all(a > b for a, b in zip(steps, steps[1:], strict=False))
         assert steps[-1] > options.cost_smoothing
         assert steps[0] == pytest.approx(scale.power(1.0), rel=1e-12)
     paper = options_for_model(seven, GaitOptions(gait="heel-toe"))

@@ -152,9 +152,13 @@ def _step_time(text: str) -> float | None:
 @click.option("--single-support-bounds", default=None,
               help="LO,HI: the single-support fraction free within these bounds, starting "
                    "from --single-support (needs --formulation full).")
-@click.option("--free-fractions", is_flag=True,
-              help="Every phase's share of the step free, within half to twice its given "
-                   "share (at most 0.95), starting from it (needs --formulation full).")
+@click.option("--free-fractions/--fixed-fractions", default=None,
+              help="Every phase's share of the step free from the first stage, within half "
+                   "to twice its given share (at most 0.95), starting from it (needs "
+                   "--formulation full); or every share fixed. [default: a built-in "
+                   "sequence of more than two phases (heel-toe) is solved with its shares "
+                   "fixed, then again with them free from that optimum, and the free one "
+                   "kept where it costs less and passes verify; docs/feet.md]")
 @click.option("--stride", is_flag=True,
               help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "
                    "lengths, no leg swap assumed (for unequal legs); cost per metre of the "
@@ -242,7 +246,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   periodic_controls: bool, friction: float | None,
                   unilateral_impulses: bool, formulation: str | None,
                   min_knee_flexion: float | None, single_support_bounds: str | None,
-                  free_fractions: bool, stride: bool,
+                  free_fractions: bool | None, stride: bool,
                   gait_kind: str | None, sequence_file: Path | None, cost: str,
                   resting_power: float | None, regularization: float,
                   torque_rate_time: float,
@@ -251,6 +255,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   multistart: bool | None,
                   warm_start: Path | None, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
+    from gaitopt.analysis.plausible import verified
     from gaitopt.cli.gait_summary import summary_table
     from gaitopt.gait.api import as_model, solve_staged_run, warm_start_usable
     from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
@@ -353,7 +358,8 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
     try:
         solution = solve_staged_run(model, options, progress=progress, warm_start=start,
                                     compiled="codegen" if compiled else None,
-                                    refine=refine, speed_given=speed is not None)
+                                    refine=refine, speed_given=speed is not None,
+                                    plausible=verified)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:
@@ -376,6 +382,11 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       f"walks at the slower default of the walk, "
                       f"{format_speed(solution.options.speed or 0.0)}; --speed chooses one")
     console.print(summary_table(gait, sequence_used))
+    if solution.share_release is not None:
+        console.print(f"phase shares: {solution.share_release['why']} (fixed J "
+                      f"{solution.share_release['fixed_cost']:.6g}"
+                      + ("" if solution.share_release["free_cost"] is None else
+                         f", free J {solution.share_release['free_cost']:.6g}") + ")")
     gait.save(output)
     console.print(f"wrote {output}")
     record = gait.solver.get("accuracy", {})

@@ -40,6 +40,12 @@ from gaitopt.gait.solve.accuracy import accuracy_record
 from gaitopt.gait.solve.diagnose import SolveFailedError, diagnose
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.refinement import refine_to_accuracy
+from gaitopt.gait.solve.share_release import (
+    PREFIX,
+    Plausibility,
+    release_shares,
+    releases_shares,
+)
 from gaitopt.gait.solve.staged import (
     ProgressFn,
     StagedRun,
@@ -98,7 +104,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                      compiled: str | None = None,
                      refine: bool | None = None,
                      speed_given: bool | None = None,
-                     check_warm_start: bool = False) -> StagedRun:
+                     check_warm_start: bool = False,
+                     plausible: Plausibility | None = None) -> StagedRun:
     """Internal: :func:`solve_gait` before the gait is recorded. Returns the
     :class:`~gaitopt.gait.solve.staged_run.StagedRun` (the engine's final result, every
     stage's record and result), which the command line, the study, the benches and the tests
@@ -112,6 +119,13 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     (:mod:`gaitopt.gait.solve.warm_accuracy`).
     ``check_warm_start``: a warm start always solves its check grid too (the cost study's
     accuracy pass), whatever the file's estimate.
+    ``plausible``: where the sequence's phase shares are guesses
+    (:mod:`gaitopt.gait.solve.share_release`), the converged fixed-share solve is followed by
+    the shares released from its optimum, kept where lower, converged and ``plausible`` (a
+    check of the released run: None when plausible, else why not;
+    :func:`gaitopt.analysis.plausible.verified`, which ``gaitopt solve`` passes). None: no
+    release, the shares stay fixed (nothing here can judge the released gait: the checks
+    of ``gaitopt verify`` live above this layer).
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
@@ -162,14 +176,16 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
             first = dataclasses.replace(retry, stages=first.stages + retry.stages,
                                         wall_time_s=first.wall_time_s + retry.wall_time_s)
 
-    def solve_on(finer: GaitOptions, before: StagedRun) -> StagedRun:
+    def solve_on(finer: GaitOptions, before: StagedRun, prefix: str = "") -> StagedRun:
         # Started from the check grid's result, which is the solution of this very NLP (the
         # check grid of the coarser grid is the finer grid), values and multipliers: IPOPT
         # confirms it in a few iterations. Without one, from the coarser grid's result (its
         # interpolants at the finer knots): no gait record needed, so a coarse motion that
         # leaves a leg's reach between knots is refined too.
-        again = solve_walking(robot, finer, warm_start=check_result(before) or before.result,
-                              progress=progress, compiled=compiled, check_warm_start=True)
+        again = _prefixed(solve_walking(robot, finer,
+                                        warm_start=check_result(before) or before.result,
+                                        progress=_prefixed_progress(progress, prefix),
+                                        compiled=compiled, check_warm_start=True), prefix)
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
 
@@ -182,7 +198,46 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     if carried is not None and run.result is first.result:
         run = dataclasses.replace(run, accuracy_extra={**carried, **extra},
                                   carried_check=check_point(warm_start))
+    # A warm start follows its start: it is not released again (the file's own solve decided).
+    if (run.success and plausible is not None and warm_start is None
+            and releases_shares(robot, run.options)):
+
+        def released(free: GaitOptions, fixed: StagedRun) -> StagedRun:
+            start = _prefixed(solve_walking(robot, free, warm_start=fixed.result,
+                                            progress=_prefixed_progress(progress, PREFIX),
+                                            compiled=compiled, check_warm_start=True),
+                              PREFIX)
+            if accuracy_record(start).get("cost_error") is None:
+                # Its check grid failed (seven-link, 80 m/min: 300 iterations, 63 s): no
+                # estimate, so not within the accuracy, and the fixed shares stand; refining
+                # it further took 10 minutes and more.
+                return start
+            return refine_to_accuracy(
+                start, refines=refines, accuracy_of=accuracy_record,
+                solve_on=lambda o, before: solve_on(o, before, PREFIX))[0]
+
+        run = release_shares(run, released, plausible)
     return run
+
+
+def _prefixed(run: StagedRun, prefix: str) -> StagedRun:
+    """``run`` with ``prefix`` before every stage's name."""
+    if not prefix:
+        return run
+    return dataclasses.replace(run, stages=tuple(
+        dataclasses.replace(s, name=prefix + s.name) for s in run.stages))
+
+
+def _prefixed_progress(progress: ProgressFn | None, prefix: str) -> ProgressFn | None:
+    """``progress`` told each stage with ``prefix`` before its name."""
+    if progress is None or not prefix:
+        return progress
+    report = progress
+
+    def told(stage: StageRecord) -> None:
+        report(dataclasses.replace(stage, name=prefix + stage.name))
+
+    return told
 
 
 def _file_estimate_may_hold(gait: Gait | None, options: GaitOptions) -> bool:
@@ -225,7 +280,7 @@ def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
 
 def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions | None = None,
                *, warm_start: Gait | None = None, progress: Callable[[str], None] | None = None,
-               compiled: str | None = None) -> Gait:
+               compiled: str | None = None, plausible: Plausibility | None = None) -> Gait:
     """Solve the minimum-energy walking problem and return the gait, the one result of a
     solve (converged or not: ``gait.success`` says; :meth:`Gait.save` refuses to write a
     failed gait). Everything the solve found is in it: ``gait.status``, ``gait.solver`` (the
@@ -244,6 +299,10 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
             outcome, iterations, cost, speed, step length, violation and time: the lines
             ``gaitopt solve`` prints); the stages are also in ``gait.solver["stages"]``.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
+        plausible: the check that lets a sequence's guessed phase shares be released after
+            the fixed-share solve (:mod:`gaitopt.gait.solve.share_release`), e.g.
+            ``gaitopt.analysis.plausible.verified`` (``gaitopt verify`` passes on the
+            released gait), which ``gaitopt solve`` uses; None: the shares stay fixed.
 
     Raises:
         MotionOutOfReachError: the converged solution's motion between knots leaves a leg's
@@ -253,7 +312,7 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
     """
     lines = None if progress is None else _stage_lines(progress)
     run = solve_staged_run(model, options, warm_start=warm_start, progress=lines,
-                           compiled=compiled)
+                           compiled=compiled, plausible=plausible)
     try:
         return gait_from_run(run)
     except MotionOutOfReachError:

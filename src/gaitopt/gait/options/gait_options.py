@@ -196,11 +196,17 @@ class SequenceOptions:
             or ``(lower, upper)``: the fraction is free within them, a decision parameter
             (``single_support_fraction`` is its first guess); full formulation, with double
             support (a walk) or a flight (a run).
-        free_phase_fractions: every phase fraction of the contact sequence (built in or
-            given) that is fixed becomes free, a decision parameter within ``[s / 2,
-            min(2 s, 0.95)]`` around its share ``s`` (which is its first guess); full
-            formulation, two phases or more. Not with ``single_support_fraction_bounds``.
-            See :func:`gaitopt.gait.sequence.phase_fractions.fraction_parameters`.
+        free_phase_fractions: ``True``: every phase fraction of the contact sequence (built
+            in or given) that is fixed becomes free from the first stage on, a decision
+            parameter within ``[s / 2, min(2 s, 0.95)]`` around its share ``s`` (which is its
+            first guess); full formulation, two phases or more. Not with
+            ``single_support_fraction_bounds``. See
+            :func:`gaitopt.gait.sequence.phase_fractions.fraction_parameters`. ``False``: the
+            shares stay fixed. ``None`` (the default): left to the sequence, fixed for the
+            solve, then released from its optimum where the sequence's shares are guesses
+            (a built-in sequence of more than two phases) and the released optimum is kept
+            where it is lower, converged and plausible
+            (:mod:`gaitopt.gait.solve.share_release`).
         phase_shares: ``None``, or each phase's share of the step (one per phase of the
             contact sequence, in (0, 1)): the first guess of the free fractions instead of the
             sequence's own, and what the knots per phase follow
@@ -216,7 +222,7 @@ class SequenceOptions:
     stride: bool = False
     single_support_fraction: float = from_model(0.85)
     single_support_fraction_bounds: tuple[float, float] | None = None
-    free_phase_fractions: bool = False
+    free_phase_fractions: bool | None = None
     phase_shares: tuple[float, ...] | None = None
     ankle: bool = True
     impulse: bool = True
@@ -450,7 +456,7 @@ class FlatOptions(TypedDict, total=False):
     stride: bool
     single_support_fraction: float
     single_support_fraction_bounds: tuple[float, float] | None
-    free_phase_fractions: bool
+    free_phase_fractions: bool | None
     phase_shares: tuple[float, ...] | None
     ankle: bool
     impulse: bool
@@ -571,7 +577,7 @@ class GaitOptions:
     single_support_fraction = _Alias[float]("sequence.single_support_fraction")
     single_support_fraction_bounds = _Alias[tuple[float, float] | None](
         "sequence.single_support_fraction_bounds")
-    free_phase_fractions = _Alias[bool]("sequence.free_phase_fractions")
+    free_phase_fractions = _Alias[bool | None]("sequence.free_phase_fractions")
     phase_shares = _Alias[tuple[float, ...] | None]("sequence.phase_shares")
     ankle = _Alias[bool]("sequence.ankle")
     impulse = _Alias[bool]("sequence.impulse")

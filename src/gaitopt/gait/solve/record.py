@@ -62,6 +62,7 @@ def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
                     "parameters": dict(s.parameters), "wall_time_s": s.wall_time_s}
                    for s in run.stages],
         "accuracy": {**accuracy_record(run), **(run.accuracy_extra or {})},
+        **({} if run.share_release is None else {"phase_shares": dict(run.share_release)}),
         **({} if res.success else {"diagnosis": diagnose(run).text()}),
     }
     return Gait(
