@@ -70,9 +70,9 @@ def test_the_structure_key_changes_with_every_field_but_the_bounds_only_ones() -
     structure unless the field only enters bounds; so a new field shapes the NLP until it is
     listed in BOUNDS_ONLY_OPTIONS, never silently shares a transcription."""
     model = load_model("five-link")
-    base = GaitOptions()
+    base = GaitOptions(cost="metabolic")  # a cost with kinks: its smoothing shapes the NLP
     key = NlpStructure.of(model, base, (8, 5), None)
-    assert NlpStructure.of(model, GaitOptions(), (8, 5), None) == key
+    assert NlpStructure.of(model, GaitOptions(cost="metabolic"), (8, 5), None) == key
     for name in sorted(FIELDS):
         changed = NlpStructure.of(model, dataclasses.replace(base, **{name: object()}),
                                   (8, 5), None)
@@ -82,6 +82,10 @@ def test_the_structure_key_changes_with_every_field_but_the_bounds_only_ones() -
             assert changed != key, name
     assert NlpStructure.of(model, base, (16, 6), None) != key
     assert NlpStructure.of(model, base, (8, 5), "codegen") != key
+    # A smooth cost has nothing to smooth: the same NLP at any smoothing.
+    paper = GaitOptions()
+    assert NlpStructure.of(model, paper.replace(cost_smoothing=1.0), (8, 5), None) == \
+        NlpStructure.of(model, paper, (8, 5), None)
 
 
 @pytest.mark.parametrize(("options", "names"), [

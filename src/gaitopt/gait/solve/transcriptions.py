@@ -77,7 +77,8 @@ class NlpStructure:
            compiled: str | None) -> NlpStructure:
         # A smooth cost has no positive parts to smooth: its NLP is the same at any
         # cost_smoothing (which follows the speed, gaitopt.gait.options.model_defaults).
-        unused = {"cost_smoothing"} if COST_TRAITS[options.cost].smooth else set()
+        traits = COST_TRAITS.get(options.cost)
+        unused = {"cost_smoothing"} if traits is not None and traits.smooth else set()
         shaping = sorted((name, repr(getattr(getattr(options, group), name)))
                          for name, group in FIELD_GROUPS.items()
                          if name not in BOUNDS_ONLY_OPTIONS and name not in unused)
