@@ -253,3 +253,17 @@ def test_the_seven_link_default_releases_its_shares_where_plausible(
         assert "swing.reversals" in record["why"]
         assert gait.cost_value == pytest.approx(record["fixed_cost"], rel=1e-9)
         assert [round(s, 6) for s in shares_of(run)] == pytest.approx(FIXED_SHARES, abs=1e-6)
+
+
+def test_a_stage_time_limit_fails_the_stage_that_reaches_it() -> None:
+    """``solve_walking(stage_seconds=...)`` (the released solve's bound) passes IPOPT's wall-time
+    limit to every stage: a limit no stage can meet fails the first one, reported as failed,
+    while the same solve without it converges."""
+    from gaitopt.gait.solve.staged import solve_walking
+
+    model = load_model("five-link")
+    options = GaitOptions(knots=(8, 5), knot_spacing="uniform", accuracy=None)
+    bounded = solve_walking(model, options, stage_seconds=1e-9)
+    assert not bounded.success
+    assert bounded.stages[0].status == "Maximum_WallTime_Exceeded"
+    assert solve_walking(model, options).success

@@ -42,6 +42,7 @@ from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.refinement import refine_to_accuracy
 from gaitopt.gait.solve.share_release import (
     PREFIX,
+    RELEASE_STAGE_SECONDS,
     Plausibility,
     release_shares,
     releases_shares,
@@ -176,7 +177,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
             first = dataclasses.replace(retry, stages=first.stages + retry.stages,
                                         wall_time_s=first.wall_time_s + retry.wall_time_s)
 
-    def solve_on(finer: GaitOptions, before: StagedRun, prefix: str = "") -> StagedRun:
+    def solve_on(finer: GaitOptions, before: StagedRun, prefix: str = "",
+                 stage_seconds: float | None = None) -> StagedRun:
         # Started from the check grid's result, which is the solution of this very NLP (the
         # check grid of the coarser grid is the finer grid), values and multipliers: IPOPT
         # confirms it in a few iterations. Without one, from the coarser grid's result (its
@@ -185,7 +187,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         again = _prefixed(solve_walking(robot, finer,
                                         warm_start=check_result(before) or before.result,
                                         progress=_prefixed_progress(progress, prefix),
-                                        compiled=compiled, check_warm_start=True), prefix)
+                                        compiled=compiled, check_warm_start=True,
+                                        stage_seconds=stage_seconds), prefix)
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
 
@@ -205,7 +208,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         def released(free: GaitOptions, fixed: StagedRun) -> StagedRun:
             start = _prefixed(solve_walking(robot, free, warm_start=fixed.result,
                                             progress=_prefixed_progress(progress, PREFIX),
-                                            compiled=compiled, check_warm_start=True),
+                                            compiled=compiled, check_warm_start=True,
+                                            stage_seconds=RELEASE_STAGE_SECONDS),
                               PREFIX)
             if accuracy_record(start).get("cost_error") is None:
                 # Its check grid failed (seven-link, 80 m/min: 300 iterations, 63 s): no
@@ -214,7 +218,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                 return start
             return refine_to_accuracy(
                 start, refines=refines, accuracy_of=accuracy_record,
-                solve_on=lambda o, before: solve_on(o, before, PREFIX))[0]
+                solve_on=lambda o, before: solve_on(o, before, PREFIX,
+                                                    RELEASE_STAGE_SECONDS))[0]
 
         run = release_shares(run, released, plausible)
     return run

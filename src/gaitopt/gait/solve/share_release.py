@@ -57,6 +57,10 @@ SAME_COST = 1e-6
 #: for over half an hour; with this limit such a release fails in minutes and the fixed
 #: shares are kept, with the failure in ``solver.phase_shares``.
 RELEASE_MAX_ITER = 300
+#: IPOPT's wall-time limit (s) of each stage of the released solve: with the speed free the
+#: released check grid's iterations slowed so that 300 of them ran for more than 10 minutes
+#: (2026-12-03, load 2-4; the converged releases' stages took 4-63 s at a load of 8-13).
+RELEASE_STAGE_SECONDS = 120.0
 
 #: A plausibility check of a converged solve: None when plausible, else why not (a line).
 Plausibility = Callable[[StagedRun], str | None]

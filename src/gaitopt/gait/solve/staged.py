@@ -184,9 +184,11 @@ class _Run:
     """One call of :func:`solve_walking`: runs stages and records them."""
 
     def __init__(self, model: RobotModel, options: GaitOptions, progress: ProgressFn | None,
-                 compiled: str | None) -> None:
+                 compiled: str | None, stage_seconds: float | None = None) -> None:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
+        #: IPOPT's wall-time limit (s) of each stage (``ipopt.max_wall_time``), or None.
+        self.stage_seconds = stage_seconds
         #: The model's size (:mod:`gaitopt.gait.options.model_scale`) and reference speed (m/s).
         self.scale = model_scale(model)
         self.reference_speed = reference_speed(model, options)
@@ -215,6 +217,9 @@ class _Run:
                                compiled=self.compiled)
         if is_mesh(knots) or tuple(knots) != coarse_knots(self.options):
             solver_options = {**fine_grid_options(self.options), **(solver_options or {})}
+        if self.stage_seconds is not None:
+            solver_options = {**(solver_options or {}),
+                              "ipopt.max_wall_time": float(self.stage_seconds)}
         start = time.perf_counter()
         nlp_bounds = with_step_time(stage_bounds(tr, relax, self.options), self.options)
         if hold_ankles:
@@ -540,7 +545,8 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   progress: ProgressFn | None = None,
                   compiled: str | None = None,
                   check_warm_start: bool = False,
-                  check_start: WarmStart | None = None) -> StagedRun:
+                  check_start: WarmStart | None = None,
+                  stage_seconds: float | None = None) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
     succeeded and which stage failed.
@@ -548,7 +554,8 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
     (:mod:`gaitopt.gait.solve.refinement` solves each finer grid so), restarted from
-    ``check_start`` where it fits (:meth:`_Run.check`).
+    ``check_start`` where it fits (:meth:`_Run.check`). ``stage_seconds``: a wall-time
+    limit (s) of each IPOPT stage (a stage that reaches it fails), or None.
 
     Raises:
         GaitOptionsError: invalid options, or a step so long that no naive start can place
@@ -559,7 +566,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()
-    run = _Run(model, options, progress, compiled)
+    run = _Run(model, options, progress, compiled, stage_seconds)
     result: Result | None = None
     if warm_start is not None:
         result = run.stage("warm start", warm_start_grid(model, options, warm_start), Relaxation(),
