@@ -67,6 +67,18 @@ def model_defaults(options: GaitOptions) -> tuple[str, ...]:
 
 
 @pytest.fixture(scope="session")
+def five() -> RobotModel:
+    """The five-link biped (the built-in model)."""
+    return load_model("five-link")
+
+
+@pytest.fixture(scope="session")
+def seven() -> RobotModel:
+    """The seven-link biped with feet (the built-in model)."""
+    return load_model("seven-link")
+
+
+@pytest.fixture(scope="session")
 def solved() -> Iterator[SolveFn]:
     """``solved(options=GaitOptions.paper(), model="five-link") -> Solved``, memoised per
     session."""

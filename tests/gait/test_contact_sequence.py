@@ -16,7 +16,6 @@ from gaitopt.gait.sequence.contact_sequence import (
     check_sequence,
     sequence_from_dict,
 )
-from gaitopt.robot.loader import load_model
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import leg_swap
 
@@ -30,14 +29,6 @@ PAPER = {
 }
 
 
-@pytest.fixture(scope="module")
-def seven() -> RobotModel:
-    return load_model("seven-link")
-
-
-@pytest.fixture(scope="module")
-def five() -> RobotModel:
-    return load_model("five-link")
 
 
 def swap(model: RobotModel) -> dict[str, str]:

@@ -54,14 +54,6 @@ FREE_WALK: dict[str, Any] = {
 }
 
 
-@pytest.fixture(scope="module")
-def five() -> RobotModel:
-    return load_model("five-link")
-
-
-@pytest.fixture(scope="module")
-def seven() -> RobotModel:
-    return load_model("seven-link")
 
 
 def _swap(model: RobotModel) -> dict[str, str]:
