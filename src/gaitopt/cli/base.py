@@ -22,6 +22,8 @@ from gaitopt.robot import ModelError
 if TYPE_CHECKING:
     from rich.console import Console
 
+    from gaitopt.study.executors import Backend
+
 #: Exception types that are the user's to fix: shown as one line, exit status 2.
 USER_ERRORS: tuple[type[Exception], ...] = (ModelError,)
 
@@ -265,3 +267,43 @@ def make_console() -> Console:
 @click.version_option(__version__, prog_name="gaitopt")
 def cli() -> None:
     """gaitopt: energy-optimal walking gaits for planar multibody bipeds."""
+
+
+class SharedBackend:
+    """The one executor of a study's sweeps (``gaitopt study --costs``, ``--walk-run``): made
+    on first use (:meth:`get`; a :class:`~gaitopt.study.executors.BackendError` becomes a
+    :class:`UserError`), closed on leaving the ``with`` block: after the points it runs, or,
+    on an error or Ctrl-C, without waiting for them (local worker processes are ended)."""
+
+    def __init__(self, workers: int | None, scheduler: str | None) -> None:
+        self.workers, self.scheduler = workers, scheduler
+        #: The executor, once made (None before, and after :meth:`close_now`).
+        self.backend: Backend | None = None
+
+    def get(self) -> Backend:
+        """The executor, made now if not yet."""
+        from gaitopt.study.driver import make_backend
+        from gaitopt.study.executors import BackendError
+
+        if self.backend is None:
+            try:
+                self.backend = make_backend(workers=self.workers, scheduler=self.scheduler)
+            except BackendError as exc:
+                raise UserError(str(exc)) from None
+        return self.backend
+
+    def close_now(self) -> None:
+        """Close the executor without waiting for its running points (Ctrl-C)."""
+        if self.backend is not None:
+            self.backend.close(wait=False)
+            self.backend = None
+
+    def __enter__(self) -> SharedBackend:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, *_: object) -> None:
+        if exc_type is not None:
+            self.close_now()
+        elif self.backend is not None:
+            self.backend.close()
+            self.backend = None

@@ -11,11 +11,10 @@ from pathlib import Path
 
 from rich.console import Console
 
-from gaitopt.cli.base import UserError, parse_knots
+from gaitopt.cli.base import SharedBackend, UserError, parse_knots
 from gaitopt.cli.report import write_cost_reports
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.robot.biped import BipedStructureError
-from gaitopt.study.executors import BackendError
 from gaitopt.study.plan import START_SPEED, SweepSpec, SweepSpecError
 from gaitopt.study.worker import PointOutcome
 from gaitopt.units import parse_speed
@@ -72,7 +71,6 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
         write_settings,
     )
     from gaitopt.study.cost_table import write_cost_table
-    from gaitopt.study.driver import make_backend
 
     start = time.perf_counter()
     powers: list[float] = []
@@ -106,23 +104,18 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
     console.print(f"cost study {directory}: {n_cases} cases "
                   f"({', '.join(m.name for m in spec.models)} x "
                   f"{', '.join(c.tag for c in spec.cases)})", soft_wrap=True)
-    backend = None
+    shared = SharedBackend(workers, scheduler)
     counted = 0
 
     def run_sweep(sweep: CostSweep, count: str, *, folder: Path | None = None,
                   spec_: SweepSpec | None = None, seeds: dict[str, Path] | None = None,
                   how: str = "") -> None:
-        nonlocal backend
         console.print(f"{count} {sweep.model} ({sweep.formulation}): {sweep.case.label}, "
                       f"{how or f'from {sweep.spec.speeds[0] * 60.0:g} m/min'}",
                       soft_wrap=True)
-        if backend is None:
-            try:
-                backend = make_backend(workers=workers, scheduler=scheduler)
-            except BackendError as exc:
-                raise UserError(str(exc)) from None
         run_with_progress(console, spec_ or sweep.spec, folder or directory / sweep.subdir,
-                          workers=workers, scheduler=scheduler, backend=backend, seeds=seeds)
+                          workers=workers, scheduler=scheduler, backend=shared.get(),
+                          seeds=seeds)
 
     def continued(sweep: CostSweep, done: list[CostSweep], count: str) -> None:
         """A case of the continuation strategy (gaitopt.study.cost_continuation): the first
@@ -151,7 +144,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                        + (f"started from {near.tag}'s walk there" if seeds and near
                           else "cold")))
 
-    try:
+    with shared:  # closed without waiting for running points on Ctrl-C or an error
         for model in spec.models:
             if spec.auto_start:  # the paper case first: its optimum sets the others' start
                 counted += "paper" in spec.costs
@@ -170,7 +163,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                 else:
                     run_sweep(sweep, f"[{counted}/{n_cases}]")
                 solved_cases.append(sweep)
-        if backend is not None:
+        if (backend := shared.backend) is not None:
             def done(sweep: CostSweep, outcome: PointOutcome | None, path: Path | None) -> None:
                 what = (f"{outcome.row.speed_m_min:6.2f} m/min  step {outcome.row.step_length:.4f}"
                         f" m  cost {outcome.row.cost:.4g}" if path is not None and outcome
@@ -183,8 +176,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
             try:
                 kept, solved, failed = run_direct_solves(spec, directory, backend, done)
             except KeyboardInterrupt:
-                backend.close(wait=False)
-                backend = None
+                shared.close_now()
                 console.print("interrupted: every finished solve is saved; rerun the same "
                               "command to resume", soft_wrap=True)
                 sys.exit(130)
@@ -217,20 +209,11 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                 try:
                     solved, failed = run_accuracy(spec, directory, backend, refined)
                 except KeyboardInterrupt:
-                    backend.close(wait=False)
-                    backend = None
+                    shared.close_now()
                     console.print("interrupted: every finished solve is saved; rerun the "
                                   "same command to resume", soft_wrap=True)
                     sys.exit(130)
                 console.print(f"accuracy: {solved} solved, {failed} failed", soft_wrap=True)
-    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
-        if backend is not None:
-            backend.close(wait=False)
-            backend = None
-        raise
-    finally:
-        if backend is not None:
-            backend.close()
     rows = collect_rows(spec, directory)
     table = write_cost_table(directory, rows)
     console.print(f"table: {table}", soft_wrap=True)

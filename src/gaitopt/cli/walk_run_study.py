@@ -10,11 +10,10 @@ from pathlib import Path
 
 from rich.console import Console
 
-from gaitopt.cli.base import UserError, parse_knots
+from gaitopt.cli.base import SharedBackend, UserError, parse_knots
 from gaitopt.cli.sweep_grid import parse_speeds
 from gaitopt.cli.sweep_progress import run_with_progress
 from gaitopt.robot.biped import BipedStructureError
-from gaitopt.study.executors import Backend, BackendError
 from gaitopt.study.plan import SweepSpecError
 
 
@@ -26,7 +25,7 @@ def run_walk_run_study(console: Console, directory: Path, model_names: Sequence[
     before anything is solved; a rerun resumes (each sweep keeps its finished points)."""
     from gaitopt.gait.api import as_model
     from gaitopt.gait.options.gait_options import GaitOptionsError
-    from gaitopt.study.driver import check_points, make_backend
+    from gaitopt.study.driver import check_points
     from gaitopt.study.findings import findings_text
     from gaitopt.study.walk_run import (
         WalkRunSpec,
@@ -56,18 +55,13 @@ def run_walk_run_study(console: Console, directory: Path, model_names: Sequence[
     console.print(f"walk-run study {directory}: {len(sweeps)} sweeps "
                   f"({', '.join(m.name for m in spec.models)} x {', '.join(spec.costs)} x "
                   "their branches)", soft_wrap=True)
-    backend: Backend | None = None
-    try:
+    with SharedBackend(workers, scheduler) as shared:  # not waited for on Ctrl-C, an error
         for k, (subdir, model, cost, branch, sweep) in enumerate(sweeps, start=1):
             console.print(f"[{k}/{len(sweeps)}] {model.name}: {branch.label}, {cost} cost, "
                           f"{len(sweep.speeds)} speeds {sweep.speeds[0] * 60:g}-"
                           f"{sweep.speeds[-1] * 60:g} m/min, {sweep.knots[0]}+{sweep.knots[1]} "
                           "knots", soft_wrap=True)
-            if backend is None:
-                try:
-                    backend = make_backend(workers=workers, scheduler=scheduler)
-                except BackendError as exc:
-                    raise UserError(str(exc)) from None
+            backend = shared.get()
             report = run_with_progress(console, sweep, directory / subdir, workers=workers,
                                        scheduler=scheduler, backend=backend)
             if report.counts.failed:  # once more, from the converged neighbours' gait files
@@ -75,14 +69,6 @@ def run_walk_run_study(console: Console, directory: Path, model_names: Sequence[
                               "its converged neighbour's gait file", soft_wrap=True)
                 run_with_progress(console, sweep, directory / subdir, workers=workers,
                                   scheduler=scheduler, backend=backend)
-    except BaseException:  # Ctrl-C in a sweep (exit 130), an error: don't wait for workers
-        if backend is not None:
-            backend.close(wait=False)
-            backend = None
-        raise
-    finally:
-        if backend is not None:
-            backend.close()
     rows = collect_rows(spec, directory)
     table = write_table(directory, rows)
     found = transitions(spec, rows)
