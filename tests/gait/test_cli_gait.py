@@ -13,6 +13,7 @@ from typing import Any
 import pytest
 from click.testing import CliRunner, Result
 
+from gaitopt.analysis.verify import Check, VerifyReport, verify_gait
 from gaitopt.cli import cli
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait
@@ -49,6 +50,43 @@ def test_solve_prints_a_summary_and_writes_a_gait_that_verifies(
     assert [p.name for p in tmp_path.iterdir()] == [out.name]  # atomic: no temporary left
     verified = CliRunner().invoke(cli, ["verify", str(out)])
     assert verified.exit_code == 0, verified.output
+
+
+def test_solve_keeps_verify_in_the_file(tmp_path: Path) -> None:
+    """The solve runs verify's checks on its gait and keeps the outcome (``solver.verify``);
+    ``--no-verify`` leaves it out."""
+    out = tmp_path / "coarse.gait.json"
+    result = solve("--knots", "4,3", "-o", str(out))
+    assert result.exit_code == 0, result.output
+    record = Gait.load(out).solver["verify"]
+    independent = verify_gait(Gait.load(out))
+    assert record["passed"] is True and independent.passed
+    assert record["checks"] == len(independent.checks) and record["failed"] == []
+    assert "verify: all" in result.output
+    unchecked = tmp_path / "unchecked.gait.json"
+    result = solve("--knots", "4,3", "--no-verify", "-o", str(unchecked))
+    assert result.exit_code == 0, result.output
+    assert "verify" not in Gait.load(unchecked).solver
+
+
+def test_a_gait_verify_rejects_is_written_with_exit_status_4(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Never exit 0 with a gait that verify rejects: the file says which checks failed (the
+    rejection stands in for a solve whose re-integration fails, e.g. a run under-resolved)."""
+    def rejects(gait: Gait, **_: Any) -> VerifyReport:
+        checks = verify_gait(gait).checks
+        return VerifyReport(tuple(Check(c.id, 2 * c.limit + 1.0, c.limit, "made to fail")
+                                  if c.id == "swing.reversals" else c for c in checks))
+
+    monkeypatch.setattr("gaitopt.analysis.verify.verify_gait", rejects)
+    out = tmp_path / "rejected.gait.json"
+    result = solve("--knots", "4,3", "-o", str(out))
+    assert result.exit_code == 4, result.output
+    text = " ".join(result.output.split())
+    assert "VERIFY FAILS 1 of" in text and "swing.reversals (7 > 3 turns)" in text
+    record = Gait.load(out).solver["verify"]
+    assert record["passed"] is False
+    assert [c["id"] for c in record["failed"]] == ["swing.reversals"]
 
 
 @pytest.fixture

@@ -24,8 +24,4 @@ def verified(run: StagedRun) -> str | None:
     except MotionOutOfReachError as exc:
         return f"its motion cannot be recorded ({exc})"
     report = verify_gait(gait)
-    if report.passed:
-        return None
-    failed = [c for c in report.checks if not c.passed]
-    return "verify fails " + ", ".join(
-        f"{c.id} ({c.value:.3g} > {c.limit:.3g} {c.unit})".replace(" )", ")") for c in failed)
+    return None if report.passed else "verify fails " + report.failed_text()

@@ -79,6 +79,20 @@ class VerifyReport:
         """Plain JSON data: ``passed`` and the list of ``checks`` (:meth:`Check.to_dict`)."""
         return {"passed": self.passed, "checks": [c.to_dict() for c in self.checks]}
 
+    def failed_text(self) -> str:
+        """The failed checks in one line, each with its value, limit and unit (e.g.
+        ``swing.reversals (6 > 3 turns), integration.interval (0.031 > 0.01)``); empty when
+        every check passed."""
+        return ", ".join(f"{c.id} ({c.value:.3g} > {c.limit:.3g} {c.unit})".replace(" )", ")")
+                         for c in self.checks if not c.passed)
+
+    def record(self) -> dict[str, object]:
+        """What a solve keeps of this report in its gait file (``solver.verify``,
+        docs/outputs.md): ``passed``, the number of ``checks`` and the ``failed`` ones
+        (:meth:`Check.to_dict`)."""
+        return {"passed": self.passed, "checks": len(self.checks),
+                "failed": [c.to_dict() for c in self.checks if not c.passed]}
+
 
 def verify_gait(gait: Gait, *, tolerance_scale: float = 1.0) -> VerifyReport:
     """Run every check on ``gait`` (see the module docstring).

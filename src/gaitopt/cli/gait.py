@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from pathlib import Path
@@ -235,6 +236,10 @@ def _step_time(text: str) -> float | None:
 @click.option("--warm-start", "warm_start", type=click.Path(dir_okay=False, path_type=Path),
               default=None, help="A gait file to start from (e.g. a neighbouring speed's "
                                  "gait); the cold path is the fallback.")
+@click.option("--verify/--no-verify", "check", default=True, show_default=True,
+              help="Run gaitopt verify's checks on the gait before writing it, keep the outcome "
+                   "in the file (solver.verify) and exit with status 4 if a check fails "
+                   "(0.2-1.5 s).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | None,
@@ -253,9 +258,10 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   control_model: str | None, mesh_tol: float | None, accuracy: float,
                   clearance: float | None, clearance_profile: str, compiled: bool,
                   multistart: bool | None,
-                  warm_start: Path | None, output: Path) -> None:
+                  warm_start: Path | None, check: bool, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
     from gaitopt.analysis.plausible import verified
+    from gaitopt.analysis.verify import verify_gait
     from gaitopt.cli.gait_summary import summary_table
     from gaitopt.gait.api import as_model, solve_staged_run, warm_start_usable
     from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
@@ -387,6 +393,13 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       f"{solution.share_release['fixed_cost']:.6g}"
                       + ("" if solution.share_release["free_cost"] is None else
                          f", free J {solution.share_release['free_cost']:.6g}") + ")")
+    report = None
+    if check:
+        report = verify_gait(gait)
+        gait = dataclasses.replace(gait, solver={**gait.solver, "verify": report.record()})
+        console.print(f"verify: all {len(report.checks)} checks pass" if report.passed else
+                      f"VERIFY FAILS {len(report.failed_ids)} of {len(report.checks)} checks: "
+                      f"{report.failed_text()} (gaitopt verify {output} for the table)")
     gait.save(output)
     console.print(f"wrote {output}")
     record = gait.solver.get("accuracy", {})
@@ -401,6 +414,8 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       f"the gait file says so (gaitopt verify: accuracy.estimate). Try "
                       "--knots with more knots, --mesh-tol 1e-4, or --accuracy 0.02")
         sys.exit(3)
+    if report is not None and not report.passed:
+        sys.exit(4)
 
 
 @cli.command("verify")

@@ -58,6 +58,11 @@ def check_solver(value: Any) -> dict[str, Any]:
             raise bad_field(f"solver.evaluations.{kind}",
                             f"expected an integer >= 0, got {count!r}")
     solver["evaluations"] = {str(k): int(v) for k, v in evaluations.items()}
+    if "verify" in solver:  # the solve's own run of verify's checks (gaitopt solve)
+        record = mapping_of("solver.verify", solver["verify"], required=("passed", "failed"))
+        if not isinstance(record["passed"], bool) or not isinstance(record["failed"], list):
+            raise bad_field("solver.verify", "expected passed (true or false) and failed (a "
+                            "list of the failed checks)")
     if "diagnosis" in solver and not isinstance(solver["diagnosis"], str):
         raise bad_field("solver.diagnosis", "expected a string (the diagnosis of a failed "
                         "solve)")
