@@ -34,6 +34,7 @@ from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.staged import StagedRun, solve_walking
+from gaitopt.gait.solve.warm_accuracy import check_point
 from gaitopt.ocp import Guess, Result, WarmStart
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
@@ -127,22 +128,26 @@ def worker_name() -> str:
     return f"{socket.gethostname()}:{os.getpid()}"
 
 
-def _warm_start(task: PointTask) -> tuple[Guess | Result | WarmStart | None, str]:
+def _warm_start(task: PointTask) -> tuple[Guess | Result | WarmStart | None, str,
+                                         WarmStart | None]:
     """The start of ``task``: its Result; from a gait file the NLP point and multipliers the
     file keeps when they fit the point's transcription (the same grid and problem structure:
     :func:`gaitopt.gait.api.restart_point`; ``file``), else the file's trajectories (``file,
-    values``); None (``none``) for a cold start."""
+    values``); None (``none``) for a cold start. Third: the file's check-grid point
+    (``solver.warm_start_check``, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) for
+    the point's check grid (used where it fits), else None."""
     if isinstance(task.warm, Result):
-        return task.warm, "result"
+        return task.warm, "result", None
     if isinstance(task.warm, SavedGait):
         try:
             gait = Gait.from_dict(json.loads(task.warm.text), source=task.warm.source)
             point = restart_point(task.model, task.options, gait)
-            return (point, "file") if point is not None else (guess_from_gait(gait),
-                                                              "file, values")
+            check = check_point(gait) if task.check_grid else None
+            return ((point, "file", check) if point is not None
+                    else (guess_from_gait(gait), "file, values", check))
         except (GaitFileError, KeyError, ValueError):
-            return None, "file unreadable"
-    return None, "none"
+            return None, "file unreadable", None
+    return None, "none", None
 
 
 def failed_point_row(task: PointTask, status: str, *, iterations: int = 0,
@@ -166,7 +171,7 @@ def solve_point(task: PointTask) -> PointOutcome:
     clock = time.perf_counter
     start = clock()
     with _LOCK:  # a start from a file's NLP point builds (or reuses) the process's transcription
-        warm, how = _warm_start(task)
+        warm, how, check = _warm_start(task)
     timings = {"warm_start_s": clock() - start}
     options = task.options.replace(max_iter=1) if task.force_fail else task.options
     solution: StagedRun | None = None
@@ -176,7 +181,7 @@ def solve_point(task: PointTask) -> PointOutcome:
     try:
         with _LOCK:
             solution = solve_walking(task.model, options, warm_start=warm,
-                                     check_warm_start=task.check_grid)
+                                     check_warm_start=task.check_grid, check_start=check)
             ipopt = sum(s.wall_time_s for s in solution.stages)
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt
