@@ -72,8 +72,12 @@ def test_multistart_keeps_the_lower_final_optimum_not_the_lower_coarse_one(
     continuation in speed reach two coarse optima whose costs in the cold stages' problem
     differ by 0.06 %, the long-step one lower; taken to the end, the continuation's is 16 %
     lower (the sweep's branch). Multistart keeps it, and the cost error estimate is the
-    kept start's (its own coarse cost)."""
-    options = GaitOptions(speed=1.0, ankle=False, impulse=False)
+    kept start's (its own coarse cost).
+
+    The accuracy is loosened to 5 % so that no refinement round follows the starts: at 1 %
+    the kept start's largest estimate lies within a few hundredths of a per cent of the
+    target, so whether a round follows depends on the machine's last bits."""
+    options = GaitOptions(speed=1.0, ankle=False, impulse=False, accuracy=0.05)
     single = solved(options).gait
     multi = solved(options.replace(multistart=True))
     gait = multi.gait
