@@ -220,10 +220,12 @@ def test_the_command_line_passes_the_choice_and_the_verify_check(
 # -- the seven-link default solves (slow: minutes each) -------------------------------------
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("speed", "released"), [(0.5, True), (0.2, False)])
+@pytest.mark.parametrize(("speed", "released"), [(0.5, True), (4 / 3, True), (0.2, False)])
 def test_the_seven_link_default_releases_its_shares_where_plausible(
         seven: RobotModel, speed: float, released: bool) -> None:
-    """30 m/min: the released optimum costs about 40 % less and passes verify; 12 m/min:
+    """30 m/min: the released optimum costs about 40 % less and passes verify; 80 m/min:
+    about 22 % less (1804.4 against 2319.3), reached by the free problem's own stages after
+    the start from the fixed-share optimum crawled (its check grid at the limit); 12 m/min:
     the fixed shares are kept (the free optimum flaps the foot, swing.reversals fails; with
     the release's iteration limit its target grid stops there first). Either way the answer
     is converged to 1 % and verified (docs/feet.md, "Free phase shares by default")."""
