@@ -220,6 +220,7 @@ def phase_knots(seq: ContactSequence, knots: Sequence[int] | Mapping[str, int]
     if len(knots) == len(step) > 2:
         return tuple(int(k) for k in knots) * repeats
     first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
+    counts: tuple[int, ...]
     if len(step) == 1:
         counts = (first,)
     else:
