@@ -107,10 +107,11 @@ def test_a_run_frees_its_stance_share_and_lengthens_its_steps() -> None:
 
 
 def test_a_run_clears_its_swing_foot_over_the_stance() -> None:
-    """A run's default swing clearance is :data:`RUN_SWING_CLEARANCE` times the leg length,
-    held by the profile rows of the stance phase on the foot that lands after the flight (a
-    given ``swing_clearance`` was ignored by a run before: its stance ends in no landing); a
-    given clearance stays, and the walk keeps the paper's ``y >= 0``."""
+    """A run on point feet has the default swing clearance :data:`RUN_SWING_CLEARANCE` times
+    the leg length (the seven-link run on its toes none), held by the profile rows of the
+    stance phase on the foot that lands after the flight (a given ``swing_clearance`` was
+    ignored by a run before: its stance ends in no landing); a given clearance stays, and the
+    walk keeps the paper's ``y >= 0``."""
     for name, leg in (("five-link", 1.0), ("adult-point-feet", 0.9275)):
         run = _resolved(name, GaitOptions(gait="run", impulse=False, speed=2.0))
         assert run.swing_clearance == pytest.approx(RUN_SWING_CLEARANCE * leg, rel=1e-3)
@@ -118,10 +119,12 @@ def test_a_run_clears_its_swing_foot_over_the_stance() -> None:
                                                swing_clearance=0.03))
     assert given.swing_clearance == 0.03
     assert _resolved("five-link", GaitOptions()).swing_clearance is None
+    assert _resolved("seven-link", GaitOptions(gait="run", impulse=False,
+                                               speed=2.0)).swing_clearance is None
     for name in ("five-link", "seven-link"):
         model = load_model(name)
         stance, flight = problem_for(model, _resolved(name, GaitOptions(
-            gait="run", impulse=False, speed=2.0))).phases
+            gait="run", impulse=False, speed=2.0, swing_clearance=0.05))).phases
         assert CLEARANCE_PROFILE in [c.name for c in stance.path_constraints]
         assert CLEARANCE_PROFILE not in [c.name for c in flight.path_constraints]
 
