@@ -253,8 +253,10 @@ class Limits:
         friction: a friction coefficient for an optional friction-cone constraint, or None.
         swing_clearance: ``c`` (m), the least mid-swing height of the swing tip: over single
             support ``y >= c (4 s (1 - s))^2`` (``clearance_profile="quartic"``) or
-            ``y >= c 4 s (1 - s)`` (``"parabola"``), ``s`` the normalised phase time; or
-            ``None`` (the paper: ``y >= 0``).
+            ``y >= c 4 s (1 - s)`` (``"parabola"``), ``s`` the normalised phase time (a
+            run's: over the stance); or ``None`` (the paper: ``y >= 0``; a run on point
+            feet then gets ``RUN_SWING_CLEARANCE`` times the leg length,
+            ``gaitopt.gait.options.model_defaults``).
         clearance_profile: ``"quartic"`` or ``"parabola"`` (see ``swing_clearance``). The
             parabola's slope at the ends is a least vertical tip velocity ``4 c / T1`` at the
             liftoff and the heel strike, which makes its cost grow with the grid (measured in
