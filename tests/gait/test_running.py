@@ -118,6 +118,11 @@ def test_a_run_clears_its_swing_foot_over_the_stance() -> None:
     given = _resolved("five-link", GaitOptions(gait="run", impulse=False, speed=2.0,
                                                swing_clearance=0.03))
     assert given.swing_clearance == 0.03
+    none = _resolved("five-link", GaitOptions(gait="run", impulse=False, speed=2.0,
+                                              swing_clearance=0.0))
+    assert none.swing_clearance == 0.0  # the paper's y >= 0: no profile rows
+    stance = problem_for(load_model("five-link"), none).phases[0]
+    assert CLEARANCE_PROFILE not in [c.name for c in stance.path_constraints]
     assert _resolved("five-link", GaitOptions()).swing_clearance is None
     assert _resolved("seven-link", GaitOptions(gait="run", impulse=False,
                                                speed=2.0)).swing_clearance is None

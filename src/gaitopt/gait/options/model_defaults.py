@@ -73,7 +73,8 @@ RUN_STANCE_GUESS = (0.95, 0.3, 0.4, 0.9)
 RUN_STEP_LENGTH_BOUNDS = (0.02, 3.0)
 #: A run's swing clearance on the reference biped (m on legs of 1 m; times ``l / 1 m``): where
 #: the caller gives none, the swing foot stays above ``c (4 s (1 - s))^2`` over the stance
-#: (``s`` its normalised time; ``GaitOptions.swing_clearance``, quartic profile). With only
+#: (``s`` its normalised time; ``GaitOptions.swing_clearance``, quartic profile; a given 0
+#: keeps the paper's ``y >= 0``). With only
 #: ``y >= 0`` the five-link run's swing foot grazed the ground at the other leg's mid-stance
 #: (0 mm at 90 and 120 m/min) and its knee flexed twice in one swing (4 and 6 turns, failing
 #: ``swing.reversals``); with 0.1 m it flexes once (2 turns) for +2.4 % and +0.1 % of the

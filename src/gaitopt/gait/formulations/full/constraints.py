@@ -198,7 +198,7 @@ def phase_path(model: RobotModel, options: GaitOptions, seq: ContactSequence, ph
                          (LANDING_CLEARANCE, [c for c in free if c in landing])):
         if points:
             path.append(height_rows(model, name, points))
-    if options.swing_clearance is not None and phase == 0:
+    if options.swing_clearance and phase == 0:  # None or 0: y >= 0 only
         swinging = landing or (tuple(c for c in seq.events[-1].touchdown if c in free)
                                if len(seq.phases) == 2 else ())
         if swinging:
