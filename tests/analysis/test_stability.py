@@ -342,11 +342,13 @@ def test_single_support_walk_monodromies_agree(single_support_gait: Gait) -> Non
 def run_gait() -> Gait:
     """A run (stance on tip 1, then flight), full coordinates, 60 m/min, 8 + 5 knots: about
     2 s."""
-    # the stance share fixed at 0.85 and the walk's step bounds (a run's defaults free the
-    # share and allow longer steps: docs/running.md)
+    # the stance share fixed at 0.85, the walk's step bounds and y >= 0 (a run's defaults free
+    # the share, allow longer steps and on point feet hold the swing foot above a clearance:
+    # docs/running.md)
     return solve_gait("five-link", GaitOptions.paper(speed=1.0, formulation="full", gait="run",
                                                      impulse=False, single_support_fraction=0.85,
-                                                     step_length_bounds=(0.02, 0.8)))
+                                                     step_length_bounds=(0.02, 0.8),
+                                                     swing_clearance=0.0))
 
 
 def test_run_step_follows_its_contact_sequence(run_gait: Gait) -> None:

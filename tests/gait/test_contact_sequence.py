@@ -10,7 +10,11 @@ from gaitopt.gait.formulations.full.physics import per_point, projection_names
 from gaitopt.gait.formulations.select import checked_sequence, default_formulation
 from gaitopt.gait.guess.sequence import contact_positions, sequence_guess
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
-from gaitopt.gait.sequence.builtin import heel_toe_sequence, walking_sequence
+from gaitopt.gait.sequence.builtin import (
+    heel_toe_sequence,
+    running_sequence,
+    walking_sequence,
+)
 from gaitopt.gait.sequence.contact_sequence import (
     ContactSequenceError,
     check_sequence,
@@ -145,3 +149,22 @@ def test_phase_knots_keep_the_density_of_phase_0(five: RobotModel, seven: RobotM
     # 15 intervals over 0.425 of the step: 35.3 per step; heel off 0.2975 -> 11 intervals,
     # double support 0.15 -> 6, heel rocker 0.1275 -> 5 (at least 6 knots everywhere).
     assert phase_knots(seq, (16, 6)) == (16, 12, 7, 6)
+
+
+@pytest.mark.parametrize("stance", [0.95, 0.85, 0.6, 0.354, 0.2])
+def test_a_runs_flight_is_not_coarser_than_its_stance(five: RobotModel, seven: RobotModel,
+                                                      stance: float) -> None:
+    """Two phases follow the density rule too: a long flight after a short stance gets the
+    stance's knots per share of the step (the 400 m/min run's flight of 65 % had 6 knots on
+    16 + 6, 5.5 times coarser than its stance, and failed ``integration.interval``)."""
+    from gaitopt.gait.sequence.contact_sequence import phase_knots
+
+    for model in (five, seven):
+        for knots in ((16, 6), (8, 5), (24, 8)):
+            first, flight = phase_knots(running_sequence(model, stance), knots)
+            assert first == knots[0]
+            assert flight >= knots[1]
+            density = (first - 1) / stance  # intervals per share of the step
+            assert (flight - 1) / (1 - stance) >= density - 1e-9  # not coarser
+            # and the fewest knots that are not: one interval less would be coarser
+            assert flight == knots[1] or (flight - 2) / (1 - stance) < density

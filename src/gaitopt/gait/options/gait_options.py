@@ -253,8 +253,10 @@ class Limits:
         friction: a friction coefficient for an optional friction-cone constraint, or None.
         swing_clearance: ``c`` (m), the least mid-swing height of the swing tip: over single
             support ``y >= c (4 s (1 - s))^2`` (``clearance_profile="quartic"``) or
-            ``y >= c 4 s (1 - s)`` (``"parabola"``), ``s`` the normalised phase time; or
-            ``None`` (the paper: ``y >= 0``).
+            ``y >= c 4 s (1 - s)`` (``"parabola"``), ``s`` the normalised phase time (a
+            run's: over the stance); ``0`` (the paper: ``y >= 0`` only); or ``None``, the
+            default: 0, except for a run on point feet, which gets ``RUN_SWING_CLEARANCE``
+            times the leg length (``gaitopt.gait.options.model_defaults``).
         clearance_profile: ``"quartic"`` or ``"parabola"`` (see ``swing_clearance``). The
             parabola's slope at the ends is a least vertical tip velocity ``4 c / T1`` at the
             liftoff and the heel strike, which makes its cost grow with the grid (measured in
@@ -924,10 +926,10 @@ def validate_options(options: GaitOptions, biped: Biped | None) -> None:
                                f"of {', '.join(repr(m) for m in CONTROL_MODELS)}")
     if o.swing_clearance is not None:
         c = _finite("limits.swing_clearance", o.swing_clearance)
-        if not 0.0 < c < reach:
-            raise GaitOptionsError(f"limits.swing_clearance = {c:g} m: must lie in (0, "
-                                   f"{reach:.3f}) m (above the ground, below the leg's reach; or "
-                                   "None)")
+        if not 0.0 <= c < reach:
+            raise GaitOptionsError(f"limits.swing_clearance = {c:g} m: must lie in [0, "
+                                   f"{reach:.3f}) m (above the ground, below the leg's reach; 0 "
+                                   "or None: y >= 0 only)")
     if o.clearance_profile not in CLEARANCE_PROFILES:
         raise GaitOptionsError(f"limits.clearance_profile = {o.clearance_profile!r}: must be one "
                                f"of {', '.join(repr(m) for m in CLEARANCE_PROFILES)}")

@@ -196,10 +196,13 @@ def phase_knots(seq: ContactSequence, knots: Sequence[int] | Mapping[str, int]
                 ) -> tuple[int, ...]:
     """Knots of each phase from the ``knots`` option (:mod:`gaitopt.gait.sequence.knots`).
 
-    ``knots = (first, others)``: two-phase sequences (and one) take them as they are (the
-    paper's single and double support); longer ones give phase 0 ``first`` knots and every
-    other phase at least ``others``, more when the density of phase 0 (intervals per share of
-    the step) asks for more, so that long phases are not coarser than phase 0. One count per
+    ``knots = (first, others)``: a one-phase sequence takes ``first``; longer ones give phase
+    0 ``first`` knots and every other phase at least ``others``, more when the density of
+    phase 0 (intervals per share of the step) asks for more, so that long phases are not
+    coarser than phase 0: phase ``i`` of share ``f_i`` gets ``max(others, 1 + ceil((first -
+    1) f_i / f_0))``. The paper's walk (``f_0 = 0.85``) keeps ``(first, others)`` (its double
+    support needs 4 of 6 knots); a run's flight of 65 % of the step after a stance of 35 %
+    gets 1 + 28 knots, not 6 (docs/running.md, "Knots follow the shares"). One count per
     phase of the step, or a mapping phase name -> count naming every phase of the step
     (:func:`~gaitopt.gait.sequence.knots.knots_in_order`): those counts as they are. A
     stride's steps get the knots of one step each (its second step those of the first: like
@@ -217,8 +220,9 @@ def phase_knots(seq: ContactSequence, knots: Sequence[int] | Mapping[str, int]
     if len(knots) == len(step) > 2:
         return tuple(int(k) for k in knots) * repeats
     first, others = int(knots[0]), int(knots[min(1, len(knots) - 1)])
-    if len(step) <= 2:
-        counts = tuple(first if i == 0 else others for i in range(len(step)))
+    counts: tuple[int, ...]
+    if len(step) == 1:
+        counts = (first,)
     else:
         density = (first - 1) / step[0].fraction
         counts = (first,) + tuple(max(others, 1 + math.ceil(density * ph.fraction - 1e-9))

@@ -14,11 +14,12 @@ times the knots), started from the previous grid's gait, whose own check grid th
 next estimate; at most :data:`MAX_ROUNDS` times (16 + 6 -> 24 + 8 -> 36 + 12 -> 54 + 18 on the
 five-link walk). Where the phases' shares of the step are free, each finer grid's knots per
 phase follow the shares the previous grid solved for (``GaitOptions.phase_shares``,
-:func:`solved_shares`): a double support that grew from 15 % to 30 % of the step gets twice
-the knots. The answer is the finest converged grid's gait, with ``accuracy.target``,
-``accuracy.within_target`` and ``accuracy.refinements`` in its file; the command line exits
-with status 3 when it is not within the target, and ``gaitopt verify`` fails its check
-``accuracy.estimate``.
+:func:`solved_shares`; the density rule of
+:func:`gaitopt.gait.sequence.contact_sequence.phase_knots`): a run's flight that grew to 65 %
+of the step after a stance of 35 % gets 1 + 28 knots on 16 + 6, not 6. The answer is the
+finest converged grid's gait, with ``accuracy.target``, ``accuracy.within_target`` and
+``accuracy.refinements`` in its file; the command line exits with status 3 when it is not
+within the target, and ``gaitopt verify`` fails its check ``accuracy.estimate``.
 """
 
 from __future__ import annotations

@@ -147,8 +147,8 @@ def height_rows(model: RobotModel, name: str, points: Sequence[str]) -> PathCons
 def clearance_profile_rows(model: RobotModel, options: GaitOptions, points: Sequence[str],
                            duration: Callable[[Any], Any]) -> PathConstraint:
     """:data:`CLEARANCE_PROFILE`, the swing clearance of the first phase: ``y_c(q) -
-    profile(s) >= 0`` (m) for each of ``points`` (those landing at its end), ``profile`` the
-    reduced problem's
+    profile(s) >= 0`` (m) for each of ``points`` (the swing foot's, :func:`phase_path`),
+    ``profile`` the reduced problem's
     (:func:`~gaitopt.gait.formulations.reduced.constraints.clearance_profile`, of height
     ``options.swing_clearance``) and ``s = t / T_0``, ``T_0 = duration(p)`` the phase's
     duration ``f steps L / v`` (s); one row per point, scale a length."""
@@ -181,7 +181,10 @@ def phase_path(model: RobotModel, options: GaitOptions, seq: ContactSequence, ph
     :func:`contact_force_rows` if a point is held; :func:`height_rows` of the free points
     (:data:`CLEARANCE`), then of those landing at the phase's end
     (:data:`LANDING_CLEARANCE`), where there are any; and in the first phase, with a swing
-    clearance and a landing, :func:`clearance_profile_rows`."""
+    clearance, :func:`clearance_profile_rows` of the points landing at its end or, in a step
+    of two phases where none does (a run's stance, whose swing foot lands after the flight),
+    of its free points that land at the step's end (a longer step's first phase without a
+    landing has none)."""
     held = seq.phases[phase].held
     path: list[PathConstraint] = []
     stated = [(c, a) for c, a in hold_axes(held) if c != placed]
@@ -195,8 +198,12 @@ def phase_path(model: RobotModel, options: GaitOptions, seq: ContactSequence, ph
                          (LANDING_CLEARANCE, [c for c in free if c in landing])):
         if points:
             path.append(height_rows(model, name, points))
-    if options.swing_clearance is not None and phase == 0 and landing:
-        path.append(clearance_profile_rows(model, options, landing, phase_duration(seq, 0)))
+    if options.swing_clearance and phase == 0:  # None or 0: y >= 0 only
+        swinging = landing or (tuple(c for c in seq.events[-1].touchdown if c in free)
+                               if len(seq.phases) == 2 else ())
+        if swinging:
+            path.append(clearance_profile_rows(model, options, swinging,
+                                               phase_duration(seq, 0)))
     return path
 
 

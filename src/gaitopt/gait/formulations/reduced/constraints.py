@@ -175,7 +175,7 @@ def single_support_path(model: RobotModel, options: GaitOptions, point: PointFn
     :func:`clearance_profile_rows`."""
     path = [stance_force_rows(model, options.friction, point),
             swing_clearance_and_hip_rows(model, point)]
-    if options.swing_clearance is not None:
+    if options.swing_clearance:  # None or 0: y >= 0 only
         path.append(clearance_profile_rows(model, options, point))
     return path
 
