@@ -41,6 +41,7 @@ from gaitopt.gait.solve.diagnose import SolveFailedError, diagnose
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.refinement import refine_to_accuracy
 from gaitopt.gait.solve.share_release import (
+    FROM_FIXED,
     PREFIX,
     RELEASE_STAGE_SECONDS,
     Plausibility,
@@ -206,32 +207,30 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
             and releases_shares(robot, run.options)):
 
         def released(free: GaitOptions, fixed: StagedRun) -> StagedRun:
-            start = _prefixed(solve_walking(robot, free, warm_start=fixed.result,
-                                            progress=_prefixed_progress(progress, PREFIX),
-                                            compiled=compiled, check_warm_start=True,
-                                            stage_seconds=RELEASE_STAGE_SECONDS),
-                              PREFIX)
-            if start.success and accuracy_record(start).get("cost_error") is None:
-                # From the fixed-share optimum IPOPT crawls where the shares move far
-                # (seven-link, 80 m/min: the heel-off share halved; J 1867, then its check
-                # grid at the 300-iteration limit), while the free problem's own stages,
-                # shares freed on the coarse grid, reach 1804.4 with both check grids
-                # converged (docs/feet.md). A warm start that fails takes that path itself.
-                cold_prefix = PREFIX + "cold: "
-                cold = _prefixed(solve_walking(robot, free,
+            # The free problem from its own stages first (the shares freed on the coarse
+            # grid): measured on the seven-link, it reached the start from the fixed-share
+            # optimum's optima at 12, 30 and 60 m/min and lower ones at 80 m/min (1804.3
+            # against 1867.4, where that start crawled) and with the speed free
+            # (share_release's module docstring, docs/feet.md).
+            run = _prefixed(solve_walking(robot, free,
+                                          progress=_prefixed_progress(progress, PREFIX),
+                                          compiled=compiled,
+                                          stage_seconds=RELEASE_STAGE_SECONDS), PREFIX)
+            if not run.success or accuracy_record(run).get("cost_error") is None:
+                warm = _prefixed(solve_walking(robot, free, warm_start=fixed.result,
                                                progress=_prefixed_progress(progress,
-                                                                           cold_prefix),
-                                               compiled=compiled,
+                                                                           FROM_FIXED),
+                                               compiled=compiled, check_warm_start=True,
                                                stage_seconds=RELEASE_STAGE_SECONDS),
-                                 cold_prefix)
-                start = dataclasses.replace(cold, stages=start.stages + cold.stages,
-                                            wall_time_s=start.wall_time_s + cold.wall_time_s)
-            if accuracy_record(start).get("cost_error") is None:
+                                 FROM_FIXED)
+                run = dataclasses.replace(warm, stages=run.stages + warm.stages,
+                                          wall_time_s=run.wall_time_s + warm.wall_time_s)
+            if accuracy_record(run).get("cost_error") is None:
                 # Its check grid failed: no estimate, so not within the accuracy, and the
                 # fixed shares stand; refining it further took 10 minutes and more.
-                return start
+                return run
             return refine_to_accuracy(
-                start, refines=refines, accuracy_of=accuracy_record,
+                run, refines=refines, accuracy_of=accuracy_record,
                 solve_on=lambda o, before: solve_on(o, before, PREFIX,
                                                     RELEASE_STAGE_SECONDS))[0]
 

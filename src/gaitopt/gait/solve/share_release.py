@@ -9,10 +9,13 @@ sequence's own guesses (a built-in sequence of more than two phases: the heel-to
 1. the problem with the shares fixed, refined to ``GaitOptions.accuracy`` (the solve as
    before);
 2. the same problem with every share free (``free_phase_fractions=True``: each within
-   ``[s / 2, min(2 s, 0.95)]`` of its share ``s``), on the first part's final grid, started
-   from its optimum (values only, the NLPs differ by the share parameters), then refined to
-   the accuracy with each phase's knots following the shares solved
-   (:mod:`gaitopt.gait.solve.refinement`). Its stages are named ``shares free: ...``.
+   ``[s / 2, min(2 s, 0.95)]`` of its share ``s``), on the first part's final grid, solved
+   from its own stages (the naive guess, the shares freed on the coarse grid: stage ``phase
+   fractions free``), or, where that fails or its check grid does not converge, started
+   from the first part's optimum (values only, the NLPs differ by the share parameters;
+   stages ``shares free: from the fixed shares: ...``); then refined to the accuracy with
+   each phase's knots following the shares solved (:mod:`gaitopt.gait.solve.refinement`).
+   Its stages are named ``shares free: ...``.
 
 The answer is the released optimum when it converged, is within the accuracy whenever the
 fixed one is, costs less (by more than :data:`SAME_COST`, relative) and passes the caller's
@@ -20,12 +23,14 @@ plausibility check (``plausible``: e.g. the swing checks of ``gaitopt verify``, 
 above this layer); otherwise the fixed-share optimum, and the gait file says which and why
 (``solver.phase_shares``, :func:`decision`).
 
-Why released last rather than free from the first stage (``free_phase_fractions=True``): the
-fixed-share optimum is the fallback, so it is solved anyway, and the release starts from it:
-at 12 and 30 m/min it reached the optima of the shares freed from the first stage, and with
-the speed free it stays near the fixed-share optimum's speed, where a cold speed-free solve
-with free shares ended at 12.9 m/min, a poor local optimum (docs/feet.md, "Free phase shares
-by default").
+Why the free problem from its own stages, not from the fixed-share optimum (measured on the
+seven-link, 2026-12-03, docs/feet.md "Free phase shares by default"): both reach the same
+optima at 12, 30 and 60 m/min (3605, 2035.1, 1655.8), but from the fixed-share optimum IPOPT
+crawls where the shares move far: at 80 m/min it stopped at J 1867.4, a point whose check grid
+ran to the iteration limit, where the free problem's own stages reach 1804.3 and converge on
+three grids; with the speed free, 1787.2 at 62.2 m/min (check grid failed) against 1707.8 at
+58.4 m/min. The fixed-share optimum is still solved first: it is the fallback, and the
+answer wherever the release is not kept.
 
 A two-phase walk's single-support share is the problem's own datum (the paper's 0.85, the
 user's ``single_support_fraction``): it stays fixed, and so do shares the caller gave (a
@@ -46,6 +51,9 @@ from gaitopt.robot.model import RobotModel
 
 #: Put before the name of every stage of the released solve.
 PREFIX = "shares free: "
+#: Put before the name of every stage of the released solve started from the fixed-share
+#: optimum (where the free problem's own stages failed or left no estimate).
+FROM_FIXED = PREFIX + "from the fixed shares: "
 #: The released optimum is kept only when it costs less than the fixed-share one by more
 #: than this (relative): within it the two are the same optimum, and the fixed shares (the
 #: sequence's, as documented) are kept.
