@@ -180,6 +180,16 @@ def reference_speed(model: RobotModel, options: GaitOptions) -> float:
     return default_speed(model, gait)
 
 
+def step_held_bounds(options: GaitOptions, result: Result) -> dict[str, Any]:
+    """The parameter bounds of ``options`` with the step length (m) and the speed (m/s) held
+    at ``result``'s values (a stage on another grid or with another smoothing started from
+    ``result``, whose release follows)."""
+    held = dict(parameter_bounds(options))
+    for key in ("step_length", "speed"):
+        held[key] = (result.parameters[key], result.parameters[key])
+    return held
+
+
 class _Run:
     """One call of :func:`solve_walking`: runs stages and records them."""
 
@@ -388,8 +398,11 @@ class _Run:
         with its multipliers and the warm-start options of the transcription, where it
         fits. Otherwise a cost with kinks first climbs
         :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` (stages ``check grid,
-        eps E W``), each stage from the last with its multipliers, every one with the
-        transcription's warm-start barrier (1e-6) instead of :data:`REGRID_OPTIONS`."""
+        eps E W, step held``) with the step length and speed held at ``result``'s
+        (:func:`step_held_bounds`: the coarse smoothings' own optima lie elsewhere, a slow
+        work optimum's at twice its speed), each stage from the last with its multipliers,
+        every one with the transcription's warm-start barrier (1e-6) instead of
+        :data:`REGRID_OPTIONS`; the last stage frees them."""
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
         if start is not None:
@@ -401,9 +414,10 @@ class _Run:
         point: Result | WarmStart = self.grid_start(grid, result, "check")
         ladder = check_smoothings(o, self.scale)
         warm = None if ladder else REGRID_OPTIONS
+        held = step_held_bounds(o, result)
         for eps in ladder:
-            point = self.stage(f"check grid, eps {eps:.3g} W", grid, Relaxation(), point,
-                               parameter_bounds(o), solver_options=check_grid_options(o),
+            point = self.stage(f"check grid, eps {eps:.3g} W, step held", grid, Relaxation(),
+                               point, held, solver_options=check_grid_options(o),
                                problem=o.replace(cost_smoothing=eps), warm_start_options=warm)
             if not point.success:
                 return
@@ -429,9 +443,7 @@ class _Run:
         tolerance when a release follows, :func:`~gaitopt.gait.solve.stages.held_stage_options`),
         then (stage ``name, all free``) released."""
         o = self.options
-        held = dict(parameter_bounds(o))
-        for key in ("step_length", "speed"):
-            held[key] = (result.parameters[key], result.parameters[key])
+        held = step_held_bounds(o, result)
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
         fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result, move), held,
