@@ -92,7 +92,7 @@ from gaitopt.gait.options.model_defaults import default_gait, default_speed, opt
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.solve.check_grid import check_knots
 from gaitopt.gait.solve.cost_continuation import (
-    check_smoothings,
+    check_holds_step,
     climb_ladder,
     continues_from_paper,
 )
@@ -396,13 +396,12 @@ class _Run:
         estimate, never changes it. ``start``: a solution of this check grid's NLP (a gait
         file's, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) to restart from instead,
         with its multipliers and the warm-start options of the transcription, where it
-        fits. Otherwise a cost with kinks first climbs
-        :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` (stages ``check grid,
-        eps E W, step held``) with the step length and speed held at ``result``'s
-        (:func:`step_held_bounds`: the coarse smoothings' own optima lie elsewhere, a slow
-        work optimum's at twice its speed), each stage from the last with its multipliers,
-        every one with the transcription's warm-start barrier (1e-6) instead of
-        :data:`REGRID_OPTIONS`; the last stage frees them."""
+        fits. Otherwise, for a cost with kinks on the heel-toe walk
+        (:func:`~gaitopt.gait.solve.cost_continuation.check_holds_step`), a first stage
+        ``check grid, step held`` with the step length and speed held at ``result``'s
+        (:func:`step_held_bounds`), then the stage that frees them, both with the
+        transcription's warm-start barrier (1e-6) instead of :data:`REGRID_OPTIONS`.
+        """
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
         if start is not None:
@@ -412,15 +411,14 @@ class _Run:
                            solver_options=check_grid_options(o))
                 return
         point: Result | WarmStart = self.grid_start(grid, result, "check")
-        ladder = check_smoothings(o, self.scale)
-        warm = None if ladder else REGRID_OPTIONS
-        held = step_held_bounds(o, result)
-        for eps in ladder:
-            point = self.stage(f"check grid, eps {eps:.3g} W, step held", grid, Relaxation(),
-                               point, held, solver_options=check_grid_options(o),
-                               problem=o.replace(cost_smoothing=eps), warm_start_options=warm)
+        warm: dict[str, Any] | None = REGRID_OPTIONS
+        if check_holds_step(o):
+            point = self.stage("check grid, step held", grid, Relaxation(), point,
+                               step_held_bounds(o, result),
+                               solver_options=check_grid_options(o))
             if not point.success:
                 return
+            warm = None
         self.stage("check grid", grid, Relaxation(), point, parameter_bounds(o),
                    solver_options=check_grid_options(o), warm_start_options=warm)
 
