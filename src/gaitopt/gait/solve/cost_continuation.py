@@ -88,12 +88,14 @@ def climb_ladder(options: GaitOptions, start: Guess, scale: ModelScale,
 CHECK_HELD_KINDS = frozenset({"heel-toe"})
 
 
-def check_holds_step(options: GaitOptions) -> bool:
+def check_holds_step(options: GaitOptions, scale: ModelScale = REFERENCE) -> bool:
     """Whether the check grid of ``options`` is solved in two stages, both at the requested
     smoothing: the step length and speed held at the target grid's optimum, then free
     (:meth:`gaitopt.gait.solve.staged._Run.check`): a cost that is not smooth
     (:data:`~gaitopt.gait.formulations.cost.COST_TRAITS`) on a contact sequence of
-    :data:`CHECK_HELD_KINDS`.
+    :data:`CHECK_HELD_KINDS` whose :func:`smoothing_ladder` has one rung at most (the
+    seven-link's 0.16 W, the cost study's smoothing; a finer one climbs
+    :func:`check_smoothings` instead, as before).
 
     Measured 2026-12-03 (docs/costs.md, "The accuracy pass"), the seven-link's cost study
     at 0.16 W, check grid 36 + 26 knots from the optimum on 24 + 16 mapped onto it with its
@@ -108,4 +110,23 @@ def check_holds_step(options: GaitOptions) -> bool:
     0.016 W with everything free from the start, IPOPT had left the optimum (the metabolic
     walk at 4.8 W/kg and 78 m/min: 600 iterations at the limit, cost 0.598 against 0.535)."""
     return (not COST_TRAITS[options.cost].smooth
-            and sequence_kind(options) in CHECK_HELD_KINDS)
+            and sequence_kind(options) in CHECK_HELD_KINDS
+            and len(smoothing_ladder(options.cost_smoothing, scale)) <= 1)
+
+
+def check_smoothings(options: GaitOptions, scale: ModelScale = REFERENCE) -> list[float]:
+    """The smoothings (W) the check grid solves before the requested one, everything free,
+    each stage from the last with its multipliers: the :func:`smoothing_ladder` of a cost
+    with kinks on a contact sequence of :data:`CHECK_HELD_KINDS` whose ladder has two rungs
+    or more (the seven-link's 0.016 W, a solve below 36.5 m/min); else none (the held check
+    of :func:`check_holds_step`, or one stage).
+
+    Measured 2026-12-03 (docs/costs.md, "The accuracy pass"), the seven-link's metabolic
+    walk at 4.8 W/kg and 78 m/min at 0.016 W, check grid 36 + 26 knots from the 24 + 16
+    optimum: the ladder 1.6, 0.16, 0.016 W converged in 131 + 243 + 83 iterations; held at
+    0.016 W directly it converged to the same optimum (0.5295) but in 2307, and held at
+    0.16 W first (332) it had not converged at 0.016 W after more than 10 minutes."""
+    if COST_TRAITS[options.cost].smooth or sequence_kind(options) not in CHECK_HELD_KINDS:
+        return []
+    ladder = smoothing_ladder(options.cost_smoothing, scale)
+    return ladder if len(ladder) > 1 else []

@@ -93,6 +93,7 @@ from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.solve.check_grid import check_knots
 from gaitopt.gait.solve.cost_continuation import (
     check_holds_step,
+    check_smoothings,
     climb_ladder,
     continues_from_paper,
 )
@@ -396,11 +397,14 @@ class _Run:
         estimate, never changes it. ``start``: a solution of this check grid's NLP (a gait
         file's, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) to restart from instead,
         with its multipliers and the warm-start options of the transcription, where it
-        fits. Otherwise, for a cost with kinks on the heel-toe walk
-        (:func:`~gaitopt.gait.solve.cost_continuation.check_holds_step`), a first stage
+        fits. Otherwise, for a cost with kinks on the heel-toe walk: at a smoothing of at most
+        the ladder's second rung (the seven-link's 0.16 W,
+        :func:`~gaitopt.gait.solve.cost_continuation.check_holds_step`) a first stage
         ``check grid, step held`` with the step length and speed held at ``result``'s
-        (:func:`step_held_bounds`), then the stage that frees them, both with the
-        transcription's warm-start barrier (1e-6) instead of :data:`REGRID_OPTIONS`.
+        (:func:`step_held_bounds`), then the stage that frees them; at a finer one the
+        :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` first (stages ``check
+        grid, eps E W``, everything free); every stage with the transcription's warm-start
+        barrier (1e-6) instead of :data:`REGRID_OPTIONS`.
         """
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
@@ -411,8 +415,15 @@ class _Run:
                            solver_options=check_grid_options(o))
                 return
         point: Result | WarmStart = self.grid_start(grid, result, "check")
-        warm: dict[str, Any] | None = REGRID_OPTIONS
-        if check_holds_step(o):
+        ladder = check_smoothings(o, self.scale)
+        warm: dict[str, Any] | None = None if ladder else REGRID_OPTIONS
+        for eps in ladder:
+            point = self.stage(f"check grid, eps {eps:.3g} W", grid, Relaxation(), point,
+                               parameter_bounds(o), solver_options=check_grid_options(o),
+                               problem=o.replace(cost_smoothing=eps), warm_start_options=warm)
+            if not point.success:
+                return
+        if check_holds_step(o, self.scale):
             point = self.stage("check grid, step held", grid, Relaxation(), point,
                                step_held_bounds(o, result),
                                solver_options=check_grid_options(o))
