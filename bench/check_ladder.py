@@ -9,7 +9,7 @@ from that optimum mapped onto the check grid with its multipliers
   ladder);
 * ``ladder``: the positive parts smoothed with 100 and 10 times the file's smoothing first
   (1.6 and 0.16 W on the seven-link), each stage from the last with its multipliers, then the
-  file's (what :func:`gaitopt.gait.solve.cost_continuation.check_smoothings` does now).
+  file's (what the check grid did before ``check_holds_step``).
 
 ``--mu`` is IPOPT's initial barrier of every stage (1e-4: ``REGRID_OPTIONS``, the one-stage
 check grid's; 1e-6: the transcription's warm start, the ladder's). Prints each stage (status,

@@ -57,7 +57,8 @@ class FakeSolution:
 
 
 def _loop(errors: list[float], *, refines: bool = True,
-          fail_at: int | None = None) -> tuple[Any, dict[str, Any], list[tuple[int, int]]]:
+          fail_at: int | None = None, max_rounds: int = MAX_ROUNDS,
+          ) -> tuple[Any, dict[str, Any], list[tuple[int, int]]]:
     """Run the loop on fake solves whose cost estimates are ``errors`` in grid order."""
     grids: list[tuple[int, int]] = []
 
@@ -70,7 +71,7 @@ def _loop(errors: list[float], *, refines: bool = True,
 
     first = FakeSolution(GaitOptions(knots=(16, 6)))
     sol, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,  # type: ignore[arg-type]
-                                    accuracy_of=accuracy_of)
+                                    accuracy_of=accuracy_of, max_rounds=max_rounds)
     return sol, extra, grids
 
 
@@ -143,6 +144,16 @@ def test_the_loop_stops_after_its_rounds_and_says_not_within() -> None:
     sol, extra, grids = _loop([0.05] * (MAX_ROUNDS + 1))
     assert len(grids) == MAX_ROUNDS
     assert extra["within_target"] is False and extra["refinements"] == MAX_ROUNDS
+
+
+def test_a_caller_may_ask_for_more_rounds() -> None:
+    """The cost study's accuracy pass asks for one more round than gaitopt solve's."""
+    more = MAX_ROUNDS + 1
+    _, extra, grids = _loop([0.05] * (more + 1), max_rounds=more)
+    assert len(grids) == more and extra["refinements"] == more
+    assert extra["within_target"] is False
+    _, extra, grids = _loop([0.05] * MAX_ROUNDS + [0.004, 0.004], max_rounds=more)
+    assert len(grids) == MAX_ROUNDS and extra["within_target"] is True
 
 
 def test_a_failed_finer_solve_keeps_the_coarser_answer() -> None:

@@ -10,12 +10,18 @@ from pathlib import Path
 
 import pytest
 
+from gaitopt.gait.api import solve_gait
+from gaitopt.gait.options.gait_options import GaitOptions
+from gaitopt.gait.record.file import Gait
 from gaitopt.robot import RobotModel
 from gaitopt.study.cost_accuracy import (
+    ACCURACY_ROUNDS,
+    ACCURATE_FILE,
     ACCURATE_NOTE,
     AccuracyOutcome,
     AccuracyTask,
     accuracy_failure,
+    accurate_gait,
     save_accurate,
 )
 from gaitopt.study.cost_study import ACCURACY, CostStudyError, CostStudySpec, collect_rows
@@ -81,3 +87,26 @@ def test_a_case_without_its_accurate_gait_is_marked(tmp_path: Path,
                         start_speed=1.25, accuracy_pass="off")
     (row,) = collect_rows(off, tmp_path)
     assert row.within_accuracy is None and "within" not in row.status
+
+
+def test_a_rerun_refines_again_a_gait_short_of_its_rounds(tmp_path: Path,
+                                                           five_link: RobotModel) -> None:
+    """A case's accurate gait is kept by a rerun when within its accuracy or refined
+    ACCURACY_ROUNDS times; one that an older pass left above the accuracy after fewer
+    rounds is solved again (None)."""
+    gait = solve_gait(five_link, GaitOptions.paper(speed=0.2, knots=(8, 5), accuracy=None))
+    assert gait.success
+    source, cost = "five-link/paper/gaits/ankle+impulse/speed-free.gait.json", 431.0
+    (tmp_path / ACCURATE_NOTE).write_text(json.dumps({"from": source, "from_cost": cost}))
+
+    def kept(within: bool, rounds: int) -> bool:
+        data = gait.to_dict()
+        data["solver"]["accuracy"] = {**(data["solver"].get("accuracy") or {}),
+                                      "within_target": within, "refinements": rounds}
+        Gait.from_dict(data).save(tmp_path / ACCURATE_FILE)
+        return accurate_gait(tmp_path, source, cost) is not None
+
+    assert kept(True, 0) and kept(True, ACCURACY_ROUNDS)
+    assert not kept(False, ACCURACY_ROUNDS - 1)
+    assert kept(False, ACCURACY_ROUNDS)
+    assert accurate_gait(tmp_path, source, cost * 1.01) is None  # another optimum

@@ -39,7 +39,7 @@ from gaitopt.gait.record.file import Gait
 from gaitopt.gait.solve.accuracy import accuracy_record
 from gaitopt.gait.solve.diagnose import SolveFailedError, diagnose
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
-from gaitopt.gait.solve.refinement import refine_to_accuracy
+from gaitopt.gait.solve.refinement import MAX_ROUNDS, refine_to_accuracy
 from gaitopt.gait.solve.share_release import (
     FROM_FIXED,
     PREFIX,
@@ -107,7 +107,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                      refine: bool | None = None,
                      speed_given: bool | None = None,
                      check_warm_start: bool = False,
-                     plausible: Plausibility | None = None) -> StagedRun:
+                     plausible: Plausibility | None = None,
+                     max_rounds: int = MAX_ROUNDS) -> StagedRun:
     """Internal: :func:`solve_gait` before the gait is recorded. Returns the
     :class:`~gaitopt.gait.solve.staged_run.StagedRun` (the engine's final result, every
     stage's record and result), which the command line, the study, the benches and the tests
@@ -120,7 +121,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     grid, unless it finds the file's own optimum again, whose estimate it then keeps
     (:mod:`gaitopt.gait.solve.warm_accuracy`).
     ``check_warm_start``: a warm start always solves its check grid too (the cost study's
-    accuracy pass), whatever the file's estimate.
+    accuracy pass), whatever the file's estimate. ``max_rounds``: the most refinements
+    (:data:`~gaitopt.gait.solve.refinement.MAX_ROUNDS`; the accuracy pass asks for more).
     ``plausible``: where the sequence's phase shares are guesses
     (:mod:`gaitopt.gait.solve.share_release`), the converged fixed-share solve is followed by
     the shares released from its optimum, kept where lower, converged and ``plausible`` (a
@@ -198,7 +200,7 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         return {**record, **carried} if carried is not None and run is first else record
 
     run, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,
-                                    accuracy_of=accuracy_of)
+                                    accuracy_of=accuracy_of, max_rounds=max_rounds)
     if carried is not None and run.result is first.result:
         run = dataclasses.replace(run, accuracy_extra={**carried, **extra},
                                   carried_check=check_point(warm_start))

@@ -7,7 +7,7 @@ solves by default (:mod:`gaitopt.gait.solve.refinement`): warm-started from its 
 the same grid, then on the check grid (1.5 times the knots), whose change gives the relative
 estimates of the cost, speed and step length (:func:`~gaitopt.gait.solve.refinement.
 relative_estimates`); while the largest exceeds the accuracy (1 %), on the check grid's
-check grid, at most :data:`~gaitopt.gait.solve.refinement.MAX_ROUNDS` times. Its gait (the
+check grid, at most :data:`ACCURACY_ROUNDS` times. Its gait (the
 finest converged grid's) is written to ``<case>/accurate.gait.json`` with, in
 ``accurate.json``, the file and cost it started from, so a rerun keeps it while the case's
 optimum is the same. The table reports the accurate gait's values and estimate
@@ -32,6 +32,15 @@ from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.record import gait_from_run
 from gaitopt.gait.solve.staged_run import StageRecord
 from gaitopt.robot.model import RobotModel
+
+#: The most refinements of a case's optimum (one more than ``gaitopt solve``'s
+#: :data:`~gaitopt.gait.solve.refinement.MAX_ROUNDS`): the heel-toe walk's study grid
+#: 24+18 knots (as its stages print them) -> 36+26 -> 54+39 -> 81+57 -> 122+86.
+#: Measured 2026-12-03 (docs/costs.md, "The accuracy pass"): the seven-link's slow optima
+#: (work, metabolic 0 W/kg, 18-19 m/min) change their cost by 2.8, 1.9, 0.8 and 0.4 % from
+#: grid to grid, so their first-order estimate (three times the change) was 1.3 and 1.5 %
+#: after three rounds.
+ACCURACY_ROUNDS = 4
 
 #: The accurate gait of a case and the note of what it started from, in the case's folder.
 ACCURATE_FILE = "accurate.gait.json"
@@ -79,7 +88,8 @@ def solve_accurate(task: AccuracyTask) -> AccuracyOutcome:
             print(f"  accuracy {task.key}: {stage.line()}", flush=True)
 
         run = solve_staged_run(task.model, task.options, warm_start=gait, refine=True,
-                               check_warm_start=True, progress=echo if task.echo else None)
+                               check_warm_start=True, progress=echo if task.echo else None,
+                               max_rounds=ACCURACY_ROUNDS)
         data = gait_from_run(run).to_dict() if run.success else None
         return AccuracyOutcome(key=task.key, gait=data, status=run.result.status,
                                wall_time_s=time.perf_counter() - start,
@@ -93,16 +103,21 @@ def solve_accurate(task: AccuracyTask) -> AccuracyOutcome:
 
 def accurate_gait(case_folder: Path, source: str, cost: float) -> Gait | None:
     """The case's accurate gait when it was refined from ``source`` (the winning gait file,
-    relative to the study's folder) of cost ``cost`` and converged; else None (to solve)."""
+    relative to the study's folder) of cost ``cost`` and converged, and is within its
+    accuracy or was refined :data:`ACCURACY_ROUNDS` times; else None (to solve: a gait
+    refined fewer times, by an older pass, is refined again)."""
     try:
         note = json.loads((case_folder / ACCURATE_NOTE).read_text(encoding="utf-8"))
         if note.get("from") != source or not math.isclose(float(note.get("from_cost")), cost,
                                                           rel_tol=1e-12):
             return None
         gait = Gait.load(case_folder / ACCURATE_FILE)
+        record = gait.solver.get("accuracy") or {}
+        short = (record.get("within_target") is False
+                 and int(record.get("refinements") or 0) < ACCURACY_ROUNDS)
     except (OSError, ValueError, TypeError, GaitFileError):
         return None
-    return gait if gait.success else None
+    return gait if gait.success and not short else None
 
 
 def save_accurate(case_folder: Path, task: AccuracyTask, outcome: AccuracyOutcome) -> Path | None:
@@ -146,5 +161,6 @@ def estimate_of(gait: Gait) -> tuple[float, str, bool | None, str]:
             "+".join(str(int(k)) for k in knots.values()))
 
 
-__all__ = ["ACCURATE_FILE", "ACCURATE_NOTE", "AccuracyOutcome", "AccuracyTask",
-           "accuracy_failure", "accurate_gait", "estimate_of", "save_accurate", "solve_accurate"]
+__all__ = ["ACCURACY_ROUNDS", "ACCURATE_FILE", "ACCURATE_NOTE", "AccuracyOutcome",
+           "AccuracyTask", "accuracy_failure", "accurate_gait", "estimate_of", "save_accurate",
+           "solve_accurate"]

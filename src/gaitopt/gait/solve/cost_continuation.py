@@ -82,24 +82,51 @@ def climb_ladder(options: GaitOptions, start: Guess, scale: ModelScale,
 
 
 #: The contact sequences (by kind, :func:`~gaitopt.gait.solve.stages.sequence_kind`) whose
-#: check grid climbs the :func:`smoothing_ladder` of a cost with kinks
-#: (:func:`check_smoothings`): where it was measured to be needed. The five-link walk's
+#: check grid of a cost with kinks first holds the step length and speed
+#: (:func:`check_holds_step`): where it was measured to be needed. The five-link walk's
 #: check grids of the costs of transport converge in one stage (docs/costs.md).
-CHECK_LADDER_KINDS = frozenset({"heel-toe"})
+CHECK_HELD_KINDS = frozenset({"heel-toe"})
+
+
+def check_holds_step(options: GaitOptions, scale: ModelScale = REFERENCE) -> bool:
+    """Whether the check grid of ``options`` is solved in two stages, both at the requested
+    smoothing: the step length and speed held at the target grid's optimum, then free
+    (:meth:`gaitopt.gait.solve.staged._Run.check`): a cost that is not smooth
+    (:data:`~gaitopt.gait.formulations.cost.COST_TRAITS`) on a contact sequence of
+    :data:`CHECK_HELD_KINDS` whose :func:`smoothing_ladder` has one rung at most (the
+    seven-link's 0.16 W, the cost study's smoothing; a finer one climbs
+    :func:`check_smoothings` instead, as before).
+
+    Measured 2026-12-03 (docs/costs.md, "The accuracy pass"), the seven-link's cost study
+    at 0.16 W, check grid 36 + 26 knots from the optimum on 24 + 16 mapped onto it with its
+    multipliers, barrier 1e-6: held, then free, the work case converged in 102 + 24
+    iterations near the optimum it came from (19.07 -> 18.37 m/min, cost -2.8 %), the
+    metabolic 1.2 W/kg case in 300 + 13 (55.58 -> 55.37 m/min, -0.5 %). The smoothing ladder
+    the check grid climbed before (1.6 W, then the requested smoothing, everything free)
+    took 52 + 236 and 64 + 370 iterations, its 1.6 W stage moving the work optimum to
+    33.6 m/min; the same ladder with the step held took 85 + 91 and 56 + 304, and its work
+    case came back to another optimum (0.00154 against 0.00407 on 24 + 16, then 0.00278 and
+    0.00338 on the finer grids): the estimate compared two optima, not two grids. At
+    0.016 W with everything free from the start, IPOPT had left the optimum (the metabolic
+    walk at 4.8 W/kg and 78 m/min: 600 iterations at the limit, cost 0.598 against 0.535)."""
+    return (not COST_TRAITS[options.cost].smooth
+            and sequence_kind(options) in CHECK_HELD_KINDS
+            and len(smoothing_ladder(options.cost_smoothing, scale)) <= 1)
 
 
 def check_smoothings(options: GaitOptions, scale: ModelScale = REFERENCE) -> list[float]:
-    """The smoothings (W) the check grid solves before the requested one: the
-    :func:`smoothing_ladder` for a cost that is not smooth
-    (:data:`~gaitopt.gait.formulations.cost.COST_TRAITS`) on a contact sequence of
-    :data:`CHECK_LADDER_KINDS`, each from the last with its multipliers (the first from the
-    target grid's optimum mapped onto the check grid); else none.
+    """The smoothings (W) the check grid solves before the requested one, everything free,
+    each stage from the last with its multipliers: the :func:`smoothing_ladder` of a cost
+    with kinks on a contact sequence of :data:`CHECK_HELD_KINDS` whose ladder has two rungs
+    or more (the seven-link's 0.016 W, a solve below 36.5 m/min); else none (the held check
+    of :func:`check_holds_step`, or one stage).
+
     Measured 2026-12-03 (docs/costs.md, "The accuracy pass"), the seven-link's metabolic
-    walk at 4.8 W/kg and 78 m/min, check grid 36 + 24 knots from the optimum on 24 + 16: at
-    the requested 0.016 W directly, IPOPT left the optimum and stopped at the iteration limit
-    (600: cost 0.598 against 0.535, violation 1.5e-3; the study's 1.2 W/kg case stopped so at
-    3000); the ladder 1.6, 0.16, 0.016 W converged in 131 + 243 + 83 iterations with the
-    warm-start barrier 1e-6, and its last stage stopped at the limit with 1e-4."""
-    if COST_TRAITS[options.cost].smooth or sequence_kind(options) not in CHECK_LADDER_KINDS:
+    walk at 4.8 W/kg and 78 m/min at 0.016 W, check grid 36 + 26 knots from the 24 + 16
+    optimum: the ladder 1.6, 0.16, 0.016 W converged in 131 + 243 + 83 iterations; held at
+    0.016 W directly it converged to the same optimum (0.5295) but in 2307, and held at
+    0.16 W first (332) it had not converged at 0.016 W after more than 10 minutes."""
+    if COST_TRAITS[options.cost].smooth or sequence_kind(options) not in CHECK_HELD_KINDS:
         return []
-    return smoothing_ladder(options.cost_smoothing, scale)
+    ladder = smoothing_ladder(options.cost_smoothing, scale)
+    return ladder if len(ladder) > 1 else []

@@ -85,6 +85,7 @@ def solved_shares(solution: StagedRun) -> tuple[float, ...] | None:
 def refine_to_accuracy(solution: StagedRun, *, refines: bool,
                        solve_on: Callable[[GaitOptions, StagedRun], StagedRun],
                        accuracy_of: Callable[[StagedRun], dict[str, Any]],
+                       max_rounds: int = MAX_ROUNDS,
                        ) -> tuple[StagedRun, dict[str, Any]]:
     """Refine ``solution`` while its worst relative estimate exceeds the options' accuracy.
 
@@ -94,6 +95,8 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         solve_on: solves ``options`` (a finer grid) started from the previous solution.
         accuracy_of: the ``solver.accuracy`` record of a solution
             (:func:`gaitopt.gait.solve.accuracy.accuracy_record`).
+        max_rounds: the most refinements (:data:`MAX_ROUNDS` unless a caller asks for more:
+            the cost study's accuracy pass).
 
     Returns:
         The finest converged solution and what to add to its ``solver.accuracy``: ``target``
@@ -108,7 +111,7 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         params = dict(solution.result.parameters)
         worst = worst_estimate(record, params)
         within = worst[0] <= target if target is not None else None
-        if within is not False or rounds >= MAX_ROUNDS or not solution.success:
+        if within is not False or rounds >= max_rounds or not solution.success:
             break
         finer = solution.options.replace(knots=check_knots(solution.options.knots),
                                          phase_shares=solved_shares(solution))

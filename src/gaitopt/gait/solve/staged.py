@@ -92,6 +92,7 @@ from gaitopt.gait.options.model_defaults import default_gait, default_speed, opt
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.solve.check_grid import check_knots
 from gaitopt.gait.solve.cost_continuation import (
+    check_holds_step,
     check_smoothings,
     climb_ladder,
     continues_from_paper,
@@ -178,6 +179,16 @@ def reference_speed(model: RobotModel, options: GaitOptions) -> float:
         except GaitOptionsError:
             gait = "walk"
     return default_speed(model, gait)
+
+
+def step_held_bounds(options: GaitOptions, result: Result) -> dict[str, Any]:
+    """The parameter bounds of ``options`` with the step length (m) and the speed (m/s) held
+    at ``result``'s values (a stage on another grid or with another smoothing started from
+    ``result``, whose release follows)."""
+    held = dict(parameter_bounds(options))
+    for key in ("step_length", "speed"):
+        held[key] = (result.parameters[key], result.parameters[key])
+    return held
 
 
 class _Run:
@@ -386,10 +397,15 @@ class _Run:
         estimate, never changes it. ``start``: a solution of this check grid's NLP (a gait
         file's, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) to restart from instead,
         with its multipliers and the warm-start options of the transcription, where it
-        fits. Otherwise a cost with kinks first climbs
-        :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` (stages ``check grid,
-        eps E W``), each stage from the last with its multipliers, every one with the
-        transcription's warm-start barrier (1e-6) instead of :data:`REGRID_OPTIONS`."""
+        fits. Otherwise, for a cost with kinks on the heel-toe walk: at a smoothing of at most
+        the ladder's second rung (the seven-link's 0.16 W,
+        :func:`~gaitopt.gait.solve.cost_continuation.check_holds_step`) a first stage
+        ``check grid, step held`` with the step length and speed held at ``result``'s
+        (:func:`step_held_bounds`), then the stage that frees them; at a finer one the
+        :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` first (stages ``check
+        grid, eps E W``, everything free); every stage with the transcription's warm-start
+        barrier (1e-6) instead of :data:`REGRID_OPTIONS`.
+        """
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
         if start is not None:
@@ -400,13 +416,20 @@ class _Run:
                 return
         point: Result | WarmStart = self.grid_start(grid, result, "check")
         ladder = check_smoothings(o, self.scale)
-        warm = None if ladder else REGRID_OPTIONS
+        warm: dict[str, Any] | None = None if ladder else REGRID_OPTIONS
         for eps in ladder:
             point = self.stage(f"check grid, eps {eps:.3g} W", grid, Relaxation(), point,
                                parameter_bounds(o), solver_options=check_grid_options(o),
                                problem=o.replace(cost_smoothing=eps), warm_start_options=warm)
             if not point.success:
                 return
+        if check_holds_step(o, self.scale):
+            point = self.stage("check grid, step held", grid, Relaxation(), point,
+                               step_held_bounds(o, result),
+                               solver_options=check_grid_options(o))
+            if not point.success:
+                return
+            warm = None
         self.stage("check grid", grid, Relaxation(), point, parameter_bounds(o),
                    solver_options=check_grid_options(o), warm_start_options=warm)
 
@@ -429,9 +452,7 @@ class _Run:
         tolerance when a release follows, :func:`~gaitopt.gait.solve.stages.held_stage_options`),
         then (stage ``name, all free``) released."""
         o = self.options
-        held = dict(parameter_bounds(o))
-        for key in ("step_length", "speed"):
-            held[key] = (result.parameters[key], result.parameters[key])
+        held = step_held_bounds(o, result)
         all_fixed = o.speed is not None and (o.step_length is not None or
                                              o.step_time is not None)
         fine = self.stage(name, grid, Relaxation(), self.grid_start(grid, result, move), held,
