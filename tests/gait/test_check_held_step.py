@@ -106,3 +106,23 @@ def test_below_the_ladders_second_rung_the_check_climbs_the_free_ladder(
     coarse = options.replace(cost_smoothing=scale.power(0.1))
     assert check_holds_step(coarse, scale) and check_smoothings(coarse, scale) == []
     assert not check_smoothings(options_for_model(seven, GaitOptions(gait="heel-toe")), scale)
+
+
+def test_free_phase_shares_hold_the_step_with_the_paper_cost(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The heel-toe walk with its shares free (the release of gaitopt solve): held, then
+    free, with the paper's cost too (with the speed free the one free stage wandered off,
+    docs/feet.md); the shares fixed keep one free stage, and so does the five-link walk."""
+    seven = load_model("seven-link")
+    options = options_for_model(seven, GaitOptions(gait="heel-toe", speed=None,
+                                                   free_phase_fractions=True))
+    assert staged.holds_free_shares(options)
+    answer = _Point(0.9727, 0.6023)
+    calls = _check_stages(options, answer, monkeypatch)
+    assert [c[0] for c in calls] == ["check grid, step held", "check grid"]
+    assert calls[0][2]["speed"] == (answer.parameters["speed"],) * 2
+    assert calls[1][2]["speed"] == parameter_bounds(options)["speed"]
+    assert not staged.holds_free_shares(options.replace(free_phase_fractions=False))
+    five = load_model("five-link")
+    assert not staged.holds_free_shares(options_for_model(
+        five, GaitOptions(formulation="full", free_phase_fractions=True)))

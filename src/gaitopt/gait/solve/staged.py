@@ -92,6 +92,7 @@ from gaitopt.gait.options.model_defaults import default_gait, default_speed, opt
 from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.solve.check_grid import check_knots
 from gaitopt.gait.solve.cost_continuation import (
+    CHECK_HELD_KINDS,
     check_holds_step,
     check_smoothings,
     climb_ladder,
@@ -189,6 +190,20 @@ def step_held_bounds(options: GaitOptions, result: Result) -> dict[str, Any]:
     for key in ("step_length", "speed"):
         held[key] = (result.parameters[key], result.parameters[key])
     return held
+
+
+def holds_free_shares(options: GaitOptions) -> bool:
+    """Whether the check grid of ``options`` holds the step length and speed first
+    (:meth:`_Run.check`) because the phase shares are free on a contact sequence of
+    :data:`~gaitopt.gait.solve.cost_continuation.CHECK_HELD_KINDS` (the heel-toe walk).
+
+    Measured 2026-12-03 (docs/feet.md, "Free phase shares by default"), the seven-link with
+    the speed free and the shares free: from the 24 + 18 optimum (J 1707.75 at 58.4 m/min) the
+    check grid with everything free wandered off (J 3618 at 67.6 m/min, violation 0.12, at the
+    120 s limit; from the other start 2755 at 75.4 m/min); held, then free, it converged in
+    13 + 7 iterations at J 1707.79 and the same speed."""
+    return (options.free_phase_fractions is True
+            and sequence_kind(options) in CHECK_HELD_KINDS)
 
 
 class _Run:
@@ -404,7 +419,9 @@ class _Run:
         (:func:`step_held_bounds`), then the stage that frees them; at a finer one the
         :func:`~gaitopt.gait.solve.cost_continuation.check_smoothings` first (stages ``check
         grid, eps E W``, everything free); every stage with the transcription's warm-start
-        barrier (1e-6) instead of :data:`REGRID_OPTIONS`.
+        barrier (1e-6) instead of :data:`REGRID_OPTIONS`. The free phase shares of the
+        heel-toe walk hold the step too, with any cost that climbs no ladder
+        (:func:`holds_free_shares`).
         """
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
@@ -423,7 +440,7 @@ class _Run:
                                problem=o.replace(cost_smoothing=eps), warm_start_options=warm)
             if not point.success:
                 return
-        if check_holds_step(o, self.scale):
+        if check_holds_step(o, self.scale) or (not ladder and holds_free_shares(o)):
             point = self.stage("check grid, step held", grid, Relaxation(), point,
                                step_held_bounds(o, result),
                                solver_options=check_grid_options(o))
