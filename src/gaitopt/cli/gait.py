@@ -158,7 +158,7 @@ def _step_time(text: str) -> float | None:
                    "to twice its given share (at most 0.95), starting from it (needs "
                    "--formulation full); or every share fixed. [default: a built-in "
                    "sequence of more than two phases (heel-toe) is solved with its shares "
-                   "fixed, then again with them free from that optimum, and the free one "
+                   "fixed, then again with them free, and the free one "
                    "kept where it costs less and passes verify; docs/feet.md]")
 @click.option("--stride", is_flag=True,
               help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "

@@ -125,8 +125,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     (:data:`~gaitopt.gait.solve.refinement.MAX_ROUNDS`; the accuracy pass asks for more).
     ``plausible``: where the sequence's phase shares are guesses
     (:mod:`gaitopt.gait.solve.share_release`), the converged fixed-share solve is followed by
-    the shares released from its optimum, kept where lower, converged and ``plausible`` (a
-    check of the released run: None when plausible, else why not;
+    the shares released (the problem solved again with them free), kept where lower,
+    converged and ``plausible`` (a check of the released run: None when plausible, else why not;
     :func:`gaitopt.analysis.plausible.verified`, which ``gaitopt solve`` passes). None: no
     release, the shares stay fixed (nothing here can judge the released gait: the checks
     of ``gaitopt verify`` live above this layer).

@@ -203,7 +203,7 @@ class SequenceOptions:
             ``single_support_fraction_bounds``. See
             :func:`gaitopt.gait.sequence.phase_fractions.fraction_parameters`. ``False``: the
             shares stay fixed. ``None`` (the default): left to the sequence, fixed for the
-            solve, then released from its optimum where the sequence's shares are guesses
+            solve, then released (solved again with the shares free) where they are guesses
             (a built-in sequence of more than two phases) and the released optimum is kept
             where it is lower, converged and plausible
             (:mod:`gaitopt.gait.solve.share_release`).

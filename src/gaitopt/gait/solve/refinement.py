@@ -33,6 +33,7 @@ from gaitopt.gait.formulations.select import contact_sequence
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.sequence.phase_fractions import free_phases
 from gaitopt.gait.solve.check_grid import check_knots
+from gaitopt.gait.solve.share_release import shares_of
 from gaitopt.gait.solve.staged_run import StagedRun
 
 #: How many times a solve is repeated on a finer grid at most.
@@ -77,9 +78,7 @@ def solved_shares(solution: StagedRun) -> tuple[float, ...] | None:
     seq = contact_sequence(solution.model, solution.options)
     if not free_phases(seq) or len(solution.result.phases) != len(seq.phases):
         return None
-    durations = [float(ph.duration) for ph in solution.result.phases]
-    step = sum(durations) / seq.steps
-    return tuple(d / step for d in durations)
+    return tuple(shares_of(solution))
 
 
 def refine_to_accuracy(solution: StagedRun, *, refines: bool,

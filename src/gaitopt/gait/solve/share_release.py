@@ -1,4 +1,4 @@
-"""Phase shares released last: the fixed-share optimum first, then the shares freed from it.
+"""Phase shares released last: the fixed-share optimum first, then the problem with them free.
 
 A contact sequence fixes each phase's share of the step time. Where those shares are the
 sequence's own guesses (a built-in sequence of more than two phases: the heel-toe walk's
@@ -134,9 +134,9 @@ def release_shares(fixed: StagedRun, solve_free: Callable[[GaitOptions, StagedRu
 
     Args:
         fixed: the converged fixed-share solve, refined.
-        solve_free: solves ``options`` (the free-share problem on ``fixed``'s final grid)
-            from ``fixed``'s optimum and refines it to the accuracy; its stage names carry
-            :data:`PREFIX`.
+        solve_free: solves ``options`` (the free-share problem on ``fixed``'s final grid;
+            from its own stages, or from ``fixed``'s optimum where those fail) and refines it
+            to the accuracy; its stage names carry :data:`PREFIX`.
         plausible: the plausibility check of the released optimum (None: none).
 
     Returns:
