@@ -50,3 +50,16 @@ def test_a_refined_mesh_gives_the_change_from_the_mesh_before_and_one_grid_none(
     alone = {**BASE, "cost_error": None}
     assert dict(accuracy_rows(alone))["cost error estimate"] == (
         "n/a (one grid; solve with --mesh-tol)")
+
+
+def test_a_large_smoothing_share_is_shown_above_the_accuracy() -> None:
+    smoothing = {"cost_smoothing": 0.01, "unsmoothed_cost": 0.0011742, "share": 0.346}
+    rows = dict(accuracy_rows({**BASE, "cost_error": None, "smoothing": smoothing}))
+    assert rows["cost smoothing"] == (
+        "35 % of J at eps 0.01 W (the motion's cost unsmoothed: 0.0011742); above 1 %: the "
+        "smoothing, not only the motion, sets this optimum (docs/costs.md)")
+    small = {**smoothing, "share": 0.0022}
+    rows = dict(accuracy_rows({**BASE, "cost_error": None, "smoothing": small}))
+    assert rows["cost smoothing"].startswith("0.22 % of J") and "above" not in rows[
+        "cost smoothing"]
+    assert "cost smoothing" not in dict(accuracy_rows({**BASE, "cost_error": None}))

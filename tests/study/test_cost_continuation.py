@@ -104,7 +104,7 @@ def test_table_accuracy_columns_round_trip(tmp_path: Path) -> None:
                     speed_m_min=61.0, step_length=0.56, step_time=0.55, cost_value=0.197,
                     file="x", start="from metabolic-rest-0.6", other_cost_value=0.2,
                     estimate=0.004, estimate_of="speed", knots="24+16+16+16",
-                    within_accuracy=True),
+                    within_accuracy=True, smoothing_share=0.011),
             CostRow(model="seven-link", formulation="full", case="work", cost="work",
                     resting_power=math.nan, success=False, status="not solved",
                     speed_m_min=math.nan, step_length=math.nan, step_time=math.nan,
@@ -114,9 +114,10 @@ def test_table_accuracy_columns_round_trip(tmp_path: Path) -> None:
     back = read_cost_table(path)
     assert [r.as_csv_dict() for r in back] == [r.as_csv_dict() for r in rows]
     assert back[0].within_accuracy is True and back[1].within_accuracy is None
+    assert back[0].smoothing_share == 0.011 and math.isnan(back[1].smoothing_share)
     # a table written before the accuracy columns reads with them empty
     old = [c for c in COST_COLUMNS if c not in ("estimate", "estimate_of", "knots",
-                                                 "within_accuracy")]
+                                                 "within_accuracy", "smoothing_share")]
     lines = cost_table_csv(rows[:1]).splitlines()
     header = lines[0].split(",")
     cells = lines[1].split(",")

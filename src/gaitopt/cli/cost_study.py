@@ -223,6 +223,12 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
         console.print(f"accuracy: {len(checked) - len(missed)} of {len(checked)} cases within "
                       f"{100 * ACCURACY:g} %" + ("" if not missed else "; not within: " + "; ".join(
                           f"{r.model} {r.case} ({r.status})" for r in missed)), soft_wrap=True)
+    smoothed = [r for r in rows if r.success and r.smoothing_share > ACCURACY]
+    if smoothed:
+        console.print(f"cost smoothing above {100 * ACCURACY:g} % of the cost (the smoothing, "
+                      "not only the motion, sets these optima; docs/costs.md): " + "; ".join(
+                          f"{r.model} {r.case} {100 * r.smoothing_share:.2g} %"
+                          for r in smoothed), soft_wrap=True)
 
     page = write_cost_reports(console, directory, directory / "report")
     console.print(f"cost study done in {time.perf_counter() - start:.0f} s. Open {page}",

@@ -100,7 +100,7 @@ def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
     rows = [("collocation error (largest per interval)", errors)]
     if accuracy["cost_error"] is None:
         rows.append(("cost error estimate", "n/a (one grid; solve with --mesh-tol)"))
-        return rows
+        return rows + smoothing_rows(accuracy)
     check = accuracy.get("check_knots")
     grid = "+".join(str(k) for k in (check or accuracy["previous_knots"]).values())
     factor = accuracy.get("cost_error_factor") or 1.0
@@ -132,7 +132,22 @@ def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
             text += (f"; estimate {factor:g} x: speed {60 * ev:.3f} m/min{_share(ev, speed)}, "
                      f"step length {el:.4f} m{_share(el, step_length)}")
         rows.append((moved, text))
-    return rows
+    return rows + smoothing_rows(accuracy)
+
+
+def smoothing_rows(accuracy: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """The summary row of ``solver.accuracy.smoothing`` (a cost of transport's smoothing
+    share, :func:`gaitopt.gait.formulations.cost.smoothing_record`); none without it."""
+    smoothing = accuracy.get("smoothing")
+    if not isinstance(smoothing, Mapping):
+        return []
+    share, target = smoothing["share"], accuracy.get("target") or 0.01
+    text = (f"{100 * share:.2g} % of J at eps {smoothing['cost_smoothing']:g} W (the motion's "
+            f"cost unsmoothed: {smoothing['unsmoothed_cost']:.6g})")
+    if share > target:
+        text += (f"; above {100 * target:g} %: the smoothing, not only the motion, sets this "
+                 "optimum (docs/costs.md)")
+    return [("cost smoothing", text)]
 
 
 def _share(error: float, value: float | None) -> str:

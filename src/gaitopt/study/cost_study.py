@@ -58,6 +58,7 @@ from typing import Any, Literal
 
 from gaitopt import __version__
 from gaitopt.fileio import write_text_atomic
+from gaitopt.gait.formulations.cost import smoothing_record
 from gaitopt.gait.options.gait_options import (
     FORMULATIONS,
     KNOT_SPACINGS,
@@ -624,6 +625,17 @@ def speed_bound_reached(speed_m_min: float, bounds: tuple[float, float], *,
     return None
 
 
+def smoothing_share(gait: Gait | Path) -> float:
+    """The share of a gait's cost that is the smoothing of its positive parts
+    (:func:`~gaitopt.gait.formulations.cost.smoothing_record`; a gait or its file); NaN for
+    the paper's cost or a file that cannot be read."""
+    try:
+        record = smoothing_record(gait if isinstance(gait, Gait) else Gait.load(gait))
+    except (OSError, ValueError, GaitFileError):
+        return math.nan
+    return math.nan if record is None else record["share"]
+
+
 def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list[CostRow]:
     """The speed-free optimum of every (model, case): the lowest over its starts
     (:func:`winner_of`), reported with the values of its accurate gait where the accuracy
@@ -676,6 +688,11 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
         bound = speed_bound_reached(fields["speed_m_min"], sweep.spec.base.speed_bounds)
         if bound is not None:
             fields["status"] = f"{fields['status']}; {SPEED_BOUND_NOTE.format(bound=bound)}"
+        share = smoothing_share(accurate if accurate is not None else top / fields["file"])
+        if target is not None and share > target:
+            fields["status"] += (f"; the smoothing is {100 * share:.2g} % of the cost "
+                                 f"(> {100 * target:g} %)")
         rows.append(CostRow(**common, success=True, cost_value=value, start=start,
-                            other_cost_value=other, **accuracy, **fields))
+                            other_cost_value=other, smoothing_share=share, **accuracy,
+                            **fields))
     return rows

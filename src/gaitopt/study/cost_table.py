@@ -31,9 +31,11 @@ COST_TABLE_FILE = "costs.csv"
 COST_COLUMNS: tuple[str, ...] = (
     "model", "formulation", "case", "cost", "resting_power", "success", "status",
     "speed_m_min", "step_length", "step_time", "cost_value", "human_distance", "start",
-    "other_cost_value", "file", "estimate", "estimate_of", "knots", "within_accuracy")
+    "other_cost_value", "file", "estimate", "estimate_of", "knots", "within_accuracy",
+    "smoothing_share")
 #: Columns added later (2026-12-03): a table without them reads with them empty.
-OPTIONAL_COLUMNS: tuple[str, ...] = ("estimate", "estimate_of", "knots", "within_accuracy")
+OPTIONAL_COLUMNS: tuple[str, ...] = ("estimate", "estimate_of", "knots", "within_accuracy",
+                                     "smoothing_share")
 
 
 class CostStudyError(ValueError):
@@ -51,7 +53,9 @@ def human_distance(speed_m_min: float, step_length: float) -> float:
 class CostRow:
     """The speed-free optimum of one (model, case): speed m/min, step m, step time s, the
     cost's value (its own units, docs/costs.md), NaN where the solve failed; ``file`` the gait
-    file relative to the study directory."""
+    file relative to the study directory; ``smoothing_share`` the share of the cost that is
+    the smoothing of its positive parts (:func:`gaitopt.gait.formulations.cost.smoothing_record`;
+    NaN for the paper's cost or where unknown)."""
 
     model: str
     formulation: str
@@ -71,6 +75,7 @@ class CostRow:
     estimate_of: str = ""
     knots: str = ""
     within_accuracy: bool | None = None
+    smoothing_share: float = math.nan
     human_distance: float = field(init=False)
 
     def __post_init__(self) -> None:
@@ -141,5 +146,7 @@ def read_cost_table(path: str | os.PathLike[str]) -> list[CostRow]:
                             estimate=number("estimate") if "estimate" in raw else math.nan,
                             estimate_of=raw.get("estimate_of") or "",
                             knots=raw.get("knots") or "",
-                            within_accuracy=flag("within_accuracy", empty=True)))
+                            within_accuracy=flag("within_accuracy", empty=True),
+                            smoothing_share=(number("smoothing_share")
+                                             if "smoothing_share" in raw else math.nan)))
     return rows

@@ -29,6 +29,7 @@ Everything here runs on numbers and CasADi symbols alike.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -283,6 +284,30 @@ def recompute_cost(gait: Any) -> float:
                 total += impulse_cost(model, options, lift, v_after, impulse)
         total += parameter_cost(model, options, p)
     return float(total / denominator(model, options, p))
+
+
+def smoothing_record(gait: Gait) -> dict[str, float] | None:
+    """How much of a saved gait's cost of transport is the smoothing of its positive parts
+    (``solver.accuracy.smoothing`` of the gait file, docs/costs.md): None for a cost without
+    smoothing (the paper's, or ``cost_smoothing`` 0); else
+
+    * ``cost_smoothing``: ``eps`` (W);
+    * ``unsmoothed_cost``: ``J0``, the cost of the same motion with ``pos(x) = max(0, x)``
+      (:func:`recompute_cost` with ``eps = 0``: the same quadrature), dimensionless;
+    * ``share``: ``(J_eps - J0) / J_eps``, ``J_eps`` the smoothed cost by that quadrature.
+
+    ``J0`` is the exact cost of a motion the unsmoothed problem allows, so that problem's
+    optimum ``J*`` is at most ``J0``; and at least ``J_eps - n_a eps T / (2 W L)``. Where the
+    share is large the smoothing, not the motion, decides the optimum: measured on the costs
+    without a resting power, whose speed-free optima slow down as ``eps`` shrinks."""
+    options = GaitOptions.from_dict(dict(gait.options))
+    if options.cost == "paper" or options.cost_smoothing <= 0.0:
+        return None
+    smoothed = recompute_cost(gait)
+    exact = recompute_cost(dataclasses.replace(
+        gait, options={**dict(gait.options), "cost_smoothing": 0.0}))
+    return {"cost_smoothing": float(options.cost_smoothing), "unsmoothed_cost": exact,
+            "share": (smoothed - exact) / smoothed if smoothed > 0.0 else 0.0}
 
 
 def impulse_events(gait: Gait) -> list[GaitEvent]:

@@ -35,6 +35,11 @@ def parse_model(data: Any) -> RobotModel:
     return model_from_dict(data, source="model")
 
 
+#: The numbers of ``solver.accuracy.smoothing``
+#: (:func:`gaitopt.gait.formulations.cost.smoothing_record`).
+SMOOTHING_KEYS = ("cost_smoothing", "unsmoothed_cost", "share")
+
+
 def check_solver(value: Any) -> dict[str, Any]:
     """Returns a checked copy of a gait's ``solver`` record (:data:`SOLVER_KEYS` present and
     typed, an optional ``diagnosis`` a string); raises :class:`GaitFileError` naming the field."""
@@ -63,6 +68,13 @@ def check_solver(value: Any) -> dict[str, Any]:
         if not isinstance(record["passed"], bool) or not isinstance(record["failed"], list):
             raise bad_field("solver.verify", "expected passed (true or false) and failed (a "
                             "list of the failed checks)")
+    accuracy = solver.get("accuracy")
+    if isinstance(accuracy, Mapping) and "smoothing" in accuracy:  # a cost of transport's
+        smoothing = mapping_of("solver.accuracy.smoothing", accuracy["smoothing"],
+                               required=SMOOTHING_KEYS)
+        solver["accuracy"] = {**accuracy, "smoothing": {
+            key: number_of(f"solver.accuracy.smoothing.{key}", smoothing[key])
+            for key in SMOOTHING_KEYS}}
     if "diagnosis" in solver and not isinstance(solver["diagnosis"], str):
         raise bad_field("solver.diagnosis", "expected a string (the diagnosis of a failed "
                         "solve)")

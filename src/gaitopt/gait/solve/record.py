@@ -10,6 +10,7 @@ solver's report and the contact sequence around them.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from gaitopt.gait.formulations import cost
@@ -65,7 +66,7 @@ def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
         **({} if run.share_release is None else {"phase_shares": dict(run.share_release)}),
         **({} if res.success else {"diagnosis": diagnose(run).text()}),
     }
-    return Gait(
+    gait = Gait(
         model_data=model.to_dict(), options=options.to_dict(),
         parameters={"step_length": step, "speed": speed, "step_time": step / speed,
                     "single_support_time": t1, "liftoff_impulse": impulse},
@@ -73,6 +74,11 @@ def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
               "formula": cost.formula(options)},
         solver=solver, phases=phases, events=events, samples=samples,
         contact_sequence=_solved_sequence(run))
+    smoothing = cost.smoothing_record(gait) if res.success else None
+    if smoothing is None:
+        return gait
+    return dataclasses.replace(gait, solver={
+        **solver, "accuracy": {**solver["accuracy"], "smoothing": smoothing}})
 
 
 def _warm_start_data(res: Result) -> dict[str, Any]:
