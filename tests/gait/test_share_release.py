@@ -1,4 +1,5 @@
-"""Phase shares released last (gait.solve.share_release): which solves release them, the
+"""Phase shares released (gait.solve.share_release): which solves release them, the free
+problem first and kept without the fixed-share solve where it wins on the coarse grid, the
 decision between the fixed-share and the released optimum on fake runs, the released run's
 record, the plausibility check on a real gait, and (slow) the seven-link default solves."""
 
@@ -20,9 +21,12 @@ from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.options.model_defaults import options_for_model
 from gaitopt.gait.solve.record import gait_from_run
 from gaitopt.gait.solve.share_release import (
+    FREEING_STAGE,
     PREFIX,
     SAME_COST,
+    coarse_release,
     decision,
+    release_first,
     release_shares,
     releases_shares,
     shares_of,
@@ -176,18 +180,102 @@ def test_the_plausibility_check_is_verify(solved: SolveFn) -> None:
 
 def test_without_a_plausibility_check_the_shares_stay_fixed(monkeypatch: pytest.MonkeyPatch,
                                                            seven: RobotModel) -> None:
-    """solve_staged_run releases only with a check: the fixed-share run is the answer."""
+    """solve_staged_run releases only with a check: the fixed-share run is the answer; with
+    one, the free problem is solved first and, where release_first does not keep it, the
+    fixed-share run follows and release_shares decides."""
     import gaitopt.gait.api as api
 
     calls: list[Any] = []
     fixed = SimpleNamespace(success=True, options=_resolved(seven))
+    own = SimpleNamespace(success=False, options=_resolved(seven))
     monkeypatch.setattr(api, "solve_walking", lambda *a, **k: fixed)
+    monkeypatch.setattr(api, "_own_release", lambda *a, **k: calls.append("own") or own)
     monkeypatch.setattr(api, "refine_to_accuracy", lambda run, **k: (run, {}))
-    monkeypatch.setattr(api, "release_shares", lambda *a, **k: calls.append(a) or a[0])
+    monkeypatch.setattr(api, "release_shares",
+                        lambda *a, **k: calls.append(("release", k["first"])) or a[0])
     monkeypatch.setattr(api, "refuse_unwalkable", lambda *a, **k: None)
     assert solve_staged_run(seven, GaitOptions()) is fixed and calls == []
     assert solve_staged_run(seven, GaitOptions(), plausible=lambda run: None) is fixed
-    assert len(calls) == 1
+    assert calls == ["own", ("release", own)]
+
+
+def _stage(name: str, objective: float, success: bool = True,
+           knots: tuple[int, ...] = (8, 5, 5, 5)) -> StageRecord:
+    return StageRecord(name=PREFIX + name, knots=knots, status="Solve_Succeeded",
+                       success=success, iterations=10, objective=objective, violation=0.0,
+                       wall_time_s=1.0, parameters={})
+
+
+COARSE = (_stage("enforced contact", 2888.0), _stage("liftoff impulse free", 2313.0),
+          _stage(FREEING_STAGE, 1617.0), _stage("target grid", 1656.0, knots=(24, 18, 16, 16)))
+
+
+def test_the_free_problem_first_is_kept_where_it_wins_on_the_coarse_grid(
+        seven: RobotModel) -> None:
+    options = _resolved(seven).replace(free_phase_fractions=True)
+    free = _fake_run(seven, options, FREE_SHARES, 1655.8, stages=COARSE)
+    assert coarse_release(free) == (2313.0, 1617.0, (8, 5, 5, 5))
+    seen: list[Any] = []
+    out = release_first(free, seven, lambda run: seen.append(run) or None)
+    assert out is not None and seen == [free]
+    assert out["released"] is True and out["fixed_cost"] == 2313.0
+    assert out["fixed_knots"] == [8, 5, 5, 5] and out["coarse_free_cost"] == 1617.0
+    assert out["free_cost"] == 1655.8
+    assert out["free_shares"] == pytest.approx(FREE_SHARES, abs=1e-12)
+    # the fixed shares are the sequence's own guesses, whatever the free run's options say
+    guesses = [ph.fraction for ph in contact_sequence(seven, _resolved(seven)).phases]
+    assert out["fixed_shares"] == pytest.approx(guesses, abs=1e-12)
+    assert math.fsum(out["fixed_shares"]) == pytest.approx(1.0, abs=1e-12)
+    assert re.search(r"cost 30.1 % less on the coarse grid \(8\+5\+5\+5 knots\): released",
+                     out["why"])
+
+
+@pytest.mark.parametrize("change", ["failed", "not within", "no gain", "implausible",
+                                    "no freeing stage", "freeing failed"])
+def test_the_free_problem_first_is_not_kept_otherwise(seven: RobotModel, change: str) -> None:
+    """Then the fixed-share problem is solved and ``decision`` chooses (None here)."""
+    options = _resolved(seven).replace(free_phase_fractions=True)
+    stages: tuple[StageRecord, ...] = COARSE
+    if change == "no gain":
+        stages = (COARSE[0], COARSE[1], _stage(FREEING_STAGE, 2313.0), COARSE[3])
+    elif change == "no freeing stage":
+        stages = (COARSE[0], COARSE[1], COARSE[3])
+    elif change == "freeing failed":
+        stages = (COARSE[0], COARSE[1], _stage(FREEING_STAGE, 1617.0, success=False))
+    free = _fake_run(seven, options, FREE_SHARES, 1655.8, stages=stages,
+                     success=change != "failed",
+                     within=False if change == "not within" else True)
+    verdict = "verify fails swing.reversals (4 > 3 turns)" if change == "implausible" else None
+    assert release_first(free, seven, lambda run: verdict) is None
+
+
+def test_a_release_after_the_free_problem_first_lists_the_stages_as_they_ran(
+        seven: RobotModel) -> None:
+    options = _resolved(seven)
+    own = _fake_run(seven, options, FREE_SHARES, 1655.8, stages=COARSE, wall=20.0)
+    fixed_stage = dataclasses.replace(COARSE[3], name="check grid")
+    fixed = _fake_run(seven, options, FIXED_SHARES, 2364.9, stages=(fixed_stage,), wall=30.0)
+    warm_stage = dataclasses.replace(COARSE[3], name=PREFIX + "from the fixed shares: x")
+
+    def solve_free(free_options: GaitOptions, start: Any) -> Any:
+        return _fake_run(seven, free_options, FREE_SHARES, 1655.0, wall=25.0,
+                         stages=own.stages + (warm_stage,))
+
+    run = release_shares(fixed, solve_free, lambda run: None, first=own)
+    assert [s.name for s in run.stages] == [s.name for s in COARSE] + [
+        "check grid", warm_stage.name]
+    assert run.share_release["released"] is True and "fixed_knots" not in run.share_release
+    assert run.wall_time_s == pytest.approx(55.0)
+
+
+def test_the_plausibility_check_runs_once_per_run() -> None:
+    import gaitopt.gait.api as api
+
+    calls: list[Any] = []
+    judged = api._judged_once(lambda run: calls.append(run) or "why")
+    a, b = SimpleNamespace(), SimpleNamespace()
+    assert [judged(a), judged(a), judged(b), judged(a)] == ["why"] * 4
+    assert calls == [a, b]
 
 
 @pytest.mark.parametrize(("flag", "value"), [([], None), (["--fixed-fractions"], False),
@@ -243,8 +331,12 @@ def test_the_seven_link_default_releases_its_shares_where_plausible(
     assert verify_gait(gait).passed
     assert gait.solver["phase_shares"] == record
     assert any(s.name.startswith(PREFIX) for s in run.stages)
-    if released:
+    if released and "fixed_knots" in record:  # kept first: compared on the coarse grid
+        assert record["coarse_free_cost"] < (1.0 - SAME_COST) * record["fixed_cost"]
+        assert not any(s.name.startswith("target grid") for s in run.stages)
+    elif released:
         assert record["free_cost"] < 0.8 * record["fixed_cost"]
+    if released:
         assert gait.cost_value == pytest.approx(record["free_cost"], rel=1e-9)
         assert gait.options["free_phase_fractions"] is True
     else:

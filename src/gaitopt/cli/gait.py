@@ -158,8 +158,9 @@ def _step_time(text: str) -> float | None:
                    "to twice its given share (at most 0.95), starting from it (needs "
                    "--formulation full); or every share fixed. [default: a built-in "
                    "sequence of more than two phases (heel-toe) is solved with its shares "
-                   "fixed, then again with them free, and the free one "
-                   "kept where it costs less and passes verify; docs/feet.md]")
+                   "free, kept where it converges, costs less than the fixed shares on the "
+                   "coarse grid and passes verify, else solved with them fixed as well; "
+                   "docs/feet.md]")
 @click.option("--stride", is_flag=True,
               help="Solve a stride: two steps (leg 1's, then leg 2's) periodic over two step "
                    "lengths, no leg swap assumed (for unequal legs); cost per metre of the "
@@ -390,10 +391,15 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                       f"{format_speed(solution.options.speed or 0.0)}; --speed chooses one")
     console.print(summary_table(gait, sequence_used))
     if solution.share_release is not None:
-        console.print(f"phase shares: {solution.share_release['why']} (fixed J "
-                      f"{solution.share_release['fixed_cost']:.6g}"
-                      + ("" if solution.share_release["free_cost"] is None else
-                         f", free J {solution.share_release['free_cost']:.6g}") + ")")
+        shares = solution.share_release
+        if "fixed_knots" in shares:  # the fixed shares solved on the coarse grid only
+            costs = (f"fixed J {shares['fixed_cost']:.6g} and free J "
+                     f"{shares['coarse_free_cost']:.6g} there; the answer's J "
+                     f"{shares['free_cost']:.6g}")
+        else:
+            costs = f"fixed J {shares['fixed_cost']:.6g}" + (
+                "" if shares["free_cost"] is None else f", free J {shares['free_cost']:.6g}")
+        console.print(f"phase shares: {shares['why']} ({costs})", soft_wrap=True)
     report = None
     if check:
         report = verify_gait(gait)

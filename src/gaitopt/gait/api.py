@@ -45,6 +45,8 @@ from gaitopt.gait.solve.share_release import (
     PREFIX,
     RELEASE_STAGE_SECONDS,
     Plausibility,
+    free_options,
+    release_first,
     release_shares,
     releases_shares,
 )
@@ -124,9 +126,10 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     accuracy pass), whatever the file's estimate. ``max_rounds``: the most refinements
     (:data:`~gaitopt.gait.solve.refinement.MAX_ROUNDS`; the accuracy pass asks for more).
     ``plausible``: where the sequence's phase shares are guesses
-    (:mod:`gaitopt.gait.solve.share_release`), the converged fixed-share solve is followed by
-    the shares released (the problem solved again with them free), kept where lower,
-    converged and ``plausible`` (a check of the released run: None when plausible, else why not;
+    (:mod:`gaitopt.gait.solve.share_release`), the problem is solved first with them free,
+    and kept where converged, lower on the coarse grid and ``plausible``; otherwise the
+    fixed-share solve follows and the free one replaces it where lower, converged and
+    ``plausible`` (a check of the released run: None when plausible, else why not;
     :func:`gaitopt.analysis.plausible.verified`, which ``gaitopt solve`` passes). None: no
     release, the shares stay fixed (nothing here can judge the released gait: the checks
     of ``gaitopt verify`` live above this layer).
@@ -151,6 +154,17 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         if refines:  # start on the grid the file was refined to (gait/solve/warm_accuracy.py)
             opts = refined_grid(warm_start, robot, opts) or opts
         guess = restart_point(robot, opts, warm_start, compiled) or guess_from_gait(warm_start)
+    # Where the shares are guesses, the free problem first, from its own stages, refined: kept
+    # where it converges, lowers the coarse cost and is plausible, and then the fixed-share
+    # problem is not solved past the coarse grid (share_release's module docstring).
+    release = plausible is not None and warm_start is None and releases_shares(robot, opts)
+    judged = None if plausible is None else _judged_once(plausible)
+    own: StagedRun | None = None
+    if release:
+        own = _own_release(robot, free_options(opts), progress, compiled, refines)
+        chosen = release_first(own, robot, judged)
+        if chosen is not None:
+            return dataclasses.replace(own, share_release=chosen)
     # A warm start that refines needs its estimate: its check grid (unless the file's holds).
     first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled,
                           check_start=check_point(warm_start) if guess is not None else None,
@@ -180,18 +194,14 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
             first = dataclasses.replace(retry, stages=first.stages + retry.stages,
                                         wall_time_s=first.wall_time_s + retry.wall_time_s)
 
-    def solve_on(finer: GaitOptions, before: StagedRun, prefix: str = "",
-                 stage_seconds: float | None = None) -> StagedRun:
+    def solve_on(finer: GaitOptions, before: StagedRun) -> StagedRun:
         # Started from the check grid's result, which is the solution of this very NLP (the
         # check grid of the coarser grid is the finer grid), values and multipliers: IPOPT
         # confirms it in a few iterations. Without one, from the coarser grid's result (its
         # interpolants at the finer knots): no gait record needed, so a coarse motion that
         # leaves a leg's reach between knots is refined too.
-        again = _prefixed(solve_walking(robot, finer,
-                                        warm_start=check_result(before) or before.result,
-                                        progress=_prefixed_progress(progress, prefix),
-                                        compiled=compiled, check_warm_start=True,
-                                        stage_seconds=stage_seconds), prefix)
+        again = solve_walking(robot, finer, warm_start=check_result(before) or before.result,
+                              progress=progress, compiled=compiled, check_warm_start=True)
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
 
@@ -205,39 +215,77 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         run = dataclasses.replace(run, accuracy_extra={**carried, **extra},
                                   carried_check=check_point(warm_start))
     # A warm start follows its start: it is not released again (the file's own solve decided).
-    if (run.success and plausible is not None and warm_start is None
-            and releases_shares(robot, run.options)):
+    if run.success and release:
 
         def released(free: GaitOptions, fixed: StagedRun) -> StagedRun:
-            # The free problem from its own stages first (the shares freed on the coarse
-            # grid): measured on the seven-link, it reached the start from the fixed-share
-            # optimum's optima at 12, 30 and 60 m/min and lower ones at 80 m/min (1804.3
-            # against 1867.4, where that start crawled) and with the speed free
-            # (share_release's module docstring, docs/feet.md).
-            run = _prefixed(solve_walking(robot, free,
-                                          progress=_prefixed_progress(progress, PREFIX),
-                                          compiled=compiled,
-                                          stage_seconds=RELEASE_STAGE_SECONDS), PREFIX)
-            if not run.success or accuracy_record(run).get("cost_error") is None:
-                warm = _prefixed(solve_walking(robot, free, warm_start=fixed.result,
-                                               progress=_prefixed_progress(progress,
-                                                                           FROM_FIXED),
-                                               compiled=compiled, check_warm_start=True,
-                                               stage_seconds=RELEASE_STAGE_SECONDS),
-                                 FROM_FIXED)
-                run = dataclasses.replace(warm, stages=run.stages + warm.stages,
-                                          wall_time_s=run.wall_time_s + warm.wall_time_s)
+            # The free problem's own run from above (solved again where the fixed solve moved
+            # to the slower default speed); where it failed or left no estimate, started from
+            # the fixed-share optimum (share_release's module docstring, docs/feet.md).
+            run = own if own is not None and own.options.speed == free.speed else \
+                _own_release(robot, free, progress, compiled, refines)
+            if run.success and accuracy_record(run).get("cost_error") is not None:
+                return run
+            warm = _prefixed(solve_walking(robot, free, warm_start=fixed.result,
+                                           progress=_prefixed_progress(progress, FROM_FIXED),
+                                           compiled=compiled, check_warm_start=True,
+                                           stage_seconds=RELEASE_STAGE_SECONDS), FROM_FIXED)
+            run = dataclasses.replace(warm, stages=run.stages + warm.stages,
+                                      wall_time_s=run.wall_time_s + warm.wall_time_s)
             if accuracy_record(run).get("cost_error") is None:
                 # Its check grid failed: no estimate, so not within the accuracy, and the
                 # fixed shares stand; refining it further took 10 minutes and more.
                 return run
-            return refine_to_accuracy(
-                run, refines=refines, accuracy_of=accuracy_record,
-                solve_on=lambda o, before: solve_on(o, before, PREFIX,
-                                                    RELEASE_STAGE_SECONDS))[0]
+            return _refined_release(robot, run, progress, compiled, refines)
 
-        run = release_shares(run, released, plausible)
+        run = release_shares(run, released, judged, first=own)
     return run
+
+
+def _own_release(model: RobotModel, options: GaitOptions, progress: ProgressFn | None,
+                 compiled: str | None, refines: bool) -> StagedRun:
+    """The free-share problem ``options`` (:func:`~gaitopt.gait.solve.share_release.free_options`)
+    solved from its own stages (the naive guess, the shares freed on the coarse grid), each
+    stage within :data:`~gaitopt.gait.solve.share_release.RELEASE_STAGE_SECONDS`, its stages
+    named with :data:`~gaitopt.gait.solve.share_release.PREFIX`, and refined to the accuracy
+    where its check grid gave an estimate (a release whose check grid failed is not refined:
+    that took 10 minutes and more)."""
+    run = _prefixed(solve_walking(model, options, progress=_prefixed_progress(progress, PREFIX),
+                                  compiled=compiled, stage_seconds=RELEASE_STAGE_SECONDS),
+                    PREFIX)
+    if not run.success or accuracy_record(run).get("cost_error") is None:
+        return run
+    return _refined_release(model, run, progress, compiled, refines)
+
+
+def _refined_release(model: RobotModel, run: StagedRun, progress: ProgressFn | None,
+                     compiled: str | None, refines: bool) -> StagedRun:
+    """A free-share run refined to the accuracy, its stages named with
+    :data:`~gaitopt.gait.solve.share_release.PREFIX`."""
+
+    def solve_on(finer: GaitOptions, before: StagedRun) -> StagedRun:
+        again = _prefixed(solve_walking(model, finer,
+                                        warm_start=check_result(before) or before.result,
+                                        progress=_prefixed_progress(progress, PREFIX),
+                                        compiled=compiled, check_warm_start=True,
+                                        stage_seconds=RELEASE_STAGE_SECONDS), PREFIX)
+        return dataclasses.replace(again, stages=before.stages + again.stages,
+                                   wall_time_s=before.wall_time_s + again.wall_time_s)
+
+    return refine_to_accuracy(run, refines=refines, accuracy_of=accuracy_record,
+                              solve_on=solve_on)[0]
+
+
+def _judged_once(plausible: Plausibility) -> Plausibility:
+    """``plausible`` run at most once per run (a verify of the released gait takes about a
+    second; the free-first decision and the fallback's may both ask)."""
+    seen: dict[int, tuple[StagedRun, str | None]] = {}
+
+    def judged(run: StagedRun) -> str | None:
+        if id(run) not in seen:
+            seen[id(run)] = (run, plausible(run))
+        return seen[id(run)][1]
+
+    return judged
 
 
 def _prefixed(run: StagedRun, prefix: str) -> StagedRun:
@@ -319,8 +367,8 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
             outcome, iterations, cost, speed, step length, violation and time: the lines
             ``gaitopt solve`` prints); the stages are also in ``gait.solver["stages"]``.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
-        plausible: the check that lets a sequence's guessed phase shares be released after
-            the fixed-share solve (:mod:`gaitopt.gait.solve.share_release`), e.g.
+        plausible: the check that lets a sequence's guessed phase shares be released
+            (:mod:`gaitopt.gait.solve.share_release`), e.g.
             ``gaitopt.analysis.plausible.verified`` (``gaitopt verify`` passes on the
             released gait), which ``gaitopt solve`` uses; None: the shares stay fixed.
 

@@ -202,10 +202,10 @@ class SequenceOptions:
             first guess); full formulation, two phases or more. Not with
             ``single_support_fraction_bounds``. See
             :func:`gaitopt.gait.sequence.phase_fractions.fraction_parameters`. ``False``: the
-            shares stay fixed. ``None`` (the default): left to the sequence, fixed for the
-            solve, then released (solved again with the shares free) where they are guesses
-            (a built-in sequence of more than two phases) and the released optimum is kept
-            where it is lower, converged and plausible
+            shares stay fixed. ``None`` (the default): left to the sequence; where they are
+            guesses (a built-in sequence of more than two phases) and the caller can judge
+            the gait (``plausible``), solved free first, the fixed shares solved too only
+            where the free optimum is not kept (converged, lower, plausible)
             (:mod:`gaitopt.gait.solve.share_release`).
         phase_shares: ``None``, or each phase's share of the step (one per phase of the
             contact sequence, in (0, 1)): the first guess of the free fractions instead of the
