@@ -244,7 +244,7 @@ def test_the_free_problem_first_is_not_kept_otherwise(seven: RobotModel, change:
         stages = (COARSE[0], COARSE[1], _stage(FREEING_STAGE, 1617.0, success=False))
     free = _fake_run(seven, options, FREE_SHARES, 1655.8, stages=stages,
                      success=change != "failed",
-                     within=False if change == "not within" else True)
+                     within=change != "not within")
     verdict = "verify fails swing.reversals (4 > 3 turns)" if change == "implausible" else None
     assert release_first(free, seven, lambda run: verdict) is None
 

@@ -110,3 +110,34 @@ def test_a_rerun_refines_again_a_gait_short_of_its_rounds(tmp_path: Path,
     assert not kept(False, ACCURACY_ROUNDS - 1)
     assert kept(False, ACCURACY_ROUNDS)
     assert accurate_gait(tmp_path, source, cost * 1.01) is None  # another optimum
+
+
+def test_a_case_whose_speed_the_smoothing_sets_gets_no_pass(
+        tmp_path: Path, seven_link: RobotModel, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A speed-free optimum whose cost is mostly the smoothing (the work cost, 0 W/kg: 43-51 %
+    measured) has no optimal speed of its own: no accuracy pass, not counted within or not
+    within, its status says why; below the threshold the pass runs as before."""
+    import gaitopt.study.cost_study as cost_study
+
+    spec = CostStudySpec(models=(seven_link,), costs=("work",), start_speed=1.25)
+    case = tmp_path / "seven-link" / "work"
+    file = _case(case, 0.004)
+    (case / file).parent.mkdir(parents=True, exist_ok=True)
+    (case / file).write_text("{}", encoding="utf-8")  # the pass reads the winner's file
+    shares: list[Path] = []
+
+    def share(path: Path) -> float:
+        shares.append(path)
+        return 0.45
+
+    monkeypatch.setattr(cost_study, "smoothing_share", share)
+    assert cost_study.accuracy_tasks(spec, tmp_path) == []
+    (row,) = collect_rows(spec, tmp_path)
+    assert row.success and row.within_accuracy is None
+    assert cost_study.SMOOTHING_NOTE in row.status and row.smoothing_share == 0.45
+    assert shares and all(p == case / file for p in shares)
+    monkeypatch.setattr(cost_study, "smoothing_share",
+                        lambda path: cost_study.SMOOTHING_SETS_SPEED / 2)
+    assert len(cost_study.accuracy_tasks(spec, tmp_path)) == 1
+    (row,) = collect_rows(spec, tmp_path)
+    assert row.within_accuracy is False and cost_study.SMOOTHING_NOTE not in row.status

@@ -60,6 +60,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
     from gaitopt.study.cost_start import StartChoice
     from gaitopt.study.cost_study import (
         ACCURACY,
+        SMOOTHING_SETS_SPEED,
         CostStudyError,
         CostStudySpec,
         CostSweep,
@@ -223,6 +224,12 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
         console.print(f"accuracy: {len(checked) - len(missed)} of {len(checked)} cases within "
                       f"{100 * ACCURACY:g} %" + ("" if not missed else "; not within: " + "; ".join(
                           f"{r.model} {r.case} ({r.status})" for r in missed)), soft_wrap=True)
+    unset = [r for r in rows if r.success and r.smoothing_share > SMOOTHING_SETS_SPEED]
+    if unset:
+        console.print("no optimal speed of their own (the smoothing sets it; the cost falls "
+                      "with the speed; not refined, not counted above): " + "; ".join(
+                          f"{r.model} {r.case} (found at {r.speed_m_min:.1f} m/min)"
+                          for r in unset), soft_wrap=True)
     smoothed = [r for r in rows if r.success and r.smoothing_share > ACCURACY]
     if smoothed:
         console.print(f"cost smoothing above {100 * ACCURACY:g} % of the cost (the smoothing, "
