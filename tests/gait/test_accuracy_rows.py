@@ -63,3 +63,12 @@ def test_a_large_smoothing_share_is_shown_above_the_accuracy() -> None:
     assert rows["cost smoothing"].startswith("0.22 % of J") and "above" not in rows[
         "cost smoothing"]
     assert "cost smoothing" not in dict(accuracy_rows({**BASE, "cost_error": None}))
+
+
+def test_a_cost_of_transport_error_has_no_paper_units() -> None:
+    accuracy = {**BASE, "cost_error": -1.2e-5, "cost_error_relative": 0.004,
+                "cost_error_factor": 3.0,
+                "check_knots": {"single_support": 24, "double_support": 8},
+                "check_cost": 0.00308, "speed_change": 0.0, "step_length_change": 0.0}
+    text = dict(accuracy_rows(accuracy, unit=""))["cost error estimate"]
+    assert text.startswith("-1.2e-05 = 0.40 % of J") and "N^2" not in text

@@ -52,7 +52,9 @@ def summary_table(gait: Gait, sequence_used: ContactSequence | None) -> Table:
     table.add_row("NLP size", f"{s['variables']} variables, {s['equality_constraints']} "
                   f"equality, {s['inequality_constraints']} inequality constraints")
     table.add_row("iterations (last stage)", str(s["iterations"]))
-    for row in accuracy_rows(s["accuracy"], speed=gait.speed, step_length=gait.step_length):
+    paper = gait.options.get("cost", "paper") == "paper"
+    for row in accuracy_rows(s["accuracy"], speed=gait.speed, step_length=gait.step_length,
+                             unit=" N^2 m s" if paper else ""):
         table.add_row(*row)
     table.add_row("wall time", f"{s['wall_time_s']:.2f} s")
     return table
@@ -87,10 +89,12 @@ def phase_fractions_text(sequence: ContactSequence, gait: Gait) -> str:
 
 
 def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
-                  step_length: float | None = None) -> list[tuple[str, str]]:
+                  step_length: float | None = None,
+                  unit: str = " N^2 m s") -> list[tuple[str, str]]:
     """Summary rows of a gait file's ``solver.accuracy``: the collocation error per phase,
     the cost's discretization error estimate and how far speed and step length moved (with
-    their estimates relative to the gait's ``speed`` and ``step_length`` when given)."""
+    their estimates relative to the gait's ``speed`` and ``step_length`` when given);
+    ``unit``: the cost's, after the error (the paper's; empty for a cost of transport)."""
     errors = ", ".join(f"{name} {'n/a' if e is None else f'{e:.1e}'} "
                        f"({accuracy['knots'][name]} knots)"
                        for name, e in accuracy["collocation_error"].items())
@@ -116,7 +120,7 @@ def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
         f" = {100 * rel:.2f} % of J: " + (
             f"within {100 * target:g} %" if rel <= target else
             f"above {100 * target:g} % (a finer --knots or --mesh-tol 1e-4)"))
-    rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g} N^2 m s{share} ({how})"))
+    rows.append(("cost error estimate", f"{accuracy['cost_error']:+.4g}{unit}{share} ({how})"))
     if accuracy.get("target") is not None:
         worst, name = accuracy.get("worst_estimate"), accuracy.get("worst_estimate_of", "cost")
         shown = "none" if worst is None else f"{100 * worst:.2g} %"
