@@ -197,6 +197,11 @@ def test_without_a_plausibility_check_the_shares_stay_fixed(monkeypatch: pytest.
     assert solve_staged_run(seven, GaitOptions()) is fixed and calls == []
     assert solve_staged_run(seven, GaitOptions(), plausible=lambda run: None) is fixed
     assert calls == ["own", ("release", own)]
+    # a fixed solve at another speed (the slower default) does not reuse the free run
+    calls.clear()
+    fixed.options = fixed.options.replace(speed=0.2)
+    assert solve_staged_run(seven, GaitOptions(), plausible=lambda run: None) is fixed
+    assert calls == ["own", ("release", None)]
 
 
 def _stage(name: str, objective: float, success: bool = True,

@@ -216,12 +216,14 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                                   carried_check=check_point(warm_start))
     # A warm start follows its start: it is not released again (the file's own solve decided).
     if run.success and release:
+        # The free problem's own run from above, unless the fixed solve moved to the slower
+        # default speed (then solved again there).
+        reused = own if own is not None and own.options.speed == run.options.speed else None
 
         def released(free: GaitOptions, fixed: StagedRun) -> StagedRun:
-            # The free problem's own run from above (solved again where the fixed solve moved
-            # to the slower default speed); where it failed or left no estimate, started from
+            # Where the free problem's own run failed or left no estimate, it is started from
             # the fixed-share optimum (share_release's module docstring, docs/feet.md).
-            run = own if own is not None and own.options.speed == free.speed else \
+            run = reused if reused is not None else \
                 _own_release(robot, free, progress, compiled, refines)
             if run.success and accuracy_record(run).get("cost_error") is not None:
                 return run
@@ -237,7 +239,7 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                 return run
             return _refined_release(robot, run, progress, compiled, refines)
 
-        run = release_shares(run, released, judged, first=own)
+        run = release_shares(run, released, judged, first=reused)
     return run
 
 
