@@ -83,7 +83,8 @@ Plausibility = Callable[[StagedRun], str | None]
 def releases_shares(model: RobotModel, options: GaitOptions) -> bool:
     """Whether a solve with ``options`` (after
     :func:`~gaitopt.gait.options.model_defaults.options_for_model`) releases its phase shares
-    after the fixed-share solve: ``free_phase_fractions`` left to the sequence (``None``), no
+    (:func:`release_first`, :func:`release_shares`): ``free_phase_fractions`` left to the
+    sequence (``None``), no
     share bounds given (``single_support_fraction_bounds``, a given contact sequence, a
     stride), a formulation that can free shares, and a built-in sequence whose step has more
     than two phases, none of them free already."""

@@ -88,8 +88,8 @@ class StagedRun:
     #: grid, so the same check grid optimum); written again with the new gait file. None
     #: otherwise.
     carried_check: WarmStart | None = None
-    #: Where the phase shares were released after the fixed-share solve, which optimum was
-    #: kept and why (:func:`gaitopt.gait.solve.share_release.decision`, the gait file's
+    #: Where the phase shares were released, which optimum was kept and why
+    #: (:func:`gaitopt.gait.solve.share_release.decision` or ``release_first``, the gait file's
     #: ``solver.phase_shares``); None where they were not.
     share_release: Mapping[str, Any] | None = None
 
