@@ -640,14 +640,17 @@ SMOOTHING_NOTE = ("no optimal speed of its own: the smoothing sets it (the cost 
 
 
 def smoothing_share(gait: Gait | Path) -> float:
-    """The share of a gait's cost that is the smoothing of its positive parts
-    (:func:`~gaitopt.gait.formulations.cost.smoothing_record`; a gait or its file); NaN for
-    the paper's cost or a file that cannot be read."""
+    """The share of a gait's cost that is the smoothing of its positive parts (a gait or its
+    file): the file's ``solver.accuracy.smoothing``, or for a file written before it
+    :func:`~gaitopt.gait.formulations.cost.smoothing_record`; NaN for the paper's cost or a
+    file that cannot be read."""
     try:
-        record = smoothing_record(gait if isinstance(gait, Gait) else Gait.load(gait))
+        loaded = gait if isinstance(gait, Gait) else Gait.load(gait)
+        stored = (loaded.solver.get("accuracy") or {}).get("smoothing")
+        record = stored if stored is not None else smoothing_record(loaded)
     except (OSError, ValueError, GaitFileError):
         return math.nan
-    return math.nan if record is None else record["share"]
+    return math.nan if record is None else float(record["share"])
 
 
 def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list[CostRow]:
@@ -677,7 +680,8 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
         value, start, fields, other = found
         accuracy: dict[str, Any] = {}
         target = spec.accuracy_of(sweep.model)
-        smoothed = smoothing_share(top / fields["file"]) > SMOOTHING_SETS_SPEED
+        winner_share = smoothing_share(top / fields["file"])
+        smoothed = winner_share > SMOOTHING_SETS_SPEED
         accurate = (accurate_gait(top / sweep.subdir, fields["file"], value)
                     if target is not None and not smoothed else None)
         if smoothed:
@@ -705,7 +709,7 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
         bound = speed_bound_reached(fields["speed_m_min"], sweep.spec.base.speed_bounds)
         if bound is not None:
             fields["status"] = f"{fields['status']}; {SPEED_BOUND_NOTE.format(bound=bound)}"
-        share = smoothing_share(accurate if accurate is not None else top / fields["file"])
+        share = smoothing_share(accurate) if accurate is not None else winner_share
         if target is not None and share > target:
             fields["status"] += (f"; the smoothing is {100 * share:.2g} % of the cost "
                                  f"(> {100 * target:g} %)")
