@@ -410,3 +410,29 @@ def test_an_unbounded_joint_has_no_excess_over_its_limits(default_gait: Gait) ->
     report = verify_gait(gait)
     for key in ("bounds.joints_knots", "bounds.joints_samples"):
         assert report.check(key).passed and np.isfinite(report.check(key).value), key
+
+
+def test_a_verifier_verifies_a_gait_once(default_solved: Any, default_gait: Gait,
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    # `gaitopt solve` judges the released gait and then writes it: the Verifier keeps the
+    # report, and returns it for the same motion with another solver record or time of
+    # writing; a gait that differs in what verify reads is verified again.
+    import gaitopt.analysis.plausible as plausible
+
+    calls: list[Gait] = []
+
+    def counted(gait: Gait, **kwargs: Any) -> VerifyReport:
+        calls.append(gait)
+        return verify_gait(gait, **kwargs)
+
+    monkeypatch.setattr(plausible, "verify_gait", counted)
+    verifier = plausible.Verifier()
+    assert verifier(default_solved.solution) is None
+    rewritten = replace(default_gait, created="2000-01-01T00:00:00+00:00",
+                        solver={**default_gait.solver, "note": "written later"})
+    assert verifier.report(rewritten).passed
+    assert len(calls) == 1
+    moved = copy.deepcopy(default_gait.to_dict())
+    moved["phases"][0]["u"][3][0] += 5.0
+    report = verifier.report(Gait.from_dict(moved))
+    assert len(calls) == 2 and not report.passed

@@ -262,8 +262,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
                   multistart: bool | None,
                   warm_start: Path | None, check: bool, output: Path) -> None:
     """Solve the minimum-energy walking problem and write the gait file."""
-    from gaitopt.analysis.plausible import verified
-    from gaitopt.analysis.verify import verify_gait
+    from gaitopt.analysis.plausible import Verifier
     from gaitopt.cli.gait_summary import summary_table
     from gaitopt.gait.api import as_model, solve_staged_run, warm_start_usable
     from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
@@ -363,11 +362,12 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
     def progress(stage: StageRecord) -> None:
         console.print("  stage " + stage.line())
 
+    verifier = Verifier()
     try:
         solution = solve_staged_run(model, options, progress=progress, warm_start=start,
                                     compiled="codegen" if compiled else None,
                                     refine=refine, speed_given=speed is not None,
-                                    plausible=verified)
+                                    plausible=verifier)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:
@@ -402,7 +402,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
         console.print(f"phase shares: {shares['why']} ({costs})", soft_wrap=True)
     report = None
     if check:
-        report = verify_gait(gait)
+        report = verifier.report(gait)
         gait = dataclasses.replace(gait, solver={**gait.solver, "verify": report.record()})
         console.print(f"verify: all {len(report.checks)} checks pass" if report.passed else
                       f"VERIFY FAILS {len(report.failed_ids)} of {len(report.checks)} checks: "

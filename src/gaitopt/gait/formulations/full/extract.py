@@ -89,7 +89,8 @@ def full_phases_and_events(model: RobotModel, seq: ContactSequence, res: Any, st
             qdd=qdd, u=u_full,
             contact_forces={hold_name(c): forces[:, 2 * k:2 * k + 2]
                             for k, c in enumerate(spec.held)},
-            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot))
+            state_names=tuple(ph.states), x=ph.x, xdot=ph.xdot,
+            error_estimate=ph.error if np.all(np.isfinite(ph.error)) else None))
         ev = seq.events[i]
         q_end, qd_end = ph.x[-1, :nq], ph.x[-1, nq:]
         jump = full.event_map(model, seq, i, q_end, qd_end, impulse)
