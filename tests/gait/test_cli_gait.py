@@ -78,7 +78,8 @@ def test_a_gait_verify_rejects_is_written_with_exit_status_4(
         return VerifyReport(tuple(Check(c.id, 2 * c.limit + 1.0, c.limit, "made to fail")
                                   if c.id == "swing.reversals" else c for c in checks))
 
-    monkeypatch.setattr("gaitopt.analysis.verify.verify_gait", rejects)
+    # The solve verifies through gaitopt.analysis.plausible.Verifier (once per gait).
+    monkeypatch.setattr("gaitopt.analysis.plausible.verify_gait", rejects)
     out = tmp_path / "rejected.gait.json"
     result = solve("--knots", "4,3", "-o", str(out))
     assert result.exit_code == 4, result.output

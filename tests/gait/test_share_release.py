@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from gaitopt.analysis.plausible import verified
+from gaitopt.analysis.plausible import Verifier, verified
 from gaitopt.analysis.verify import verify_gait
 from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.formulations.select import contact_sequence
@@ -290,7 +290,8 @@ def test_the_command_line_passes_the_choice_and_the_verify_check(
         value: bool | None) -> None:
     """``gaitopt solve``: no flag leaves the shares to the sequence (released where they are
     guesses), ``--fixed-fractions`` / ``--free-fractions`` decide; the solve gets
-    ``verified`` as its plausibility check."""
+    a :class:`~gaitopt.analysis.plausible.Verifier` (``verified``, remembering each report)
+    as its plausibility check."""
     from click.testing import CliRunner
 
     import gaitopt.gait.api as api
@@ -307,7 +308,7 @@ def test_the_command_line_passes_the_choice_and_the_verify_check(
                                       *flag, "-o", str(tmp_path / "g.gait.json")])
     assert result.exit_code == 0, result.output
     assert seen["options"].free_phase_fractions is value
-    assert seen["plausible"] is verified
+    assert isinstance(seen["plausible"], Verifier)
 
 
 # -- the seven-link default solves (slow: minutes each) -------------------------------------
