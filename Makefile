@@ -44,7 +44,7 @@ costs: $(STAMP)
 
 # The walk-run study (docs/running.md): the walks and runs of the five-link, seven-link and
 # adult-point-feet bipeds at each speed under the paper's and the metabolic cost, and the
-# walk-run transition (about an hour on one worker process).
+# walk-run transition (about 20 minutes on 2 cores).
 walk-run: $(STAMP)
 	$(BIN)/gaitopt study --walk-run -o out/walk-run
 
