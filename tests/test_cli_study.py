@@ -224,3 +224,54 @@ def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,
         for path in gaits:
             options = Gait.load(path).options
             assert {k: options[k] for k in expected} == expected
+
+
+def test_the_check_sweep_with_feet_starts_each_point_from_the_same_point(tmp_path: Path) -> None:
+    """With feet every fixed-speed check-grid point is seeded from the study's gait of the
+    same point (no continuation in speed), and only where that gait exists; each speed-free
+    optimum continues from its group's point at the start speed. The five-link walk keeps
+    its chains, each from a cold start."""
+    from gaitopt.cli.study import check_sweep, study_spec
+
+    feet = study_spec("seven-link", "24,48,72", {"knots": (36, 24)})
+    assert feet.continuation
+    for key in [p.key for p in feet.points]:  # the study's gaits of every point
+        (tmp_path / key).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / key).write_text("{}", encoding="utf-8")
+    (tmp_path / feet.points[0].key).unlink()  # one point failed in the study: no gait
+    check, seeds = check_sweep(feet, tmp_path)
+    assert not check.continuation
+    assert [p.key for p in check.points] == [p.key for p in feet.points]
+    fixed = [p for p in check.points if p.speed is not None]
+    free = [p for p in check.points if p.speed is None]
+    assert len(free) == len(check.variants) and len(fixed) == 3 * len(check.variants)
+    assert all(check.parents[p.key] is None for p in fixed)
+    for p in free:  # from the point at the start speed (72 m/min) of its variant
+        parent = next(q for q in fixed if q.key == check.parents[p.key])
+        assert parent.variant == p.variant and parent.speed == pytest.approx(1.2)
+    assert seeds == {p.key: tmp_path / p.key for p in fixed[1:]}
+    assert feet.points[0].key not in seeds
+
+    walk = study_spec("five-link", "6,12", {"knots": (24, 8)})
+    check, seeds = check_sweep(walk, tmp_path)
+    assert check is walk and seeds == {}
+
+
+def test_a_failed_point_of_a_sweep_without_chains_restarts_from_its_nearest_neighbour(
+        tmp_path: Path) -> None:
+    """The rerun of a check sweep with feet starts a point without a gait file from the
+    nearest converged fixed-speed point of its variant, never from another variant's."""
+    from gaitopt.cli.study import check_sweep, neighbour_seeds, study_spec
+
+    check, _ = check_sweep(study_spec("seven-link", "24,48,72", {"knots": (36, 24)}), tmp_path)
+    by = {(p.variant, None if p.speed is None else round(p.speed * 60.0)): p.key
+          for p in check.points}
+    missing = {("plain", 24), ("plain", 48), ("ankle", 72), ("ankle", None)}
+    for key in set(by) - missing:
+        (tmp_path / by[key]).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / by[key]).write_text("{}", encoding="utf-8")
+    seeds = neighbour_seeds(check, tmp_path)
+    assert seeds == {by["plain", 24]: tmp_path / by["plain", 72],
+                     by["plain", 48]: tmp_path / by["plain", 72],
+                     by["ankle", 72]: tmp_path / by["ankle", 48],
+                     by["ankle", None]: tmp_path / by["ankle", 48]}

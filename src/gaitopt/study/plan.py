@@ -74,7 +74,10 @@ class SweepSpec:
             values the points are solved with (for the five-link biped the same values).
         continuation: points warm-start from their neighbours along the speed axis; with
             False every point starts alone (cold, or from a seed file: the refinement sweep
-            of :mod:`gaitopt.study.grid_error`).
+            of :mod:`gaitopt.study.grid_error`), but see ``free_from_start``.
+        free_from_start: with ``continuation`` False, each speed-free optimum still
+            warm-starts from its group's fixed-speed point at the start speed (its values and
+            multipliers; the check sweep with feet, :func:`gaitopt.cli.study.check_sweep`).
         check_grid: every point solves its check grid after the answer, a warm-started one
             too (``solve_walking(check_warm_start=True)``), so that every gait file carries
             the cost's grid error estimate (``solver.accuracy.cost_error``); otherwise only
@@ -90,6 +93,7 @@ class SweepSpec:
     single_support: tuple[float, ...] = (0.85,)
     base: GaitOptions = field(default_factory=GaitOptions)
     continuation: bool = True
+    free_from_start: bool = False
     check_grid: bool = False
 
     def __post_init__(self) -> None:
@@ -137,9 +141,9 @@ class SweepSpec:
     @cached_property
     def parents(self) -> Mapping[str, str | None]:
         """Point key -> the key of the point it is warm-started from (None: cold start)."""
-        parents: dict[str, str | None] = {}
-        if not self.continuation:
-            return {p.key: None for p in self.points}
+        parents: dict[str, str | None] = {p.key: None for p in self.points}
+        if not self.continuation and not self.free_from_start:
+            return parents
         groups: dict[tuple[Any, ...], list[SweepPoint]] = {}
         for p in self.points:
             groups.setdefault(p.group, []).append(p)
@@ -147,7 +151,7 @@ class SweepSpec:
             fixed = [p for p in members if p.speed is not None]
             free = [p for p in members if p.speed is None]
             start = start_index([p.speed for p in fixed if p.speed is not None], self.start)
-            for i, p in enumerate(fixed):
+            for i, p in enumerate(fixed if self.continuation else ()):
                 parents[p.key] = (None if i == start else
                                   fixed[i - 1].key if i > start else fixed[i + 1].key)
             for p in free:
@@ -334,6 +338,7 @@ def sweep_settings(spec: SweepSpec) -> dict[str, Any]:
         "options": shared,
     } | ({"step_times": list(spec.step_times)} if spec.step_times != (None,) else {}) | (
         {} if spec.continuation else {"continuation": False}) | (
+        {"free_from_start": True} if spec.free_from_start else {}) | (
         {"check_grid": True} if spec.check_grid else {})
 
 
