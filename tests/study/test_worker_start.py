@@ -53,3 +53,48 @@ def test_a_point_from_a_file_solves_its_check_grid_to_the_same_estimate(
     accuracy = outcome.gait["solver"]["accuracy"]
     original = json.loads(saved.text)["solver"]["accuracy"]
     assert accuracy["check_cost"] == pytest.approx(original["check_cost"], rel=1e-5)
+
+
+def finer(model: RobotModel, warm: SavedGait) -> PointTask:
+    """The point of ``task`` on 24 + 8 knots (the file solved 16 + 6)."""
+    return PointTask(key="k", model=model,
+                     options=options_for_model(model, GaitOptions(speed=0.3, knots=(24, 8))),
+                     variant="ankle+impulse", speed_mode="fixed", structure="s", warm=warm,
+                     relfile="k.gait.json")
+
+
+def test_a_file_of_another_grid_starts_the_point_with_its_multipliers_mapped(
+        five_link: RobotModel, saved: SavedGait) -> None:
+    """The file's point and multipliers mapped onto the point's grid (the study's check and
+    refinement sweeps): a start with multipliers, not the file's values alone; mapped onto
+    the file's own grid it is the file's point again."""
+    from gaitopt.gait.api import regridded_point, restart_point
+    from gaitopt.gait.record.file import Gait
+    from gaitopt.gait.solve.warm_accuracy import stored_point
+    from gaitopt.ocp import WarmStart
+    from gaitopt.study.worker import REGRIDDED
+
+    point, how, _ = _warm_start(finer(five_link, saved))
+    assert how == REGRIDDED and isinstance(point, WarmStart)
+    assert np.all(np.isfinite(point.lam_g)) and np.any(point.lam_g != 0.0)
+
+    gait = Gait.from_dict(json.loads(saved.text))
+    own = regridded_point(five_link, options(five_link), gait)
+    kept = stored_point(gait.solver["warm_start"])
+    assert own is not None and kept is not None
+    assert restart_point(five_link, options(five_link), gait) is not None  # the same grid
+    np.testing.assert_allclose(own.w, kept.w, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(own.lam_g, kept.lam_g, rtol=1e-6, atol=1e-9)
+
+    without = json.loads(saved.text)
+    del without["solver"]["warm_start"]  # a file written before it kept its point
+    assert regridded_point(five_link, finer(five_link, saved).options,
+                           Gait.from_dict(without)) is None
+
+
+def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
+        five_link: RobotModel, saved: SavedGait) -> None:
+    outcome = solve_point(finer(five_link, saved))
+    cold = solve_gait(five_link, finer(five_link, saved).options)
+    assert outcome.gait is not None and outcome.warm == "file, regridded"
+    assert outcome.gait["cost"]["value"] == pytest.approx(cold.cost_value, rel=1e-5)

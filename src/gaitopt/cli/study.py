@@ -337,15 +337,16 @@ def check_sweep(check: SweepSpec, directory: Path) -> tuple[SweepSpec, dict[str,
     for a study in ``directory``. The five-link walk as ``check`` says: chains along the
     speed axis, each from a cold start. A walk with feet (any contact sequence but the
     two-phase walk): each fixed-speed point warm-started from the study's gait of the same
-    point where it converged (its values on the finer grid; no continuation in speed), so
-    the check grid solves the optimum the estimate compares with; each speed-free optimum
+    point where it converged (its point and multipliers mapped onto the finer grid,
+    :func:`gaitopt.gait.api.regridded_point`; no continuation in speed), so the check grid
+    solves the optimum the estimate compares with; each speed-free optimum
     from its group's check point at the start speed (values and multipliers, as before:
     from its own gait's values the check grid's optimum moved by 3 m/min, to a dearer one).
 
     Measured on the seven-link study (docs/studies.md, "The check sweep with feet"):
     chained from the neighbour at the next speed, the check grid reached other local optima
-    than the study's grid at 12 and 24 m/min (8 % and 4 % apart), which the estimate read as
-    grid errors above 1 % and the refinement re-solved on up to 81 + 54 knots (900 s), and
+    than the study's grid at 12 and 24 m/min (8.5 % and 1.4 % apart), which the estimate read
+    as grid errors above 1 % and the refinement re-solved on up to 81 + 54 knots (900 s), and
     one chained point ran 476 iterations in 980 s (16 from its own gait)."""
     if check.base.gait == "walk":
         return check, {}

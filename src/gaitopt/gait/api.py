@@ -66,7 +66,8 @@ from gaitopt.gait.solve.warm_accuracy import (
     same_problem,
     stored_point,
 )
-from gaitopt.ocp import Guess, PhaseGuess, WarmStart
+from gaitopt.ocp import Guess, PhaseGuess, ProblemError, WarmStart
+from gaitopt.ocp.regrid import regridded
 from gaitopt.robot import RobotModel, load_model
 
 
@@ -353,6 +354,36 @@ def restart_point(model: RobotModel, options: GaitOptions, gait: Gait,
     # than their counts, which would build the same NLP twice).
     tr = transcription_for(model, options, target_grid(model, options), compiled=compiled)
     return point if point.fits(tr.layout, tr.method, tr.nlp.lbg.size) else None
+
+
+def regridded_point(model: RobotModel, options: GaitOptions, gait: Gait,
+                    compiled: str | None = None) -> WarmStart | None:
+    """The NLP point and multipliers a gait file keeps (``solver.warm_start``) mapped onto
+    the grid ``options`` solve on, where the file solved the same problem on another fixed
+    grid (its ``knots``, ``knot_spacing`` and ``phase_shares`` options; the layout checked):
+    its values interpolated and its multipliers mapped (:func:`gaitopt.ocp.regrid.regridded`),
+    as a solve maps its own solution onto its check grid. Start IPOPT from it with
+    :data:`~gaitopt.gait.solve.staged.REGRID_OPTIONS` (``solve_walking(warm_start_options=...)``).
+    None where the file keeps no point, it does not fit the file's own grid, or either grid
+    is adaptive (``mesh_tol``)."""
+    point = stored_point(gait.solver.get("warm_start"))
+    saved = gait.options
+    if point is None or options.mesh_tol is not None or saved.get("mesh_tol") is not None:
+        return None
+    try:
+        shares, spacing = saved.get("phase_shares"), saved["knot_spacing"]
+        if spacing not in ("uniform", "cosine"):
+            return None
+        own = options.replace(knots=tuple(int(k) for k in saved["knots"]),
+                              knot_spacing="uniform" if spacing == "uniform" else "cosine",
+                              phase_shares=None if shares is None else
+                              tuple(float(v) for v in shares))
+        source = transcription_for(model, own, target_grid(model, own), compiled=compiled)
+        target = transcription_for(model, options, target_grid(model, options),
+                                   compiled=compiled)
+        return regridded(target, source.result_at(point))
+    except (KeyError, TypeError, ValueError, ProblemError):  # options, file or problem
+        return None
 
 
 def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions | None = None,

@@ -302,6 +302,25 @@ class Transcription:
             out = call_solver(solver, args)
         return self._result(out, b)
 
+    def result_at(self, start: WarmStart) -> Result:
+        """The :class:`~gaitopt.ocp.Result` of this transcription at the NLP point and
+        multipliers ``start`` (a solution kept in a file, unscaled as a Result holds them),
+        without solving: its trajectories, parameters and multipliers, e.g. to map it onto
+        another grid (:func:`gaitopt.ocp.regrid.regridded`). Its status says so
+        (``not solved``, not a success).
+
+        Raises:
+            ProblemError: ``start`` was made for another transcription (layout, method or
+                constraint count differ).
+        """
+        if not start.fits(self.layout, self.method, self.nlp.lbg.size):
+            raise ProblemError("start: made for another transcription (layout differs)")
+        n = self.nlp
+        out = SolverOutput(start.w / n.d_w, start.lam_x * n.d_w / n.objective_scale,
+                           start.lam_g * n.d_g / n.objective_scale, math.nan,
+                           {"return_status": "not solved"}, None)
+        return self._result(out, self._bounds)
+
     def _result(self, out: SolverOutput, b: Bounds) -> Result:
         nlp = self.nlp
         w = out.x * nlp.d_w

@@ -584,10 +584,16 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   compiled: str | None = None,
                   check_warm_start: bool = False,
                   check_start: WarmStart | None = None,
-                  stage_seconds: float | None = None) -> StagedRun:
+                  stage_seconds: float | None = None,
+                  warm_start_options: dict[str, Any] | None = None) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
     succeeded and which stage failed.
+
+    ``warm_start_options``: IPOPT options of stage ``warm start`` merged over the
+    transcription's warm-start options, for a ``warm_start`` with multipliers
+    (:data:`REGRID_OPTIONS` for one mapped from another grid,
+    :func:`gaitopt.gait.api.regridded_point`).
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
@@ -609,7 +615,8 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     if warm_start is not None:
         result = run.stage("warm start", warm_start_grid(model, options, warm_start), Relaxation(),
                            warm_start, parameter_bounds(options),
-                           solver_options=PRIMAL_WARM_OPTIONS)
+                           solver_options=PRIMAL_WARM_OPTIONS,
+                           warm_start_options=warm_start_options)
         if not result.success:
             result = None
         elif check_warm_start and options.mesh_tol is None:
