@@ -218,8 +218,10 @@ def test_a_seven_link_run_converges_and_verifies(speed_m_min: float) -> None:
 def test_a_seven_link_run_at_400_m_per_min_resolves_its_flight() -> None:
     """At 400 m/min the seven-link run's flight takes about 65 % of the step: its knots follow
     the stance's density, and the re-integration of every interval passes
-    (``integration.interval``, which failed on main's 6 flight knots; the run still fails
-    ``swing.reversals``, its ankle on its joint limit: docs/running.md)."""
+    (``integration.interval``, which failed on main's 6 flight knots). Without a plausibility
+    check this optimum fails ``swing.reversals``, its ankle on its joint limit, which
+    ``gaitopt solve`` mends with its torque-rate fallback
+    (tests/gait/test_torque_rate_fallback.py, docs/running.md)."""
     gait = solve_gait("seven-link", GaitOptions(gait="run", impulse=False, speed=400.0 / 60.0))
     assert gait.success
     assert gait.solver["accuracy"]["within_target"]

@@ -48,6 +48,7 @@ from gaitopt.gait.options.model_scale import model_scale
 from gaitopt.gait.options.preflight import refuse_unwalkable
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.staged import REFERENCE_SPEED, StageRecord, reference_speed
+from gaitopt.gait.solve.torque_rate_fallback import fallback_line
 from gaitopt.robot.biped import BipedStructureError
 from gaitopt.units import format_speed, parse_speed
 
@@ -400,6 +401,8 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
             costs = f"fixed J {shares['fixed_cost']:.6g}" + (
                 "" if shares["free_cost"] is None else f", free J {shares['free_cost']:.6g}")
         console.print(f"phase shares: {shares['why']} ({costs})", soft_wrap=True)
+    if solution.torque_rate_fallback is not None:
+        console.print(fallback_line(solution.torque_rate_fallback), soft_wrap=True)
     report = None
     if check:
         report = verifier.report(gait)

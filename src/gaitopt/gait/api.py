@@ -58,6 +58,14 @@ from gaitopt.gait.solve.staged import (
     transcription_for,
 )
 from gaitopt.gait.solve.staged_run import check_result as check_result
+from gaitopt.gait.solve.torque_rate_fallback import (
+    FALLBACK_TORQUE_RATE_TIMES,
+    fallback_record,
+    rejection,
+    smoothed_options,
+    verdict_on,
+)
+from gaitopt.gait.solve.torque_rate_fallback import PREFIX as SMOOTHED
 from gaitopt.gait.solve.transcriptions import target_grid
 from gaitopt.gait.solve.warm_accuracy import (
     carried_estimate,
@@ -133,7 +141,9 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     ``plausible`` (a check of the released run: None when plausible, else why not;
     :func:`gaitopt.analysis.plausible.verified`, which ``gaitopt solve`` passes). None: no
     release, the shares stay fixed (nothing here can judge the released gait: the checks
-    of ``gaitopt verify`` live above this layer).
+    of ``gaitopt verify`` live above this layer). A converged answer that ``plausible``
+    rejects is solved again with a torque-rate term where its cost has none
+    (:mod:`gaitopt.gait.solve.torque_rate_fallback`).
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
@@ -245,10 +255,45 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                 # Its check grid failed: no estimate, so not within the accuracy, and the
                 # fixed shares stand; refining it further took 10 minutes and more.
                 return run
-            return _refined_release(robot, run, progress, compiled, refines)
+            return _refined(robot, run, progress, compiled, refines, PREFIX,
+                            RELEASE_STAGE_SECONDS)
 
         run = release_shares(run, released, judged, first=reused)
-    return run
+    return _smoothed_if_rejected(robot, run, judged, progress, compiled, refines)
+
+
+def _smoothed_if_rejected(model: RobotModel, run: StagedRun, judged: Plausibility | None,
+                          progress: ProgressFn | None, compiled: str | None,
+                          refines: bool) -> StagedRun:
+    """``run``, or where ``judged`` rejects its answer, the first answer of the same problem
+    with a torque-rate term (each ``tau`` of
+    :data:`~gaitopt.gait.solve.torque_rate_fallback.FALLBACK_TORQUE_RATE_TIMES` in turn,
+    solved from the answer before and refined) that converges and passes
+    (:mod:`gaitopt.gait.solve.torque_rate_fallback`); either way with every stage and the
+    record of what was done."""
+    why = rejection(run, judged)
+    if why is None or judged is None:
+        return run
+    tries: list[tuple[float, StagedRun, str | None]] = []
+    start, stages, wall = run, run.stages, run.wall_time_s
+    for tau in FALLBACK_TORQUE_RATE_TIMES:
+        smoothed = _prefixed(solve_walking(model, smoothed_options(start.options, tau),
+                                           warm_start=start.result,
+                                           progress=_prefixed_progress(progress, SMOOTHED),
+                                           compiled=compiled, check_warm_start=True), SMOOTHED)
+        if smoothed.success and accuracy_record(smoothed).get("cost_error") is not None:
+            smoothed = _refined(model, smoothed, progress, compiled, refines, SMOOTHED)
+        verdict = verdict_on(smoothed, judged)
+        tries.append((tau, smoothed, verdict))
+        stages, wall = stages + smoothed.stages, wall + smoothed.wall_time_s
+        if verdict is None:
+            return dataclasses.replace(smoothed, stages=stages, wall_time_s=wall,
+                                       share_release=run.share_release,
+                                       torque_rate_fallback=fallback_record(why, run, tries))
+        if smoothed.success:
+            start = smoothed
+    return dataclasses.replace(run, stages=stages, wall_time_s=wall,
+                               torque_rate_fallback=fallback_record(why, run, tries))
 
 
 def _own_release(model: RobotModel, options: GaitOptions, progress: ProgressFn | None,
@@ -264,20 +309,21 @@ def _own_release(model: RobotModel, options: GaitOptions, progress: ProgressFn |
                     PREFIX)
     if not run.success or accuracy_record(run).get("cost_error") is None:
         return run
-    return _refined_release(model, run, progress, compiled, refines)
+    return _refined(model, run, progress, compiled, refines, PREFIX, RELEASE_STAGE_SECONDS)
 
 
-def _refined_release(model: RobotModel, run: StagedRun, progress: ProgressFn | None,
-                     compiled: str | None, refines: bool) -> StagedRun:
-    """A free-share run refined to the accuracy, its stages named with
-    :data:`~gaitopt.gait.solve.share_release.PREFIX`."""
+def _refined(model: RobotModel, run: StagedRun, progress: ProgressFn | None,
+             compiled: str | None, refines: bool, prefix: str,
+             stage_seconds: float | None = None) -> StagedRun:
+    """``run`` refined to the accuracy, the stages of each finer grid named with ``prefix``
+    and each within ``stage_seconds`` (None: no limit)."""
 
     def solve_on(finer: GaitOptions, before: StagedRun) -> StagedRun:
         again = _prefixed(solve_walking(model, finer,
                                         warm_start=check_result(before) or before.result,
-                                        progress=_prefixed_progress(progress, PREFIX),
+                                        progress=_prefixed_progress(progress, prefix),
                                         compiled=compiled, check_warm_start=True,
-                                        stage_seconds=RELEASE_STAGE_SECONDS), PREFIX)
+                                        stage_seconds=stage_seconds), prefix)
         return dataclasses.replace(again, stages=before.stages + again.stages,
                                    wall_time_s=before.wall_time_s + again.wall_time_s)
 
@@ -408,9 +454,11 @@ def solve_gait(model: RobotModel | str | os.PathLike[str], options: GaitOptions 
             ``gaitopt solve`` prints); the stages are also in ``gait.solver["stages"]``.
         compiled: ``None`` or ``"codegen"`` to compile the NLP to C (cached on disk).
         plausible: the check that lets a sequence's guessed phase shares be released
-            (:mod:`gaitopt.gait.solve.share_release`), e.g.
-            ``gaitopt.analysis.plausible.verified`` (``gaitopt verify`` passes on the
-            released gait), which ``gaitopt solve`` uses; None: the shares stay fixed.
+            (:mod:`gaitopt.gait.solve.share_release`) and that an answer must pass, else it
+            is solved again with a torque-rate term
+            (:mod:`gaitopt.gait.solve.torque_rate_fallback`), e.g.
+            ``gaitopt.analysis.plausible.verified`` (``gaitopt verify`` passes on the gait),
+            which ``gaitopt solve`` uses; None: the shares stay fixed, no fallback.
 
     Raises:
         MotionOutOfReachError: the converged solution's motion between knots leaves a leg's

@@ -64,6 +64,8 @@ def _gait(run: StagedRun, phases: tuple[GaitPhase, ...],
                    for s in run.stages],
         "accuracy": {**accuracy_record(run), **(run.accuracy_extra or {})},
         **({} if run.share_release is None else {"phase_shares": dict(run.share_release)}),
+        **({} if run.torque_rate_fallback is None else
+           {"torque_rate_fallback": dict(run.torque_rate_fallback)}),
         **({} if res.success else {"diagnosis": diagnose(run).text()}),
     }
     gait = Gait(

@@ -92,6 +92,10 @@ class StagedRun:
     #: (:func:`gaitopt.gait.solve.share_release.decision` or ``release_first``, the gait file's
     #: ``solver.phase_shares``); None where they were not.
     share_release: Mapping[str, Any] | None = None
+    #: Where the answer was rejected and solved again with a torque-rate term, what was done
+    #: (:func:`gaitopt.gait.solve.torque_rate_fallback.fallback_record`, the gait file's
+    #: ``solver.torque_rate_fallback``); None where it was not.
+    torque_rate_fallback: Mapping[str, Any] | None = None
 
     @property
     def success(self) -> bool:
