@@ -257,6 +257,20 @@ def test_the_check_sweep_with_feet_starts_each_point_from_the_same_point(tmp_pat
     assert check is walk and seeds == {}
 
 
+def test_the_study_with_feet_starts_its_impulse_chains_from_the_variants_without() -> None:
+    """With feet the two impulse variants' chains start from the variants without the
+    impulse (two cold starts instead of four, each 22-45 s on the seven-link); the five-link
+    study keeps four cold starts, as the paper's."""
+    from gaitopt.cli.study import study_spec
+
+    feet = study_spec("seven-link", "24,48,72", {"knots": (24, 16)})
+    cold = {p.variant for p in feet.points if feet.parents[p.key] is None}
+    assert cold == {"ankle", "plain"}
+    walk = study_spec("five-link", "6,12", {"knots": (16, 6)})
+    assert not walk.impulse_from_no_impulse
+    assert {p.variant for p in walk.points if walk.parents[p.key] is None} == set(VARIANTS)
+
+
 def test_a_failed_point_of_a_sweep_without_chains_restarts_from_its_nearest_neighbour(
         tmp_path: Path) -> None:
     """The rerun of a check sweep with feet starts a point without a gait file from the

@@ -52,6 +52,29 @@ def test_chains_start_at_12_m_min_and_march_both_ways() -> None:
     assert len(s.points) == 21
 
 
+def test_impulse_chains_start_from_their_variant_without_the_impulse() -> None:
+    """With ``impulse_from_no_impulse`` each impulse variant's start point continues from the
+    same point of its variant without the impulse (the same ankle torques), which starts
+    cold; every other parent is the chain's. Without chains (the check sweep) it does
+    nothing, and only a sweep that uses it says so in its settings."""
+    plain = spec()
+    s = spec(impulse_from_no_impulse=True)
+    start = "speed-012.00m_min.gait.json"
+    cold = sorted(k for k, parent in s.parents.items() if parent is None)
+    assert cold == [f"gaits/ankle/{start}", f"gaits/plain/{start}"]
+    assert s.parents[f"gaits/ankle+impulse/{start}"] == f"gaits/ankle/{start}"
+    assert s.parents[f"gaits/impulse/{start}"] == f"gaits/plain/{start}"
+    changed = {k for k in s.parents if s.parents[k] != plain.parents[k]}
+    assert changed == {f"gaits/ankle+impulse/{start}", f"gaits/impulse/{start}"}
+    assert sweep_settings(s)["impulse_from_no_impulse"] is True
+    assert "impulse_from_no_impulse" not in sweep_settings(plain)
+    alone = spec(impulse_from_no_impulse=True, continuation=False)
+    assert all(parent is None for parent in alone.parents.values())
+    assert "impulse_from_no_impulse" not in sweep_settings(alone)
+    only = spec(impulse_from_no_impulse=True, variants=("ankle+impulse", "impulse"))
+    assert sum(parent is None for parent in only.parents.values()) == 2  # none to start from
+
+
 def test_start_is_the_speed_nearest_12_m_min() -> None:
     assert start_index([0.05, 0.1, 0.15]) == 2
     assert start_index([0.3, 0.5]) == 0

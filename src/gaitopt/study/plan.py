@@ -12,7 +12,8 @@ fraction) form continuation chains along the speed axis::
 The point nearest the start speed (:attr:`SweepSpec.start`: for the five-link walk
 :data:`START_SPEED`, 12 m/min, the paper's optimum; for the heel-toe walk of ``seven-link``
 72.2 m/min) is solved cold; every other point is warm-started from its finished neighbour
-toward that start (its *parent*).
+toward that start (its *parent*). With ``impulse_from_no_impulse`` (the study with feet) the start point of an
+impulse variant is warm-started from the same point of its variant without the impulse.
 
 Directory layout: with one combination of step length and single-support fraction the sweep
 directory is a plain sweep (``summary.csv``, ``gaits/<variant>/...``, see
@@ -34,7 +35,13 @@ from gaitopt import __version__
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.gait.options.model_defaults import default_speed, options_for_model
 from gaitopt.robot.model import RobotModel
-from gaitopt.study.summary import VARIANTS, SpeedMode, gait_relpath, variant_flags
+from gaitopt.study.summary import (
+    VARIANTS,
+    SpeedMode,
+    gait_relpath,
+    variant_flags,
+    variant_name,
+)
 
 #: Speed (m/s) of the cold start of each chain of the five-link walk: the paper's optimal
 #: 12 m/min. Another model's or gait's chains start at its gait's default speed
@@ -78,6 +85,13 @@ class SweepSpec:
         free_from_start: with ``continuation`` False, each speed-free optimum still
             warm-starts from its group's fixed-speed point at the start speed (its values and
             multipliers; the check sweep with feet, :func:`gaitopt.cli.study.check_sweep`).
+        impulse_from_no_impulse: with ``continuation``, the chain of a variant with the
+            liftoff impulse starts from its variant without it (the same ankle torques) at
+            the start speed, where that variant is in the sweep, instead of cold: that
+            optimum is a feasible point of the impulse problem (the impulse at 0). The study
+            with feet (:func:`gaitopt.cli.study.study_spec`): measured on the seven-link at
+            72 m/min, the same optima as cold (2255.695 and 10504.669) in 53 and 41
+            iterations instead of 611 and 413 (docs/studies.md).
         check_grid: every point solves its check grid after the answer, a warm-started one
             too (``solve_walking(check_warm_start=True)``), so that every gait file carries
             the cost's grid error estimate (``solver.accuracy.cost_error``); otherwise only
@@ -94,6 +108,7 @@ class SweepSpec:
     base: GaitOptions = field(default_factory=GaitOptions)
     continuation: bool = True
     free_from_start: bool = False
+    impulse_from_no_impulse: bool = False
     check_grid: bool = False
 
     def __post_init__(self) -> None:
@@ -156,6 +171,18 @@ class SweepSpec:
                                   fixed[i - 1].key if i > start else fixed[i + 1].key)
             for p in free:
                 parents[p.key] = fixed[start].key if fixed else None
+        if self.continuation and self.impulse_from_no_impulse:
+            starts = {}
+            for group, members in groups.items():
+                fixed = [p for p in members if p.speed is not None]
+                if fixed:
+                    starts[group] = fixed[start_index([p.speed for p in fixed
+                                                       if p.speed is not None], self.start)]
+            for (variant, *rest), first in starts.items():
+                ankle, impulse = variant_flags(variant)
+                without = starts.get((variant_name(ankle=ankle, impulse=False), *rest))
+                if impulse and without is not None:
+                    parents[first.key] = without.key
         return parents
 
     @cached_property
@@ -339,6 +366,8 @@ def sweep_settings(spec: SweepSpec) -> dict[str, Any]:
     } | ({"step_times": list(spec.step_times)} if spec.step_times != (None,) else {}) | (
         {} if spec.continuation else {"continuation": False}) | (
         {"free_from_start": True} if spec.free_from_start else {}) | (
+        {"impulse_from_no_impulse": True}
+        if spec.continuation and spec.impulse_from_no_impulse else {}) | (
         {"check_grid": True} if spec.check_grid else {})
 
 
