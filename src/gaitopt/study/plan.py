@@ -12,8 +12,9 @@ fraction) form continuation chains along the speed axis::
 The point nearest the start speed (:attr:`SweepSpec.start`: for the five-link walk
 :data:`START_SPEED`, 12 m/min, the paper's optimum; for the heel-toe walk of ``seven-link``
 72.2 m/min) is solved cold; every other point is warm-started from its finished neighbour
-toward that start (its *parent*). With ``impulse_from_no_impulse`` (the study with feet) the start point of an
-impulse variant is warm-started from the same point of its variant without the impulse.
+toward that start (its *parent*). With ``impulse_from_no_impulse`` (the study with feet) the
+start point of an impulse variant is warm-started from the same point of its variant without
+the impulse.
 
 Directory layout: with one combination of step length and single-support fraction the sweep
 directory is a plain sweep (``summary.csv``, ``gaits/<variant>/...``, see
