@@ -11,7 +11,7 @@ import pytest
 
 from gaitopt.analysis.plausible import verified
 from gaitopt.analysis.verify import verify_gait
-from gaitopt.gait.api import solve_gait
+from gaitopt.gait.api import solve_gait, solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.gait.solve.torque_rate_fallback import (
@@ -75,7 +75,8 @@ def test_a_smoothed_answer_that_is_rejected_too_leaves_the_first_standing() -> N
 
 def test_a_plausible_answer_or_a_cost_with_the_term_is_not_solved_again() -> None:
     """A plausible answer is judged once and kept; a cost that has a torque-rate term
-    already is not smoothed again, whatever the check says."""
+    already is not smoothed again, whatever the check says; nor is any answer where the
+    caller turns the fallback off."""
     calls: list[float] = []
 
     def plausible(run: StagedRun) -> str | None:
@@ -90,6 +91,10 @@ def test_a_plausible_answer_or_a_cost_with_the_term_is_not_solved_again() -> Non
                        plausible=lambda run: "always rejected")
     assert "torque_rate_fallback" not in rated.solver
     assert rated.options["torque_rate_time"] == 0.01
+    unsmoothed = solve_staged_run("five-link", WALK, plausible=lambda run: "always rejected",
+                                  smooth_rejected=False)  # gaitopt solve --no-verify
+    assert unsmoothed.torque_rate_fallback is None
+    assert unsmoothed.options.torque_rate_time == 0.0
 
 
 @pytest.mark.slow

@@ -242,7 +242,9 @@ def _step_time(text: str) -> float | None:
 @click.option("--verify/--no-verify", "check", default=True, show_default=True,
               help="Run gaitopt verify's checks on the gait before writing it, keep the outcome "
                    "in the file (solver.verify) and exit with status 4 if a check fails "
-                   "(0.2-1.5 s).")
+                   "(0.2-1.5 s). An answer that fails is first solved again with a "
+                   "torque-rate term (tau 0.02, 0.03, 0.05 s), kept where it passes "
+                   "(solver.torque_rate_fallback; docs/running.md).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("gait.gait.json"), show_default=True, help="Gait file to write.")
 def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | None,
@@ -368,7 +370,7 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
         solution = solve_staged_run(model, options, progress=progress, warm_start=start,
                                     compiled="codegen" if compiled else None,
                                     refine=refine, speed_given=speed is not None,
-                                    plausible=verifier)
+                                    plausible=verifier, smooth_rejected=check)
     except (GaitOptionsError, BipedStructureError) as exc:
         raise UserError(str(exc)) from None
     if not solution.success:

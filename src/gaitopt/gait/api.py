@@ -119,6 +119,7 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                      speed_given: bool | None = None,
                      check_warm_start: bool = False,
                      plausible: Plausibility | None = None,
+                     smooth_rejected: bool = True,
                      max_rounds: int = MAX_ROUNDS) -> StagedRun:
     """Internal: :func:`solve_gait` before the gait is recorded. Returns the
     :class:`~gaitopt.gait.solve.staged_run.StagedRun` (the engine's final result, every
@@ -143,7 +144,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
     release, the shares stay fixed (nothing here can judge the released gait: the checks
     of ``gaitopt verify`` live above this layer). A converged answer that ``plausible``
     rejects is solved again with a torque-rate term where its cost has none
-    (:mod:`gaitopt.gait.solve.torque_rate_fallback`).
+    (:mod:`gaitopt.gait.solve.torque_rate_fallback`), unless ``smooth_rejected`` is False
+    (``gaitopt solve --no-verify``: then only the release is judged).
     ``speed_given``: whether the caller chose the speed; None: unless it is left to the
     model. A cold solve at the model's default speed that fails is tried once more at the
     slower default speed of the walk (:func:`slower_default`), the stages of both attempts
@@ -259,6 +261,8 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
                             RELEASE_STAGE_SECONDS)
 
         run = release_shares(run, released, judged, first=reused)
+    if not smooth_rejected:
+        return run
     return _smoothed_if_rejected(robot, run, judged, progress, compiled, refines)
 
 
