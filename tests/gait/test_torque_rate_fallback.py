@@ -97,6 +97,19 @@ def test_a_plausible_answer_or_a_cost_with_the_term_is_not_solved_again() -> Non
     assert unsmoothed.options.torque_rate_time == 0.0
 
 
+def test_an_answer_outside_its_accuracy_target_is_not_smoothed() -> None:
+    """An answer refined toward an accuracy it did not reach is reported as such (exit
+    status 3 from ``gaitopt solve``), not smoothed: the check rejects it for its accuracy,
+    which the term does not mend (smoothing it once refined past 400 knots a phase)."""
+    run = solve_staged_run("five-link", GaitOptions(speed=0.5, ankle=False, impulse=False,
+                                                    accuracy=1e-5),
+                           plausible=lambda run: "always rejected")
+    assert run.success
+    assert run.accuracy_extra is not None and run.accuracy_extra["within_target"] is False
+    assert run.torque_rate_fallback is None
+    assert not any(s.name.startswith(PREFIX) for s in run.stages)
+
+
 @pytest.mark.slow
 def test_the_seven_link_run_at_400_m_per_min_passes_verify_from_the_default_solve() -> None:
     """Its optimum without the term holds the swing ankle on its plantarflexion limit and

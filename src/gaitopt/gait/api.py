@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from gaitopt.gait.formulations.full.physics import actuator_names
-from gaitopt.gait.options.gait_options import GaitOptions, follows_model
+from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError, follows_model
 from gaitopt.gait.options.model_defaults import default_speed, options_for_model
 from gaitopt.gait.options.preflight import refuse_unwalkable
 from gaitopt.gait.record.file import Gait
@@ -278,17 +278,23 @@ def _smoothed_if_rejected(model: RobotModel, run: StagedRun, judged: Plausibilit
     why = rejection(run, judged)
     if why is None or judged is None:
         return run
-    tries: list[tuple[float, StagedRun, str | None]] = []
+    tries: list[tuple[float, float | None, str | None]] = []
     start, stages, wall = run, run.stages, run.wall_time_s
     for tau in FALLBACK_TORQUE_RATE_TIMES:
-        smoothed = _prefixed(solve_walking(model, smoothed_options(start.options, tau),
-                                           warm_start=start.result,
-                                           progress=_prefixed_progress(progress, SMOOTHED),
-                                           compiled=compiled, check_warm_start=True), SMOOTHED)
-        if smoothed.success and accuracy_record(smoothed).get("cost_error") is not None:
-            smoothed = _refined(model, smoothed, progress, compiled, refines, SMOOTHED)
+        try:
+            smoothed = _prefixed(solve_walking(model, smoothed_options(start.options, tau),
+                                               warm_start=start.result,
+                                               progress=_prefixed_progress(progress, SMOOTHED),
+                                               compiled=compiled, check_warm_start=True),
+                                 SMOOTHED)
+            if smoothed.success and accuracy_record(smoothed).get("cost_error") is not None:
+                smoothed = _refined(model, smoothed, progress, compiled, refines, SMOOTHED)
+        except GaitOptionsError as exc:  # e.g. a refinement past the knots a phase may have
+            tries.append((tau, None, f"its solve was refused: {exc}"))
+            break
         verdict = verdict_on(smoothed, judged)
-        tries.append((tau, smoothed, verdict))
+        tries.append((tau, float(smoothed.result.objective) if smoothed.success else None,
+                      verdict))
         stages, wall = stages + smoothed.stages, wall + smoothed.wall_time_s
         if verdict is None:
             return dataclasses.replace(smoothed, stages=stages, wall_time_s=wall,

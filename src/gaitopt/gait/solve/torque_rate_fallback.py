@@ -42,10 +42,19 @@ PREFIX = "smoothed: "
 def rejection(run: StagedRun, judged: Plausibility | None) -> str | None:
     """Why ``run``'s converged answer is rejected by ``judged`` and may be smoothed (one
     line, e.g. ``verify fails swing.reversals (6 > 3 turns)``), or None: no check, a failed
-    solve, a cost that already has a torque-rate term, or a plausible answer."""
-    if judged is None or not run.success or run.options.torque_rate_time > 0.0:
+    solve, an answer outside its accuracy target (reported as such, exit status 3: the
+    check rejects it for that, which a torque-rate term does not mend, and refining a
+    smoothed answer from its finest grid went past the 400 knots a phase may have), a cost
+    that already has a torque-rate term, or a plausible answer."""
+    if judged is None or not run.success or run.options.torque_rate_time > 0.0 \
+            or not within_accuracy(run):
         return None
     return judged(run)
+
+
+def within_accuracy(run: StagedRun) -> bool:
+    """False where ``run`` was refined toward an accuracy target and did not reach it."""
+    return (run.accuracy_extra or {}).get("within_target") is not False
 
 
 def smoothed_options(options: GaitOptions, tau: float) -> GaitOptions:
@@ -60,23 +69,24 @@ def verdict_on(run: StagedRun, judged: Plausibility) -> str | None:
         return "its solve failed"
     if accuracy_record(run).get("cost_error") is None:
         return "its check grid gave no error estimate"
+    if not within_accuracy(run):
+        return "not within the accuracy target"
     return judged(run)
 
 
 def fallback_record(why: str, first: StagedRun,
-                    tries: list[tuple[float, StagedRun, str | None]]) -> dict[str, Any]:
+                    tries: list[tuple[float, float | None, str | None]]) -> dict[str, Any]:
     """The gait file's ``solver.torque_rate_fallback``: ``why`` the first answer was
     rejected, its cost (``first_cost``, without the term, in the cost's units), ``kept``
     (whether a smoothed answer is the gait), ``torque_rate_time`` (s: the kept answer's
-    ``tau``, None where none was kept) and ``tries``: each ``tau`` tried in order with its
-    ``cost`` (the term included; None where its solve failed) and ``verdict`` (None where it
-    passed, else why not: :func:`verdict_on`)."""
+    ``tau``, None where none was kept) and ``tries``: each ``(tau, cost, verdict)`` tried, in
+    order, as ``torque_rate_time``, ``cost`` (the term included; None where its solve
+    failed) and ``verdict`` (None where it passed, else why not: :func:`verdict_on`)."""
     kept = [tau for tau, _, verdict in tries if verdict is None]
     return {"why": why, "first_cost": float(first.result.objective), "kept": bool(kept),
             "torque_rate_time": kept[0] if kept else None,
-            "tries": [{"torque_rate_time": tau,
-                       "cost": float(run.result.objective) if run.success else None,
-                       "verdict": verdict} for tau, run, verdict in tries]}
+            "tries": [{"torque_rate_time": tau, "cost": cost, "verdict": verdict}
+                      for tau, cost, verdict in tries]}
 
 
 def fallback_line(record: Mapping[str, Any]) -> str:
