@@ -186,7 +186,7 @@ def test_without_a_plausibility_check_the_shares_stay_fixed(monkeypatch: pytest.
     import gaitopt.gait.api as api
 
     calls: list[Any] = []
-    fixed = SimpleNamespace(success=True, options=_resolved(seven))
+    fixed = SimpleNamespace(success=True, options=_resolved(seven), accuracy_extra=None)
     own = SimpleNamespace(success=False, options=_resolved(seven))
     monkeypatch.setattr(api, "solve_walking", lambda *a, **k: fixed)
     monkeypatch.setattr(api, "_own_release", lambda *a, **k: calls.append("own") or own)
