@@ -62,7 +62,6 @@ from gaitopt.gait.solve.torque_rate_fallback import (
     FALLBACK_TORQUE_RATE_TIMES,
     fallback_record,
     rejection,
-    smoothed_options,
     verdict_on,
 )
 from gaitopt.gait.solve.torque_rate_fallback import PREFIX as SMOOTHED
@@ -282,7 +281,7 @@ def _smoothed_if_rejected(model: RobotModel, run: StagedRun, judged: Plausibilit
     start, stages, wall = run, run.stages, run.wall_time_s
     for tau in FALLBACK_TORQUE_RATE_TIMES:
         try:
-            smoothed = _prefixed(solve_walking(model, smoothed_options(start.options, tau),
+            smoothed = _prefixed(solve_walking(model, start.options.replace(torque_rate_time=tau),
                                                warm_start=start.result,
                                                progress=_prefixed_progress(progress, SMOOTHED),
                                                compiled=compiled, check_warm_start=True),

@@ -163,22 +163,19 @@ class SweepSpec:
         groups: dict[tuple[Any, ...], list[SweepPoint]] = {}
         for p in self.points:
             groups.setdefault(p.group, []).append(p)
-        for members in groups.values():
+        starts: dict[tuple[Any, ...], SweepPoint] = {}  # each group's point at the start
+        for group, members in groups.items():
             fixed = [p for p in members if p.speed is not None]
             free = [p for p in members if p.speed is None]
             start = start_index([p.speed for p in fixed if p.speed is not None], self.start)
+            if fixed:
+                starts[group] = fixed[start]
             for i, p in enumerate(fixed if self.continuation else ()):
                 parents[p.key] = (None if i == start else
                                   fixed[i - 1].key if i > start else fixed[i + 1].key)
             for p in free:
                 parents[p.key] = fixed[start].key if fixed else None
         if self.continuation and self.impulse_from_no_impulse:
-            starts = {}
-            for group, members in groups.items():
-                fixed = [p for p in members if p.speed is not None]
-                if fixed:
-                    starts[group] = fixed[start_index([p.speed for p in fixed
-                                                       if p.speed is not None], self.start)]
             for (variant, *rest), first in starts.items():
                 ankle, impulse = variant_flags(variant)
                 without = starts.get((variant_name(ankle=ankle, impulse=False), *rest))

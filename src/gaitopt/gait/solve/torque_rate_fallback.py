@@ -24,7 +24,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.solve.accuracy import accuracy_record
 from gaitopt.gait.solve.share_release import Plausibility
 from gaitopt.gait.solve.staged_run import StagedRun
@@ -55,11 +54,6 @@ def rejection(run: StagedRun, judged: Plausibility | None) -> str | None:
 def within_accuracy(run: StagedRun) -> bool:
     """False where ``run`` was refined toward an accuracy target and did not reach it."""
     return (run.accuracy_extra or {}).get("within_target") is not False
-
-
-def smoothed_options(options: GaitOptions, tau: float) -> GaitOptions:
-    """``options`` with the torque-rate term of time ``tau`` (s)."""
-    return options.replace(torque_rate_time=tau)
 
 
 def verdict_on(run: StagedRun, judged: Plausibility) -> str | None:
