@@ -408,6 +408,29 @@ def test_cli_analyses_a_run(run_gait: Gait, tmp_path: Path) -> None:
     assert len(data["multipliers"]) == 2 * run_gait.model.nq - 4
 
 
+def test_report_analyses_in_worker_processes_equal_those_in_this_one(gait: Gait,
+                                                                     tmp_path: Path) -> None:
+    """The report's analyses of gait files in two local processes (started at once, collected
+    later) give the rows the same analyses give in this process, in the files' order."""
+    from gaitopt.viz.stability_table import stability_rows, start_stability_rows
+
+    path = gait.save(tmp_path / "optimum.gait.json")
+    failed = dataclasses.replace(gait, solver={**gait.solver, "success": False,
+                                               "status": "Infeasible_Problem_Detected"})
+    bad = failed.save(tmp_path / "failed.gait.json", allow_failed=True)
+    rows = start_stability_rows([("optimum", path), ("failed", bad)], workers=2)()
+    (here,) = stability_rows([("optimum", Gait.load(path))])
+    assert [r.label for r in rows] == ["optimum", "failed"]
+    for cell, expected in ((rows[0].open_loop, here.open_loop),
+                           (rows[0].tracked, here.tracked)):
+        assert cell.report is not None and expected.report is not None
+        assert cell.report.spectral_radius == pytest.approx(expected.report.spectral_radius,
+                                                            rel=1e-9)
+        assert cell.report.verdict == expected.report.verdict
+    assert rows[1].open_loop.report is None and "did not converge" in rows[1].open_loop.text()
+    assert rows[1].tracked.report is None
+
+
 def test_report_table_shows_both_analyses_of_a_gait(gait: Gait) -> None:
     from gaitopt.viz.stability_table import REPORT_PD, stability_rows, stability_table_html
 

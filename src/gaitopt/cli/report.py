@@ -28,9 +28,12 @@ def sweep_dirs(directory: Path) -> list[Path]:
 
 
 def write_reports(console: Console, directory: Path, out: Path,
-                  compare: tuple[Path, ...] = ()) -> list[Path]:
+                  compare: tuple[Path, ...] = (), workers: int | None = None) -> list[Path]:
     """Write the report of each (sub-)sweep, print where and the findings; ``compare``: other
-    sweep folders drawn beside each (printed: their optima against people's walk)."""
+    sweep folders drawn beside each (printed: their optima against people's walk);
+    ``workers``: local processes of the stability analyses (None: the CPUs available; 0 or
+    1: this process)."""
+    from gaitopt.study.driver import default_workers
     from gaitopt.study.findings import findings_text
     from gaitopt.viz.report import write_report
     from gaitopt.viz.sweep_comparison import comparison_text
@@ -42,7 +45,8 @@ def write_reports(console: Console, directory: Path, out: Path,
     for sweep in sweep_dirs(directory):
         target = out if sweep == directory else out / sweep.name
         try:
-            info = write_report(sweep, target, compare=compare)
+            info = write_report(sweep, target, compare=compare,
+                                workers=default_workers() if workers is None else workers)
         except SummaryError as exc:
             raise UserError(str(exc)) from None
         if info.compared:

@@ -288,7 +288,7 @@ def study_command(directory: Path | None, model_names: tuple[str, ...], speeds: 
         refine_points(console, directory, spec, grid_error(directory, rows),
                       workers=workers, scheduler=scheduler)
     out = directory / "report"
-    pages = write_reports(console, directory, out)
+    pages = write_reports(console, directory, out, workers=workers)
     errors = grid_error(directory, rows)
     if errors is not None:
         rows = errors.reported(rows)

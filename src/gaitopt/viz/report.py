@@ -61,7 +61,7 @@ from gaitopt.study.summary import (
     rows_of,
 )
 from gaitopt.viz.gait_figures import heights_figure, hip_motion_figure, torques_figure
-from gaitopt.viz.stability_table import stability_rows, stability_table_html
+from gaitopt.viz.stability_table import stability_table_html, start_stability_rows
 from gaitopt.viz.stick import stick_strip_figure
 from gaitopt.viz.style import VARIANT_LABELS, gait_style, png_data_uri, save_figure
 from gaitopt.viz.sweep_comparison import (
@@ -116,13 +116,14 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
                  svg: bool = True,
                  check_dir: str | os.PathLike[str] | None = None,
                  compare: Sequence[str | os.PathLike[str]] = (),
-                 stability: bool = True) -> ReportInfo:
+                 stability: bool = True, workers: int = 1) -> ReportInfo:
     """Write the report of the sweep in ``sweep_dir`` to ``out_dir`` (see module docstring);
     ``svg=False`` skips the SVG copies of the figures; ``check_dir`` is the check sweep on a
     finer grid (default ``<sweep_dir>/check-grid`` when it exists); ``compare``: other sweep
     folders drawn beside this one (:mod:`gaitopt.viz.sweep_comparison`, figure
     ``compare_sweeps``); ``stability``: the Floquet multipliers of each variant's optimal gait
-    (:mod:`gaitopt.viz.stability_table`; a few seconds per gait).
+    (:mod:`gaitopt.viz.stability_table`; a few seconds per gait), run in ``workers`` local
+    processes while the figures are drawn when ``workers`` > 1.
 
     Raises :class:`gaitopt.study.summary.SummaryError` if ``summary.csv`` is missing or
     invalid; unreadable gait files are reported in the HTML, not raised.
@@ -154,6 +155,10 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
         load(fast[v])
     gaits = {f: g for f, g in cache.items() if g is not None}
     findings = assess_findings(rows, gaits)
+    stability_rows = start_stability_rows(
+        [(f"{v}, {row.speed_m_min:.1f} m/min", sweep / row.file) for v in VARIANTS
+         if (row := optimal[v]) is not None and load(row) is not None] if stability else [],
+        workers=workers)
 
     def grid_note(shown: Sequence[SummaryRow | None] | None = None, what: str = "cost") -> str:
         """The grid and error-estimate sentence of a figure showing ``shown`` (all rows)."""
@@ -240,10 +245,8 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
             f"stick_{v.replace('+', '-')}", f"One step of the optimal walk, {v}."
             + grid_note([optimal[v]]))
     if stability:
-        optima = [(f"{v}, {row.speed_m_min:.1f} m/min", gait) for v in VARIANTS
-                  if (row := optimal[v]) is not None and (gait := load(row)) is not None]
         sections.append("<h2>Orbital stability of the optimal gaits</h2>"
-                        + stability_table_html(stability_rows(optima)))
+                        + stability_table_html(stability_rows()))
     sections.append("<h2>Solver statistics</h2>" + _solver_table(rows, optimal, load))
     sections.append("<h2>Findings of the paper, checked</h2>" + findings_html(findings))
     sections.append("<h2>All sweep points</h2>" + _summary_table(rows))
