@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -229,8 +230,9 @@ def test_sweep_passes_the_problem_options_to_every_point(runner: CliRunner,
 def test_the_check_sweep_with_feet_starts_each_point_from_the_same_point(tmp_path: Path) -> None:
     """With feet every fixed-speed check-grid point is seeded from the study's gait of the
     same point (no continuation in speed), and only where that gait exists; each speed-free
-    optimum continues from its group's point at the start speed. The five-link walk keeps
-    its chains, each from a cold start."""
+    optimum continues from its group's point at the start speed; every point with ankle
+    torques and the impulse from the same check point with ankle torques only. The
+    five-link walk keeps its chains, each from a cold start."""
     from gaitopt.cli.study import check_sweep, study_spec
 
     feet = study_spec("seven-link", "24,48,72", {"knots": (36, 24)})
@@ -245,11 +247,16 @@ def test_the_check_sweep_with_feet_starts_each_point_from_the_same_point(tmp_pat
     fixed = [p for p in check.points if p.speed is not None]
     free = [p for p in check.points if p.speed is None]
     assert len(free) == len(check.variants) and len(fixed) == 3 * len(check.variants)
-    assert all(check.parents[p.key] is None for p in fixed)
+    twin = {p.key: replace(p, variant="ankle").key for p in check.points
+            if p.variant == "ankle+impulse"}
+    assert all(check.parents[p.key] == twin.get(p.key) for p in fixed)
     for p in free:  # from the point at the start speed (72 m/min) of its variant
+        if p.key in twin:
+            assert check.parents[p.key] == twin[p.key]
+            continue
         parent = next(q for q in fixed if q.key == check.parents[p.key])
         assert parent.variant == p.variant and parent.speed == pytest.approx(1.2)
-    assert seeds == {p.key: tmp_path / p.key for p in fixed[1:]}
+    assert seeds == {p.key: tmp_path / p.key for p in fixed[1:] if p.key not in twin}
     assert feet.points[0].key not in seeds
 
     walk = study_spec("five-link", "6,12", {"knots": (24, 8)})

@@ -178,3 +178,42 @@ def test_a_limited_memory_solver_derives_no_hessian_and_finds_the_same_optimum()
     assert quasi.objective == pytest.approx(exact.objective, rel=1e-7)
     assert again.objective == pytest.approx(exact.objective, rel=1e-7)
     assert exact.iterations < quasi.iterations  # Newton's steps against quasi-Newton's
+
+
+def test_a_result_of_fewer_constraint_blocks_restarts_with_its_multipliers_by_name() -> None:
+    """A solution of the problem without an added constraint (inactive at its optimum)
+    restarts the problem with it: the shared blocks' multipliers carried over by name, the
+    added block's at 0, and IPOPT finds the same optimum at once; from the values alone it
+    takes longer. A result of other variables is refused."""
+    import dataclasses
+
+    import casadi as ca
+
+    from gaitopt.ocp import BoundaryConstraint
+    from gaitopt.ocp.validate import ProblemError
+
+    base = P.brachistochrone(intervals=20)
+    res = transcribe(base).solve(P.brachistochrone_guess())
+    assert res.success and res.constraint_blocks
+    cap = BoundaryConstraint("final speed cap", lambda ends, p: ends["slide"].xf[2],
+                             lower=-ca.inf, upper=10.0)  # the optimum ends at 3.43 m/s
+    tr = transcribe(dataclasses.replace(base, boundary_constraints=(cap,)))
+    start = tr.carried_over(res)
+    added = tr.nlp.constraints.block("final speed cap")
+    assert np.all(start.lam_g[added.rows] == 0.0)
+    rows, at = {}, 0
+    for name, n in res.constraint_blocks:
+        rows[name], at = slice(at, at + n), at + n
+    shared = [b for b in tr.nlp.constraints.blocks if b.name in rows]
+    assert len(shared) == len(res.constraint_blocks)
+    for b in shared:
+        np.testing.assert_array_equal(start.lam_g[b.rows], res.lam_g[rows[b.name]])
+    np.testing.assert_array_equal(start.w, res.w)
+    again = tr.solve(res, warm_start_multipliers=True)
+    values = tr.solve(res)
+    assert again.success and values.success
+    assert again.objective == pytest.approx(res.objective, rel=1e-9)
+    assert again.iterations <= 3 < values.iterations
+    with pytest.raises(ProblemError):
+        tr.carried_over(transcribe(P.brachistochrone(intervals=12)).solve(
+            P.brachistochrone_guess()))

@@ -75,6 +75,29 @@ def test_impulse_chains_start_from_their_variant_without_the_impulse() -> None:
     assert sum(parent is None for parent in only.parents.values()) == 2  # none to start from
 
 
+def test_ankle_impulse_points_start_from_the_ankle_points_of_their_speed() -> None:
+    """With ``ankle_impulse_from_ankle`` every point with ankle torques and the impulse (the
+    speed-free one too) starts from the same point with ankle torques only, in a sweep with
+    chains or without (the check and refinement sweeps); the other variants keep their
+    parents, a point whose twin is not in the sweep too, and the settings say so."""
+    def twin(key: str) -> str:
+        return key.replace("gaits/ankle+impulse/", "gaits/ankle/")
+
+    for chains in (True, False):
+        before = spec(continuation=chains, impulse_from_no_impulse=True)
+        s = spec(continuation=chains, impulse_from_no_impulse=True,
+                 ankle_impulse_from_ankle=True)
+        for p in s.points:
+            expected = twin(p.key) if p.variant == "ankle+impulse" else before.parents[p.key]
+            assert s.parents[p.key] == expected
+        assert sweep_settings(s)["ankle_impulse_from_ankle"] is True
+        assert "ankle_impulse_from_ankle" not in sweep_settings(before)
+        # every chain still ends in a cold start
+        assert all(chain_from(s, p.key) for p in s.points)
+    alone = spec(ankle_impulse_from_ankle=True, variants=("ankle+impulse", "impulse"))
+    assert alone.parents == spec(variants=("ankle+impulse", "impulse")).parents
+
+
 def test_start_is_the_speed_nearest_12_m_min() -> None:
     assert start_index([0.05, 0.1, 0.15]) == 2
     assert start_index([0.3, 0.5]) == 0

@@ -326,7 +326,9 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
     the two-phase walk) starts each impulse variant's chain from its variant without the
     impulse (``SweepSpec.impulse_from_no_impulse``): the cold starts at 72 m/min took 400-600
     iterations and 22-45 s each; the five-link walk's cold starts take about a second and
-    stay cold, as in the paper."""
+    stay cold, as in the paper. With feet, too, every point with ankle torques and the
+    impulse starts from the same point with ankle torques only
+    (``SweepSpec.ankle_impulse_from_ankle``), on every grid of the study."""
     def spec_of(text: str) -> SweepSpec:
         return make_spec(model_name=model_name, speeds=text, variants="all", free=True,
                          step_length="free", single_support="0.85", problem=grid)
@@ -334,7 +336,8 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
     spec = spec_of(speeds or STUDY_SPEEDS)
     default = STUDY_SPEEDS_BY_GAIT.get(str(spec.base.gait), STUDY_SPEEDS)
     spec = spec_of(default) if speeds is None and default != STUDY_SPEEDS else spec
-    return spec if spec.base.gait == "walk" else replace(spec, impulse_from_no_impulse=True)
+    return spec if spec.base.gait == "walk" else replace(spec, impulse_from_no_impulse=True,
+                                                         ankle_impulse_from_ankle=True)
 
 
 def check_sweep(check: SweepSpec, directory: Path) -> tuple[SweepSpec, dict[str, Path]]:

@@ -145,6 +145,10 @@ class Result:
         method: transcription method name; mesh: normalised knots per phase.
         layout_signature: identifies the variable layout (multipliers are reused only when the
             layouts match).
+        constraint_blocks: ``(name, rows)`` of each block of ``g`` in order (empty for a
+            Result made without a transcription): multipliers carry over by block name to a
+            problem with the same variables and other constraint blocks
+            (:meth:`gaitopt.ocp.Transcription.carried_over`).
     """
 
     status: str
@@ -164,6 +168,7 @@ class Result:
     mesh: tuple[Array, ...]
     layout_signature: tuple[object, ...]
     message: str = ""
+    constraint_blocks: tuple[tuple[str, int], ...] = ()
     stats: Mapping[str, object] = field(default_factory=dict, repr=False)
 
     def phase(self, key: int | str) -> PhaseTrajectory:

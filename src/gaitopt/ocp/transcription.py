@@ -257,7 +257,8 @@ class Transcription:
         ``warm_start_options`` merged over them apply, over ``options``. With ``regrid`` too,
         a Result on another grid of this problem (same method) passes its multipliers mapped
         onto this grid (:func:`gaitopt.ocp.regrid.regridded`; a Result of another problem
-        is a ProblemError)."""
+        is a ProblemError). A Result of the same variables with other constraint blocks
+        passes its multipliers by block name (:meth:`carried_over`)."""
         b = bounds or self._bounds
         if b.layout.signature() != self.layout.signature() or b.lbg.size != self.nlp.lbg.size:
             raise ProblemError("bounds: made for another transcription (layout differs)")
@@ -272,6 +273,11 @@ class Transcription:
         if (warm_start_multipliers and regrid and isinstance(guess, Result)
                 and guess.layout_signature != self.layout.signature()):
             guess = regridded(self, guess)
+        if (warm_start_multipliers and isinstance(guess, Result) and guess.constraint_blocks
+                and guess.layout_signature == self.layout.signature()
+                and guess.method == self.method
+                and guess.constraint_blocks != self.constraint_blocks):
+            guess = self.carried_over(guess)
         w0 = self.initial_guess(guess)
         d_w, d_g, s_j = self.nlp.d_w, self.nlp.d_g, self.nlp.objective_scale
         args: dict[str, Any] = dict(x0=w0 / d_w, lbx=b.lbw / d_w, ubx=b.ubw / d_w,
@@ -301,6 +307,41 @@ class Transcription:
         else:
             out = call_solver(solver, args)
         return self._result(out, b)
+
+    @property
+    def constraint_blocks(self) -> tuple[tuple[str, int], ...]:
+        """``(name, rows)`` of each block of ``g``, in order."""
+        return tuple((b.name, b.rows.stop - b.rows.start) for b in self.nlp.constraints.blocks)
+
+    def carried_over(self, result: Result) -> WarmStart:
+        """The solution ``result`` of a problem with this transcription's variables and method
+        but other constraint blocks (one with constraints added or left out, e.g. a liftoff
+        impulse's rows) as a start of this one: its values and variable multipliers as they
+        are, each constraint block's multipliers from the block of the same name and size
+        (0 for a block ``result`` lacks). Where the added constraints hold at ``result``
+        with zero multipliers it is a KKT point of this problem, and IPOPT restarts there as
+        from its own solution.
+
+        Raises:
+            ProblemError: ``result`` has other variables or another method, or no block
+                names.
+        """
+        if (result.layout_signature != self.layout.signature() or result.method != self.method
+                or not result.constraint_blocks):
+            raise ProblemError("carried_over: the result is of other variables or method")
+        source: dict[str, slice] = {}
+        start = 0
+        for name, rows in result.constraint_blocks:
+            source[name] = slice(start, start + rows)
+            start += rows
+        lam_g = np.zeros(self.nlp.lbg.size)
+        for block in self.nlp.constraints.blocks:
+            rows = source.get(block.name)
+            if rows is not None and rows.stop - rows.start == block.rows.stop - block.rows.start:
+                lam_g[block.rows] = result.lam_g[rows]
+        return WarmStart(w=np.asarray(result.w, dtype=float),
+                         lam_x=np.asarray(result.lam_x, dtype=float), lam_g=lam_g,
+                         layout=repr(self.layout.signature()), method=self.method)
 
     def result_at(self, start: WarmStart) -> Result:
         """The :class:`~gaitopt.ocp.Result` of this transcription at the NLP point and
@@ -369,6 +410,7 @@ class Transcription:
             parameters={name: float(p[i]) for i, name in enumerate(self.layout.parameters)},
             w=w, lam_x=lam_x, lam_g=lam_g, method=self.method, mesh=self.mesh,
             layout_signature=self.layout.signature(), message=out.error or status,
+            constraint_blocks=self.constraint_blocks,
             stats={k: v for k, v in st.items() if not isinstance(v, dict | list)})
 
     @property
