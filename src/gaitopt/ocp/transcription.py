@@ -331,9 +331,9 @@ class Transcription:
             raise ProblemError("carried_over: the result is of other variables or method")
         source: dict[str, slice] = {}
         start = 0
-        for name, rows in result.constraint_blocks:
-            source[name] = slice(start, start + rows)
-            start += rows
+        for name, size in result.constraint_blocks:
+            source[name] = slice(start, start + size)
+            start += size
         lam_g = np.zeros(self.nlp.lbg.size)
         for block in self.nlp.constraints.blocks:
             rows = source.get(block.name)
