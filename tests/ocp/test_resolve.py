@@ -217,3 +217,34 @@ def test_a_result_of_fewer_constraint_blocks_restarts_with_its_multipliers_by_na
     with pytest.raises(ProblemError):
         tr.carried_over(transcribe(P.brachistochrone(intervals=12)).solve(
             P.brachistochrone_guess()))
+
+
+def test_the_secant_start_predicts_the_next_solution_of_a_smooth_family() -> None:
+    """``secant_start`` through the solutions at xf = 1.0 and 1.1 (the brachistochrone's
+    end point) lies closer to the solution at 1.2 than the last solution does (values and
+    multipliers: a smooth family, so the secant is second-order accurate), and IPOPT
+    restarts from it to the same optimum; results of different transcriptions, or an
+    infinite ratio, are refused."""
+    from gaitopt.ocp import secant_start
+    from gaitopt.ocp.validate import ProblemError
+
+    def solved(xf: float) -> object:
+        res = transcribe(P.brachistochrone(xf=xf, intervals=20)).solve(
+            P.brachistochrone_guess(xf=xf))
+        assert res.success
+        return res
+
+    a, b, c = solved(1.0), solved(1.1), solved(1.2)
+    start = secant_start(a, b, 1.0)  # type: ignore[arg-type]
+    np.testing.assert_allclose(start.w, 2.0 * b.w - a.w)  # type: ignore[attr-defined]
+    for got, last, want in ((start.w, b.w, c.w), (start.lam_g, b.lam_g, c.lam_g)):  # type: ignore[attr-defined]
+        assert np.linalg.norm(got - want) < 0.2 * np.linalg.norm(last - want)
+    again = transcribe(P.brachistochrone(xf=1.2, intervals=20)).solve(
+        start, warm_start_multipliers=True)
+    assert again.success
+    assert again.objective == pytest.approx(c.objective, rel=1e-8)  # type: ignore[attr-defined]
+    with pytest.raises(ProblemError):
+        secant_start(a, transcribe(P.brachistochrone(intervals=12)).solve(  # type: ignore[arg-type]
+            P.brachistochrone_guess()), 1.0)
+    with pytest.raises(ProblemError):
+        secant_start(a, b, float("inf"))  # type: ignore[arg-type]

@@ -188,3 +188,23 @@ def test_settings_differences_name_each_changed_field() -> None:
     assert any(d.startswith("options.tol:") for d in diffs)
     assert len(diffs) == 2
     assert a["model"]["content_hash"] == MODEL.content_hash()
+
+
+def test_secant_steps_reach_two_points_back_along_their_own_chain() -> None:
+    """With ``secant`` a fixed-speed point two or more steps from its chain's start names the
+    point before its parent and the step ratio; the chain's first step, the speed-free points,
+    a start from another variant and a sweep without it name none."""
+    s = spec(speeds=tuple(v / 60 for v in (6, 12, 24, 30, 36)), impulse_from_no_impulse=True,
+             secant=True)
+    key = {(p.variant, None if p.speed is None else round(p.speed * 60)): p.key
+           for p in s.points}
+    # chains start at 12 m/min: 24 -> 30 -> 36 upward, 6 downward
+    assert s.secant_step(key["ankle", 30]) == (key["ankle", 12], pytest.approx(0.5))
+    assert s.secant_step(key["ankle", 36]) == (key["ankle", 24], pytest.approx(1.0))
+    assert s.secant_step(key["impulse", 36]) == (key["impulse", 24], pytest.approx(1.0))
+    for k in (key["ankle", 24], key["ankle", 6], key["ankle", 12], key["ankle", None],
+              key["impulse", 24]):  # impulse 24 m/min: its chain's start came from plain
+        assert s.secant_step(k) is None
+    assert spec(speeds=s.speeds).secant_step(key["ankle", 36]) is None
+    assert sweep_settings(s)["secant"] is True
+    assert "secant" not in sweep_settings(spec(speeds=s.speeds))

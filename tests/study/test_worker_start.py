@@ -98,3 +98,34 @@ def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
     cold = solve_gait(five_link, finer(five_link, saved).options)
     assert outcome.gait is not None and outcome.warm == "file, regridded"
     assert outcome.gait["cost"]["value"] == pytest.approx(cold.cost_value, rel=1e-5)
+
+
+def test_a_chain_point_starts_from_the_secant_through_the_two_before(
+        five_link: RobotModel) -> None:
+    """With the chain's last two Results (``PointTask.secant``) a point starts from their
+    secant prediction (values and multipliers), reaches the optimum the last Result alone
+    reaches, and falls back to that Result where the two are of different grids."""
+    from gaitopt.gait.solve.staged import solve_walking
+    from gaitopt.ocp import WarmStart
+
+    def at(speed: float, knots: tuple[int, int] = (16, 6)) -> GaitOptions:
+        return options_for_model(five_link, GaitOptions(speed=speed, knots=knots))
+
+    first = solve_walking(five_link, at(0.2)).result
+    last = solve_walking(five_link, at(0.3), warm_start=first).result
+    assert first.success and last.success
+
+    def point(secant: tuple[object, float] | None) -> PointTask:
+        return PointTask(key="k", model=five_link, options=at(0.45), variant="ankle+impulse",
+                         speed_mode="fixed", structure="s", warm=last, relfile="k.gait.json",
+                         secant=secant)  # type: ignore[arg-type]
+
+    start, how, _ = _warm_start(point((first, 1.5)))
+    assert how == "result, secant" and isinstance(start, WarmStart)
+    np.testing.assert_allclose(start.w, last.w + 1.5 * (last.w - first.w))
+    np.testing.assert_allclose(start.lam_g, last.lam_g + 1.5 * (last.lam_g - first.lam_g))
+    secant, alone = solve_point(point((first, 1.5))), solve_point(point(None))
+    assert secant.success and alone.success and alone.warm == "result"
+    assert secant.row.cost == pytest.approx(alone.row.cost, rel=1e-6)
+    other = solve_walking(five_link, at(0.2, (24, 8))).result
+    assert _warm_start(point((other, 1.5)))[1] == "result"

@@ -328,7 +328,9 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
     iterations and 22-45 s each; the five-link walk's cold starts take about a second and
     stay cold, as in the paper. With feet, too, every point with ankle torques and the
     impulse starts from the same point with ankle torques only
-    (``SweepSpec.ankle_impulse_from_ankle``), on every grid of the study."""
+    (``SweepSpec.ankle_impulse_from_ankle``), on every grid of the study, and a chain's
+    third and later points start from the secant prediction through the two before
+    (``SweepSpec.secant``)."""
     def spec_of(text: str) -> SweepSpec:
         return make_spec(model_name=model_name, speeds=text, variants="all", free=True,
                          step_length="free", single_support="0.85", problem=grid)
@@ -337,7 +339,8 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
     default = STUDY_SPEEDS_BY_GAIT.get(str(spec.base.gait), STUDY_SPEEDS)
     spec = spec_of(default) if speeds is None and default != STUDY_SPEEDS else spec
     return spec if spec.base.gait == "walk" else replace(spec, impulse_from_no_impulse=True,
-                                                         ankle_impulse_from_ankle=True)
+                                                         ankle_impulse_from_ankle=True,
+                                                         secant=True)
 
 
 def check_sweep(check: SweepSpec, directory: Path) -> tuple[SweepSpec, dict[str, Path]]:

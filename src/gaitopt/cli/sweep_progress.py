@@ -41,7 +41,8 @@ def point_line(point: SweepPoint, outcome: PointOutcome) -> str:
     else:
         speed = f"{point.speed * 60:6.2f}"
     extra = f" [{point.subdir}]" if point.subdir else ""
-    start = {"result": "warm", "file": "warm (file)", "file, regridded": "warm (file, regridded)",
+    start = {"result": "warm", "result, secant": "warm (secant)", "file": "warm (file)",
+             "file, regridded": "warm (file, regridded)",
              "file, values": "warm (file values)", "none": "cold"}.get(outcome.warm,
                                                                            outcome.warm)
     if outcome.fell_back:

@@ -417,8 +417,10 @@ def regridded_point(model: RobotModel, options: GaitOptions, gait: Gait,
     the grid ``options`` solve on, where the file solved the same problem on another fixed
     grid (its ``knots``, ``knot_spacing`` and ``phase_shares`` options; the layout checked):
     its values interpolated and its multipliers mapped (:func:`gaitopt.ocp.regrid.regridded`),
-    as a solve maps its own solution onto its check grid. Start IPOPT from it with
-    :data:`~gaitopt.gait.solve.staged.REGRID_OPTIONS` (``solve_walking(warm_start_options=...)``).
+    as a solve maps its own solution onto its check grid. Sweep workers start IPOPT from it
+    with the warm start's barrier (1e-6; :data:`gaitopt.study.worker.REGRIDDED`); a solve's
+    own move from a coarser optimum uses :data:`~gaitopt.gait.solve.staged.REGRID_OPTIONS`
+    (``solve_walking(warm_start_options=...)``).
     None where the file keeps no point, it does not fit the file's own grid, or either grid
     is adaptive (``mesh_tol``)."""
     point = stored_point(gait.solver.get("warm_start"))

@@ -6,7 +6,7 @@ State a :class:`Problem` of :class:`Phase` objects, then ``tr = transcribe(probl
 
 from gaitopt.ocp.bounds import Bounds
 from gaitopt.ocp.costate import costates, one_sided_costates
-from gaitopt.ocp.guess import Guess, PhaseGuess, WarmStart, warm_start_of
+from gaitopt.ocp.guess import Guess, PhaseGuess, WarmStart, secant_start, warm_start_of
 from gaitopt.ocp.layout import ConstraintLayout, Layout, PhaseLayout
 from gaitopt.ocp.problem import (
     BoundaryConstraint,
@@ -55,6 +55,7 @@ __all__ = [
     "one_sided_costates",
     "refine",
     "refined_mesh",
+    "secant_start",
     "transcribe",
     "warm_start_of",
 ]

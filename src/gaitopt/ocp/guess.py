@@ -88,6 +88,29 @@ def warm_start_of(result: Result) -> WarmStart:
                      layout=repr(result.layout_signature), method=result.method)
 
 
+def secant_start(before: Result, last: Result, ratio: float) -> WarmStart:
+    """The secant prediction of a solution one more step along a continuation:
+    ``last + ratio (last - before)`` for the values ``w`` and the multipliers ``lam_x,
+    lam_g`` alike, ``before`` and ``last`` the solutions at the parameter values ``p_0, p_1``
+    and ``ratio = (p_2 - p_1) / (p_1 - p_0)`` for the next value ``p_2`` (1 for equal steps).
+    Both must be of one transcription (layout, method and constraint count); IPOPT moves a
+    predicted value that leaves its bounds back inside.
+
+    Raises:
+        ProblemError: the two results are of different transcriptions, or ``ratio`` is not
+            finite.
+    """
+    if (before.layout_signature != last.layout_signature or before.method != last.method
+            or before.w.size != last.w.size or before.lam_g.size != last.lam_g.size):
+        raise ProblemError("secant_start: the two results are of different transcriptions")
+    if not math.isfinite(ratio):
+        raise ProblemError(f"secant_start: ratio = {ratio}: need a finite step ratio")
+    a, b = warm_start_of(before), warm_start_of(last)
+    return WarmStart(w=b.w + ratio * (b.w - a.w), lam_x=b.lam_x + ratio * (b.lam_x - a.lam_x),
+                     lam_g=b.lam_g + ratio * (b.lam_g - a.lam_g), layout=b.layout,
+                     method=b.method)
+
+
 def default_value(lo: float, hi: float) -> float:
     """Midpoint of finite bounds, else 0 clipped into them."""
     if math.isfinite(lo) and math.isfinite(hi):

@@ -233,11 +233,15 @@ class _Driver:
         self.given[key] = offer
         # a kept neighbour's gait file is read here: workers may not see this directory
         warm = SavedGait.read(offer) if isinstance(offer, str) else offer
+        secant = self.spec.secant_step(key)
+        before = self.offers.get(secant[0]) if secant is not None else None
+        trend = ((before, secant[1]) if secant is not None and isinstance(warm, Result)
+                 and isinstance(before, Result) and self.state[secant[0]] == "ok" else None)
         self.tasks[key] = PointTask(key=key, model=self.spec.model_of(p),
                                     options=self.spec.options(p), variant=p.variant,
                                     speed_mode=p.speed_mode, structure=p.structure, warm=warm,
                                     relfile=p.relfile, force_fail=key in self.fail_points,
-                                    check_grid=self.spec.check_grid)
+                                    check_grid=self.spec.check_grid, secant=trend)
         return self.tasks[key]
 
     def run(self) -> None:

@@ -17,6 +17,7 @@ structure it already has.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -33,9 +34,9 @@ from gaitopt.gait.api import guess_from_gait, regridded_point, restart_point
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
-from gaitopt.gait.solve.staged import REGRID_OPTIONS, StagedRun, solve_walking
+from gaitopt.gait.solve.staged import StagedRun, solve_walking
 from gaitopt.gait.solve.warm_accuracy import check_point
-from gaitopt.ocp import Guess, Result, WarmStart
+from gaitopt.ocp import Guess, ProblemError, Result, WarmStart, secant_start
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row, variant_flags
 
@@ -44,7 +45,12 @@ from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row
 #: study's check and refinement sweeps with feet). Measured on the seven-link check grid
 #: (36 + 24 knots from 24 + 16, 2026-12-03): 17-58 iterations at nine points where the
 #: file's values alone took 34-643, and converged at a point where they failed (24 m/min
-#: without ankle torques or impulse); the same optima (within 0.003 %).
+#: without ankle torques or impulse); the same optima (within 0.003 %). IPOPT restarts there
+#: with the warm start's barrier, 1e-6 (:data:`gaitopt.ocp.transcription.WARM_START_OPTIONS`),
+#: not the 1e-4 (``REGRID_OPTIONS``) of a solve's own move onto its check grid, which moves
+#: from a coarser optimum: at 15 check points (2026-12-04) 8-25 iterations instead of 17-92,
+#: the same optima (within 1e-8) at 14 and at 48 m/min with ankle torques the study grid's
+#: branch (2621.90, the study grid 2621.97) where 1e-4 moved to a dearer one (2623.13).
 REGRIDDED = "file, regridded"
 #: Problem structures whose transcription this process has built (see module docstring).
 _BUILT: set[str] = set()
@@ -79,7 +85,10 @@ class PointTask:
     file's path relative to the sub-sweep folder (the summary row's ``file``).
     ``force_fail`` (a testing hook) solves with ``max_iter = 1`` so that the point fails
     through the real solver path. ``check_grid``: a warm-started point also solves its
-    check grid (:attr:`gaitopt.study.plan.SweepSpec.check_grid`).
+    check grid (:attr:`gaitopt.study.plan.SweepSpec.check_grid`). ``secant``: with a Result
+    ``warm``, the Result before it on the chain and the step ratio: the point starts from
+    their secant prediction (:func:`gaitopt.ocp.secant_start`;
+    :attr:`gaitopt.study.plan.SweepSpec.secant`).
     """
 
     key: str
@@ -92,6 +101,7 @@ class PointTask:
     relfile: str
     force_fail: bool = False
     check_grid: bool = False
+    secant: tuple[Result, float] | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -102,7 +112,8 @@ class PointOutcome:
     the solved gait as plain data in the gait-file schema (``Gait.to_dict()``) for the driver
     to write, None for a failed point (and once written); ``result`` the final engine result
     when the point succeeded (for its neighbours), else None;
-    ``warm`` how it started (``result``, ``file`` (its NLP point and multipliers), ``file,
+    ``warm`` how it started (``result``, ``result, secant`` (the secant prediction through
+    its chain's last two Results), ``file`` (its NLP point and multipliers), ``file,
     regridded`` (those of a file on another grid, mapped: :data:`REGRIDDED`), ``file,
     values`` (its trajectories), ``none``, or ``file unreadable``);
     ``fell_back`` whether a warm start failed and the cold path was taken;
@@ -145,6 +156,10 @@ def _warm_start(task: PointTask) -> tuple[Guess | Result | WarmStart | None, str
     (``solver.warm_start_check``, :func:`gaitopt.gait.solve.warm_accuracy.check_point`) for
     the point's check grid (used where it fits), else None."""
     if isinstance(task.warm, Result):
+        if task.secant is not None:
+            before, ratio = task.secant
+            with contextlib.suppress(ProblemError):  # not of one transcription: the Result
+                return secant_start(before, task.warm, ratio), "result, secant", None
         return task.warm, "result", None
     if isinstance(task.warm, SavedGait):
         try:
@@ -192,9 +207,7 @@ def solve_point(task: PointTask) -> PointOutcome:
     try:
         with _LOCK:
             solution = solve_walking(task.model, options, warm_start=warm,
-                                     check_warm_start=task.check_grid, check_start=check,
-                                     warm_start_options=REGRID_OPTIONS if how == REGRIDDED
-                                     else None)
+                                     check_warm_start=task.check_grid, check_start=check)
             ipopt = sum(s.wall_time_s for s in solution.stages)
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt
