@@ -20,12 +20,20 @@ from gaitopt.robot import (
 )
 from gaitopt.robot.inertia import ellipsoid_inertia
 
+# The trees need distinct names, which Hypothesis's short strings often repeat: its health
+# check on filtered draws (9 kept of 59 early in one run on 2026-12-04) is about speed, not
+# the test's verdict, so it is off like the two others.
 FUZZ = settings(deadline=None, max_examples=150,
-                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                       HealthCheck.filter_too_much])
 
-# Names: any printable text without surrounding spaces (the schema's rule).
-names = st.text(st.characters(blacklist_categories=("Cs",)), min_size=1, max_size=12).filter(
-    lambda s: s == s.strip() and s.strip() != "" and s.isprintable())
+# Names: any printable text without surrounding spaces (the schema's rule): one or two words
+# of printable characters (Python's: no control, format, private, unassigned or surrogate code
+# points, no separators) joined by a space. Drawn from every character and filtered, half the
+# names were thrown away and Hypothesis's health check failed the test now and then.
+_word = st.text(st.characters(blacklist_categories=("Cs", "Cc", "Cf", "Co", "Cn", "Zl", "Zp",
+                                                    "Zs")), min_size=1, max_size=6)
+names = st.lists(_word, min_size=1, max_size=2).map(" ".join)
 finite = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 positive = st.floats(1e-6, 1e3, allow_nan=False, allow_infinity=False)
 
