@@ -143,10 +143,13 @@ class Reference:
         return np.asarray(self.pin.from_pin(m), dtype=float)
 
     def bias(self, q: Array, qd: Array) -> Array:
-        """h(q, qd) = C(q, qd) qd + g(q) (nq,) (Pinocchio's RNEA with qdd = 0)."""
+        """h(q, qd) = C(q, qd) qd + g(q) + D qd (nq,): Pinocchio's RNEA with qdd = 0, plus the
+        joints' viscous damping ``D = diag(b)`` from the model data (Pinocchio's RNEA leaves
+        damping out; the seven-link's ankles have b = 2 N m s/rad)."""
         P = self.pin.to_pin
         h = pin.rnea(self.pin.model, self.data, P(q), P(qd), np.zeros(self.model.nq))
-        return np.asarray(self.pin.from_pin(h), dtype=float)
+        damping = np.asarray(self.model.coordinate_damping, dtype=float)
+        return np.asarray(self.pin.from_pin(h), dtype=float) + damping * np.asarray(qd)
 
     def contact_jacobian(self, q: Array, contact: str) -> Array:
         """Linear world-frame Jacobian (2, nq) of a contact point."""
