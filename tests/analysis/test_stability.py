@@ -418,7 +418,8 @@ def test_report_analyses_in_worker_processes_equal_those_in_this_one(gait: Gait,
     failed = dataclasses.replace(gait, solver={**gait.solver, "success": False,
                                                "status": "Infeasible_Problem_Detected"})
     bad = failed.save(tmp_path / "failed.gait.json", allow_failed=True)
-    rows = start_stability_rows([("optimum", path), ("failed", bad)], workers=2)()
+    rows = start_stability_rows([("optimum", gait, path), ("failed", failed, bad)],
+                                workers=2)()
     (here,) = stability_rows([("optimum", Gait.load(path))])
     assert [r.label for r in rows] == ["optimum", "failed"]
     for cell, expected in ((rows[0].open_loop, here.open_loop),

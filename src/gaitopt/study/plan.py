@@ -180,12 +180,11 @@ class SweepSpec:
         if self.continuation or self.free_from_start:
             parents |= self._chain_parents()
         if self.ankle_impulse_from_ankle:
-            keys = {p.key for p in self.points}
             ankle_only = variant_name(ankle=True, impulse=False)
             for p in self.points:
                 if variant_flags(p.variant) == (True, True):
                     twin = replace(p, variant=ankle_only).key
-                    parents[p.key] = twin if twin in keys else parents[p.key]
+                    parents[p.key] = twin if twin in self._points_by_key else parents[p.key]
         return parents
 
     def secant_step(self, key: str) -> tuple[str, float] | None:

@@ -156,9 +156,9 @@ def write_report(sweep_dir: str | os.PathLike[str], out_dir: str | os.PathLike[s
     gaits = {f: g for f, g in cache.items() if g is not None}
     findings = assess_findings(rows, gaits)
     stability_rows = start_stability_rows(
-        [(f"{v}, {row.speed_m_min:.1f} m/min", sweep / row.file) for v in VARIANTS
-         if (row := optimal[v]) is not None and load(row) is not None] if stability else [],
-        workers=workers)
+        [(f"{v}, {row.speed_m_min:.1f} m/min", gait, sweep / row.file) for v in VARIANTS
+         if (row := optimal[v]) is not None and (gait := load(row)) is not None]
+        if stability else [], workers=workers)
 
     def grid_note(shown: Sequence[SummaryRow | None] | None = None, what: str = "cost") -> str:
         """The grid and error-estimate sentence of a figure showing ``shown`` (all rows)."""

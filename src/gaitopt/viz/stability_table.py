@@ -78,27 +78,28 @@ def _file_cell(path: Path, pd: tuple[float, float] | None) -> StabilityCell:
     return _cell(Gait.load(path), pd)
 
 
-def start_stability_rows(files: Sequence[tuple[str, Path]], pd: tuple[float, float] = REPORT_PD,
-                         *, workers: int = 1) -> Callable[[], list[StabilityRow]]:
-    """Start the two analyses of each ``(label, gait file)`` and return the function that
-    waits for them and gives the rows (as :func:`stability_rows`). With ``workers`` > 1 they
-    run at once in that many local processes (at most one per analysis; the PD-tracked ones
-    first, the slower on a model with feet), so the caller can go on meanwhile; else in this
-    process when the function is called."""
-    if workers <= 1 or not files:
-        return lambda: stability_rows([(label, Gait.load(path)) for label, path in files], pd)
+def start_stability_rows(optima: Sequence[tuple[str, Gait, Path]],
+                         pd: tuple[float, float] = REPORT_PD, *,
+                         workers: int = 1) -> Callable[[], list[StabilityRow]]:
+    """Start the two analyses of each ``(label, gait, its file)`` and return the function
+    that waits for them and gives the rows (as :func:`stability_rows`). With ``workers`` > 1
+    they run at once in that many local processes, each loading the file (at most one per
+    analysis; the PD-tracked ones first, the slower on a model with feet), so the caller can
+    go on meanwhile; else on the gaits in this process when the function is called."""
+    if workers <= 1 or not optima:
+        return lambda: stability_rows([(label, gait) for label, gait, _ in optima], pd)
     from gaitopt.study.executors import mp_context
 
-    pool = ProcessPoolExecutor(max_workers=min(workers, 2 * len(files)),
+    pool = ProcessPoolExecutor(max_workers=min(workers, 2 * len(optima)),
                                mp_context=mp_context())
-    tracked = [pool.submit(_file_cell, path, pd) for _, path in files]
+    tracked = [pool.submit(_file_cell, path, pd) for _, _, path in optima]
     about: list[Future[StabilityCell]] = [pool.submit(_file_cell, path, None)
-                                          for _, path in files]
+                                          for _, _, path in optima]
 
     def rows() -> list[StabilityRow]:
         try:
             return [StabilityRow(label, a.result(), t.result())
-                    for (label, _), a, t in zip(files, about, tracked, strict=True)]
+                    for (label, _, _), a, t in zip(optima, about, tracked, strict=True)]
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
 
