@@ -140,6 +140,67 @@ def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> 
                 assert p[1] > -2e-3, (ph.name, c, p)
 
 
+def test_the_inverse_kinematics_jacobian_is_the_residuals_derivative(seven: RobotModel) -> None:
+    # The guess's least squares take the kinematics' own Jacobian: it must be the derivative
+    # of the residual (central differences, points away from the ground's kink).
+    from gaitopt.gait.guess.sequence import _contact_kinematics, _PoseFit
+
+    names = [c.name for c in seven.contacts]
+    targets = {"heel_1": (0.0, 0.0, 10.0), "toe_1": (0.2, 0.0, 10.0),
+               "heel_2": (None, 0.03, 1.0), "toe_2": (-0.3, 0.02, 1.0)}
+    pose = np.zeros(seven.nq)
+    fit = _PoseFit(_contact_kinematics(seven, names), names, targets, (0.1, 0.9), pose, 1.1)
+    rng = np.random.default_rng(1)
+    for _ in range(10):
+        q = np.concatenate([[0.0, 1.2, 0.0], rng.uniform(-0.5, 0.5, seven.nq - 3)])
+        jac = fit.jacobian(q)
+        h = 1e-6
+        fd = np.column_stack([(fit.residual(q + h * e) - fit.residual(q - h * e)) / (2 * h)
+                              for e in np.eye(seven.nq)])
+        assert jac.shape == fd.shape
+        np.testing.assert_allclose(jac, fd, atol=1e-7)
+
+
+@pytest.mark.parametrize("speed, step", [(0.5, 0.45), (1.0, 0.666), (1.5, 0.75)])
+def test_the_sequence_guess_moves_without_jumps(seven: RobotModel, speed: float,
+                                                step: float) -> None:
+    """The inverse kinematics follows one branch: neighbouring knots of a fine grid (a few
+    ms apart) differ by little. The swing targets of a heel and a toe taken each on its own
+    time off the ground asked for the toe 0.3 m behind the heel, and the poses jumped by
+    2 rad between samples (accelerations of 1e5 rad/s^2 in the guess)."""
+    seq = heel_toe_sequence(seven, swap(seven), 0.85, impulse=True)
+    guess = sequence_guess(seven, seq, swap(seven), speed=speed, step_length=step,
+                           knots=(60, 40), ankle=True)
+    for ph in guess.phases:
+        q = ph.x[:, :seven.nq]
+        dt = np.diff(ph.t)
+        assert dt.max() < 0.01
+        jumps = np.abs(np.diff(q, axis=0)).max(axis=1)
+        assert jumps.max() < 0.1, (ph.name, int(np.argmax(jumps)), jumps.max())
+
+
+def test_a_flying_foots_targets_keep_its_length(seven: RobotModel) -> None:
+    from gaitopt.gait.guess.sequence import _ground_points, _targets
+
+    seq = heel_toe_sequence(seven, swap(seven), 0.85, impulse=True)
+    step, total = 0.666, 0.666
+    rows = _ground_points(seq, seq.period_contacts(swap(seven)), step, total)
+    bodies = {c.name: tuple(o.name for o in seven.contacts if o.link == c.link)
+              for c in seven.contacts}
+    length = float(np.diff([seq.ground_x(c, step) for c in ("heel_1", "toe_1")])[0])
+    flying = 0
+    for t in np.linspace(0.0, total, 200):
+        tg = _targets(rows, bodies, float(t), 0.05)
+        for heel, toe in (("heel_1", "toe_1"), ("heel_2", "toe_2")):
+            a, b = tg[heel], tg[toe]
+            assert a is not None and b is not None
+            if a[0] is not None and b[0] is not None and a[2] == b[2] == 1.0:
+                flying += 1
+                assert b[0] - a[0] == pytest.approx(length, abs=1e-12)
+            assert a[1] is not None and 0.0 <= a[1] <= 0.05
+    assert flying > 50
+
+
 def test_phase_knots_keep_the_density_of_phase_0(five: RobotModel, seven: RobotModel) -> None:
     from gaitopt.gait.sequence.contact_sequence import phase_knots
 

@@ -101,32 +101,65 @@ def _ground_points(seq: ContactSequence, swap: Mapping[str, str], step: float, t
     return out
 
 
-def _target(rows: list[tuple[float, float, float | None]], t: float, lift: float
-            ) -> tuple[float | None, float, float] | None:
-    """``(x or None, y, weight)`` target of a point at time ``t`` from its held intervals."""
-    for t0, t1, x in rows:
-        if t0 - 1e-12 <= t <= t1 + 1e-12:
-            return x, 0.0, W_HELD
-    before = [r for r in rows if r[1] < t]
-    after = [r for r in rows if r[0] > t]
-    if not before or not after:
-        return None
-    (_, ta, xa), (tb, _, xb) = before[-1], after[0]
-    s = (t - ta) / (tb - ta)
-    x = None if xa is None or xb is None else xa + (xb - xa) * float(smoothstep(np.array(s)))
-    return x, lift * float(np.sin(np.pi * s)), W_SWING
+#: A point's target at one time: ``(x or None, y or None, weight)``; None: no terms at all.
+Target = tuple[float | None, float | None, float] | None
+
+
+def _targets(rows: Mapping[str, list[tuple[float, float, float | None]]],
+             bodies: Mapping[str, tuple[str, ...]], t: float, lift: float
+             ) -> dict[str, Target]:
+    """Each contact's target at time ``t`` from the held intervals ``rows`` (contact ->
+    ``(t0, t1, x)``); ``bodies``: contact -> the contacts on its link (itself included).
+
+    * held: its ground point, ``(x, 0)`` (``x`` None without an anchor), weight ``W_HELD``;
+    * off the ground: the height ``lift sin(pi s_c)``, ``s_c`` the fraction of its own time
+      off the ground (from its last ground point to its next), weight ``W_SWING``, so the
+      height starts and ends at 0 where the point lifts and lands; where its whole link is
+      off the ground also ``x``, from its last ground point to its next by smoothstep over
+      the link's flight, ``s = (t - t_a) / (t_b - t_a)`` from the last of the link's points
+      to leave the ground (``t_a``) to the first to come down (``t_b``): the points of one
+      link share ``s``, so their targets keep the link's length; while another point of its
+      link is held (a heel rising about the toe, a toe coming down after the heel) no
+      ``x``: the held point and the pose place it;
+    * no ground point before or after ``t``: None.
+    """
+    def held_at(c: str) -> tuple[float, float, float | None] | None:
+        return next((r for r in rows.get(c, []) if r[0] - 1e-12 <= t <= r[1] + 1e-12), None)
+
+    out: dict[str, Target] = {}
+    for c, mates in bodies.items():
+        row = held_at(c)
+        if row is not None:
+            out[c] = (row[2], 0.0, W_HELD)
+            continue
+        before = {m: [r for r in rows.get(m, []) if r[1] < t] for m in mates}
+        after = {m: [r for r in rows.get(m, []) if r[0] > t] for m in mates}
+        if not before[c] or not after[c]:
+            out[c] = None
+            continue
+        (_, ta, xa), (tb, _, xb) = before[c][-1], after[c][0]
+        y = lift * float(np.sin(np.pi * (t - ta) / (tb - ta)))
+        flying = all(before.values()) and all(after.values()) and not any(
+            held_at(m) is not None for m in mates)
+        if not flying or xa is None or xb is None:
+            out[c] = (None, y, W_SWING)
+            continue
+        ta = max(before[m][-1][1] for m in mates)
+        tb = min(after[m][0][0] for m in mates)
+        s = (t - ta) / (tb - ta)
+        out[c] = (xa + (xb - xa) * float(smoothstep(np.array(s))), y, W_SWING)
+    return out
 
 
 def _check_placed(model: RobotModel, phase: str, t: float, q: Array,
-                  targets: Mapping[str, tuple[float | None, float, float] | None],
-                  step: float) -> None:
+                  targets: Mapping[str, Target], step: float) -> None:
     """Raise :class:`ReachError` if a held point of the guess at time ``t`` is farther than
     :data:`PLACEMENT_TOL` from its ground point (the legs cannot reach it)."""
     for c, tgt in targets.items():
         if tgt is None or tgt[2] != W_HELD:
             continue
         p = np.asarray(contact_position(model, q, c), dtype=float).ravel()
-        miss = float(np.hypot(0.0 if tgt[0] is None else p[0] - tgt[0], p[1] - tgt[1]))
+        miss = float(np.hypot(0.0 if tgt[0] is None else p[0] - tgt[0], p[1]))
         if miss > model_scale(model).length(PLACEMENT_TOL):
             raise ReachError(
                 f"the legs of model {model.name!r} cannot hold {c!r} on its ground point in "
@@ -138,19 +171,94 @@ def contact_positions(model: RobotModel, names: list[str]
                       ) -> Callable[[Array], dict[str, Array]]:
     """``q -> {contact: world position (2,), m}`` for the contacts ``names``: the kinematics of
     :func:`~gaitopt.dynamics.kinematics.contact_position` as one CasADi function of ``q``
-    (the same expressions, evaluated by CasADi's virtual machine instead of Python floats:
-    the inverse kinematics above evaluates them some 37,000 times per guess of the
-    seven-link, 12 s of CPU in Python, 1 s so)."""
-    q = ca.SX.sym("q", model.nq)
-    fn = ca.Function("contact_positions", [q],
-                     [ca.horzcat(*[ca.vertcat(*ca.vertsplit(ca.SX(contact_position(
-                         model, q, c)))) for c in names])])
+    (the same expressions, evaluated by CasADi's virtual machine instead of Python floats)."""
+    fn = _contact_kinematics(model, names)
 
     def evaluate(qq: Array) -> dict[str, Array]:
-        out = np.asarray(fn(np.asarray(qq, dtype=float)), dtype=float)
+        out = np.asarray(fn(np.asarray(qq, dtype=float))[0], dtype=float)
         return {c: out[:, j] for j, c in enumerate(names)}
 
     return evaluate
+
+
+def _contact_kinematics(model: RobotModel, names: list[str]) -> ca.Function:
+    """CasADi function ``q (nq,) -> (P (2, n) m, dP/dq (2 n, nq))``: the world positions of
+    the contacts ``names`` (column ``j`` is ``names[j]``) and the Jacobian of ``P`` stacked
+    by columns (row ``2 j + a`` is coordinate ``a`` of ``names[j]``)."""
+    q = ca.SX.sym("q", model.nq)
+    points = ca.horzcat(*[ca.vertcat(*ca.vertsplit(ca.SX(contact_position(model, q, c))))
+                          for c in names])
+    return ca.Function("contact_kinematics", [q],
+                       [points, ca.jacobian(ca.vec(points), q)])
+
+
+class _PoseFit:
+    """The inverse kinematics' residual of one sample time and its exact Jacobian, for
+    ``scipy.optimize.least_squares`` (the module docstring's terms; distances per reference
+    leg length ``per_length``):
+
+    * per targeted point ``c``: ``W_HELD (min(y_c, 0))`` (never below the ground), ``w_c (x_c -
+      x*_c)`` where the target has an ``x``, ``w_c (y_c - y*_c)``;
+    * ``W_BASE (x_b - x*_b)``, ``W_BASE (y_b - y*_b)``, ``W_TORSO theta_b``, ``W_JOINT (q_j -
+      pose_j)``.
+
+    The Jacobian comes from :func:`_contact_kinematics` (the kinematics' own derivative; the
+    finite differences it replaces took some 37,000 residual evaluations per guess of the
+    seven-link, 8 s); ``min(y, 0)`` takes the derivative of ``y`` below the ground, 0 above.
+    """
+
+    def __init__(self, kinematics: ca.Function, names: list[str],
+                 targets: Mapping[str, Target], base: tuple[float, float], pose: Array,
+                 per_length: float) -> None:
+        self.kinematics = kinematics
+        self.pose = pose
+        self.per_length = per_length
+        self.base = base
+        cols = [j for j, c in enumerate(names) if targets[c] is not None]
+        tgts = [targets[names[j]] for j in cols]
+        self.cols = np.array(cols, dtype=int)
+        self.weights = np.array([t[2] for t in tgts if t is not None], dtype=float)
+        with_x = [(k, t[0]) for k, t in enumerate(tgts) if t is not None and t[0] is not None]
+        self.x_rows = np.array([k for k, _ in with_x], dtype=int)
+        self.target_x = np.array([x for _, x in with_x], dtype=float)
+        with_y = [(k, t[1]) for k, t in enumerate(tgts) if t is not None and t[1] is not None]
+        self.y_rows = np.array([k for k, _ in with_y], dtype=int)
+        self.target_y = np.array([y for _, y in with_y], dtype=float)
+        self._last: tuple[Array, Array, Array] | None = None
+
+    def _evaluate(self, q: Array) -> tuple[Array, Array]:
+        """The targeted points ``(2, n)`` and their Jacobian ``(n, 2, nq)`` at ``q`` (the last
+        ``q``'s kept: the solver asks for the residual and then the Jacobian at a point)."""
+        if self._last is None or not np.array_equal(self._last[0], q):
+            points, jac = self.kinematics(np.asarray(q, dtype=float))
+            self._last = (np.array(q, dtype=float), np.asarray(points)[:, self.cols],
+                          np.asarray(jac).reshape(-1, 2, q.size)[self.cols])
+        return self._last[1], self._last[2]
+
+    def residual(self, q: Array) -> Array:
+        p, _ = self._evaluate(q)
+        pl, w = self.per_length, self.weights
+        return np.concatenate([
+            W_HELD * pl * np.minimum(p[1], 0.0),
+            (w * pl)[self.x_rows] * (p[0, self.x_rows] - self.target_x),
+            (w * pl)[self.y_rows] * (p[1, self.y_rows] - self.target_y),
+            [W_BASE * pl * (q[BASE_X] - self.base[0]), W_BASE * pl * (q[BASE_Y] - self.base[1]),
+             W_TORSO * q[BASE_ANGLE]],
+            W_JOINT * (q[3:] - self.pose[3:])])
+
+    def jacobian(self, q: Array) -> Array:
+        p, d = self._evaluate(q)
+        pl, w = self.per_length, self.weights
+        fixed = np.zeros((q.size, q.size))
+        fixed[0, BASE_X] = W_BASE * pl
+        fixed[1, BASE_Y] = W_BASE * pl
+        fixed[2, BASE_ANGLE] = W_TORSO
+        fixed[3:, 3:] = W_JOINT * np.eye(q.size - 3)
+        return np.vstack([
+            (W_HELD * pl * (p[1] < 0.0))[:, None] * d[:, 1],
+            (w * pl)[self.x_rows, None] * d[self.x_rows, 0],
+            (w * pl)[self.y_rows, None] * d[self.y_rows, 1],
+            fixed])
 
 
 def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, str], *,
@@ -188,34 +296,20 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     q = np.clip(pose.copy(), lo, hi)
     q[BASE_X], q[BASE_Y] = middle - v * total / 2.0, 0.95 * stand
     ends = np.concatenate([[0.0], np.cumsum([ph.fraction for ph in seq.phases])]) * total
-    positions = contact_positions(model, names)
+    kinematics = _contact_kinematics(model, names)
+    bodies = {c.name: tuple(o.name for o in model.contacts if o.link == c.link)
+              for c in model.contacts}
     phases: list[PhaseGuess] = []
     for i, ph in enumerate(seq.phases):
         t_fine = np.linspace(ends[i], ends[i + 1], SAMPLES)
         q_fine = np.zeros((SAMPLES, model.nq))
         for k, t in enumerate(t_fine):
-            targets = {c: _target(rows.get(c, []), float(t), lift) for c in names}
+            targets = _targets(rows, bodies, float(t), lift)
             base = (middle + v * (t - total / 2.0), 0.95 * stand)
 
-            def residual(qq: Array, targets: dict[str, tuple[float | None, float, float] | None]
-                         = targets, base: tuple[float, float] = base) -> Array:
-                r = []
-                points = positions(qq)
-                for c, tgt in targets.items():
-                    if tgt is None:
-                        continue
-                    p = points[c]
-                    r.append(W_HELD * per_length * min(p[1], 0.0))   # never below the ground
-                    if tgt[0] is not None:
-                        r.append(tgt[2] * per_length * (p[0] - tgt[0]))
-                    r.append(tgt[2] * per_length * (p[1] - tgt[1]))
-                r += [W_BASE * per_length * (qq[BASE_X] - base[0]),
-                      W_BASE * per_length * (qq[BASE_Y] - base[1]), W_TORSO * qq[BASE_ANGLE]]
-                r += list(W_JOINT * (qq[3:] - pose[3:]))
-                return np.array(r)
-
-            q = least_squares(residual, np.clip(q, lo + 1e-9, hi - 1e-9), bounds=(lo, hi),
-                              xtol=1e-10, ftol=1e-10).x
+            fit = _PoseFit(kinematics, names, targets, base, pose, per_length)
+            q = least_squares(fit.residual, np.clip(q, lo + 1e-9, hi - 1e-9), jac=fit.jacobian,
+                              bounds=(lo, hi), xtol=1e-10, ftol=1e-10).x
             q_fine[k] = q
             _check_placed(model, ph.name, float(t), q, targets, step)
         count = knots[min(i, 1)]
