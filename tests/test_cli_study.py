@@ -276,6 +276,8 @@ def test_the_study_with_feet_starts_its_impulse_chains_from_the_variants_without
     walk = study_spec("five-link", "6,12", {"knots": (16, 6)})
     assert not walk.impulse_from_no_impulse
     assert {p.variant for p in walk.points if walk.parents[p.key] is None} == set(VARIANTS)
+    # the cold starts with feet leave their check grids to the study's check sweep
+    assert not feet.check_cold and walk.check_cold
 
 
 def test_a_failed_point_of_a_sweep_without_chains_restarts_from_its_nearest_neighbour(

@@ -208,3 +208,10 @@ def test_secant_steps_reach_two_points_back_along_their_own_chain() -> None:
     assert spec(speeds=s.speeds).secant_step(key["ankle", 36]) is None
     assert sweep_settings(s)["secant"] is True
     assert "secant" not in sweep_settings(spec(speeds=s.speeds))
+
+
+def test_check_cold_is_a_setting_of_the_sweep_only_when_off() -> None:
+    # sweep.json of a sweep whose cold starts skip their check grid says so; a sweep with
+    # the default (every folder written before the field existed) does not change.
+    assert "check_cold" not in sweep_settings(spec())
+    assert sweep_settings(spec(check_cold=False))["check_cold"] is False

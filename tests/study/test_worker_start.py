@@ -129,3 +129,24 @@ def test_a_chain_point_starts_from_the_secant_through_the_two_before(
     assert secant.row.cost == pytest.approx(alone.row.cost, rel=1e-6)
     other = solve_walking(five_link, at(0.2, (24, 8))).result
     assert _warm_start(point((other, 1.5)))[1] == "result"
+
+
+def test_a_cold_point_leaves_its_check_grid_to_the_sweep_where_asked(
+        five_link: RobotModel) -> None:
+    """``PointTask.check_cold`` (``SweepSpec.check_cold``): a cold point solves its check grid
+    for the estimate by default; without it the same answer comes without that stage."""
+
+    def cold(check_cold: bool) -> PointTask:
+        return PointTask(key="k", model=five_link, options=options(five_link),
+                         variant="ankle+impulse", speed_mode="fixed", structure="s", warm=None,
+                         relfile="k.gait.json", check_cold=check_cold)
+
+    checked, unchecked = solve_point(cold(True)), solve_point(cold(False))
+    assert checked.gait is not None and unchecked.gait is not None
+    assert checked.warm == unchecked.warm == "none"
+    names = [[s["name"] for s in o.gait["solver"]["stages"]] for o in (checked, unchecked)]
+    assert "check grid" in names[0] and not any("check grid" in n for n in names[1])
+    assert names[1] == [n for n in names[0] if "check grid" not in n]
+    assert unchecked.row.cost == checked.row.cost
+    assert checked.gait["solver"]["accuracy"]["check_cost"] is not None
+    assert unchecked.gait["solver"]["accuracy"]["check_cost"] is None

@@ -330,7 +330,8 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
     impulse starts from the same point with ankle torques only
     (``SweepSpec.ankle_impulse_from_ankle``), on every grid of the study, and a chain's
     third and later points start from the secant prediction through the two before
-    (``SweepSpec.secant``)."""
+    (``SweepSpec.secant``), and the cold starts leave their check grid to the study's check
+    sweep (``SweepSpec.check_cold``)."""
     def spec_of(text: str) -> SweepSpec:
         return make_spec(model_name=model_name, speeds=text, variants="all", free=True,
                          step_length="free", single_support="0.85", problem=grid)
@@ -340,7 +341,7 @@ def study_spec(model_name: str, speeds: str | None, grid: dict[str, Any]) -> Swe
     spec = spec_of(default) if speeds is None and default != STUDY_SPEEDS else spec
     return spec if spec.base.gait == "walk" else replace(spec, impulse_from_no_impulse=True,
                                                          ankle_impulse_from_ankle=True,
-                                                         secant=True)
+                                                         secant=True, check_cold=False)
 
 
 def check_sweep(check: SweepSpec, directory: Path) -> tuple[SweepSpec, dict[str, Path]]:

@@ -241,7 +241,8 @@ class _Driver:
                                     options=self.spec.options(p), variant=p.variant,
                                     speed_mode=p.speed_mode, structure=p.structure, warm=warm,
                                     relfile=p.relfile, force_fail=key in self.fail_points,
-                                    check_grid=self.spec.check_grid, secant=trend)
+                                    check_grid=self.spec.check_grid,
+                                    check_cold=self.spec.check_cold, secant=trend)
         return self.tasks[key]
 
     def run(self) -> None:

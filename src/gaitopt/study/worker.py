@@ -85,7 +85,8 @@ class PointTask:
     file's path relative to the sub-sweep folder (the summary row's ``file``).
     ``force_fail`` (a testing hook) solves with ``max_iter = 1`` so that the point fails
     through the real solver path. ``check_grid``: a warm-started point also solves its
-    check grid (:attr:`gaitopt.study.plan.SweepSpec.check_grid`). ``secant``: with a Result
+    check grid (:attr:`gaitopt.study.plan.SweepSpec.check_grid`); ``check_cold``: a cold
+    point does (:attr:`gaitopt.study.plan.SweepSpec.check_cold`). ``secant``: with a Result
     ``warm``, the Result before it on the chain and the step ratio: the point starts from
     their secant prediction (:func:`gaitopt.ocp.secant_start`;
     :attr:`gaitopt.study.plan.SweepSpec.secant`).
@@ -101,6 +102,7 @@ class PointTask:
     relfile: str
     force_fail: bool = False
     check_grid: bool = False
+    check_cold: bool = True
     secant: tuple[Result, float] | None = None
 
 
@@ -207,7 +209,8 @@ def solve_point(task: PointTask) -> PointOutcome:
     try:
         with _LOCK:
             solution = solve_walking(task.model, options, warm_start=warm,
-                                     check_warm_start=task.check_grid, check_start=check)
+                                     check_warm_start=task.check_grid, check_start=check,
+                                     check_cold=task.check_cold or task.check_grid)
             ipopt = sum(s.wall_time_s for s in solution.stages)
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt

@@ -210,9 +210,12 @@ class _Run:
     """One call of :func:`solve_walking`: runs stages and records them."""
 
     def __init__(self, model: RobotModel, options: GaitOptions, progress: ProgressFn | None,
-                 compiled: str | None, stage_seconds: float | None = None) -> None:
+                 compiled: str | None, stage_seconds: float | None = None,
+                 check_grid: bool = True) -> None:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
+        #: Whether :meth:`refine` solves the check grid after the target grid.
+        self.check_grid = check_grid
         #: IPOPT's wall-time limit (s) of each stage (``ipopt.max_wall_time``), or None.
         self.stage_seconds = stage_seconds
         #: The model's size (:mod:`gaitopt.gait.options.model_scale`) and reference speed (m/s).
@@ -393,12 +396,13 @@ class _Run:
         speed held at the coarse solution's (a fine grid started from a coarse solution with
         them free can wander to a far worse local optimum), then released. Without
         ``mesh_tol``, then :meth:`check`: the same problem on the check grid, for the cost
-        error estimate; the target grid's solution is the answer."""
+        error estimate; the target grid's solution is the answer (not when the run was made
+        with ``check_cold=False``)."""
         o = self.options
         if tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform":
             return result
         fine = self.on_grid("target grid", target_grid(self.model, o), result)
-        if fine.success and o.mesh_tol is None:
+        if fine.success and o.mesh_tol is None and self.check_grid:
             self.check(fine)
         return fine
 
@@ -585,7 +589,8 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   check_warm_start: bool = False,
                   check_start: WarmStart | None = None,
                   stage_seconds: float | None = None,
-                  warm_start_options: dict[str, Any] | None = None) -> StagedRun:
+                  warm_start_options: dict[str, Any] | None = None,
+                  check_cold: bool = True) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
     succeeded and which stage failed.
@@ -600,6 +605,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     (:mod:`gaitopt.gait.solve.refinement` solves each finer grid so), restarted from
     ``check_start`` where it fits (:meth:`_Run.check`). ``stage_seconds``: a wall-time
     limit (s) of each IPOPT stage (a stage that reaches it fails), or None.
+    ``check_cold``: after a cold (or continued) solve's target grid, solve its check grid
+    for the cost error estimate (without ``mesh_tol``); False leaves the answer without the
+    estimate, as a warm start without ``check_warm_start`` (a sweep whose points are
+    estimated by a sweep of their own, :mod:`gaitopt.study.grid_error`).
 
     Raises:
         GaitOptionsError: invalid options, or a step so long that no naive start can place
@@ -610,7 +619,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()
-    run = _Run(model, options, progress, compiled, stage_seconds)
+    run = _Run(model, options, progress, compiled, stage_seconds, check_grid=check_cold)
     result: Result | None = None
     if warm_start is not None:
         result = run.stage("warm start", warm_start_grid(model, options, warm_start), Relaxation(),
