@@ -8,7 +8,7 @@ import pytest
 from gaitopt.dynamics.kinematics import contact_position
 from gaitopt.gait.formulations.full.physics import per_point, projection_names
 from gaitopt.gait.formulations.select import checked_sequence, default_formulation
-from gaitopt.gait.guess.sequence import contact_positions, sequence_guess
+from gaitopt.gait.guess.sequence import contact_kinematics, sequence_guess
 from gaitopt.gait.options.gait_options import GaitOptions, GaitOptionsError
 from gaitopt.gait.sequence.builtin import (
     heel_toe_sequence,
@@ -110,14 +110,14 @@ def test_the_guess_kinematics_are_the_model_kinematics(seven: RobotModel) -> Non
     # The inverse kinematics of the guess evaluates the contact points as one CasADi
     # function: the same expressions as the Python-float kinematics, so the same numbers.
     names = [c.name for c in seven.contacts]
-    positions = contact_positions(seven, names)
+    positions = contact_kinematics(seven, names)
     rng = np.random.default_rng(0)
     for _ in range(50):
         q = rng.uniform(-1.5, 1.5, seven.nq)
-        got = positions(q)
-        for c in names:
+        got = np.asarray(positions(q)[0], dtype=float)
+        for j, c in enumerate(names):
             want = np.asarray(contact_position(seven, q, c), dtype=float).ravel()
-            np.testing.assert_allclose(got[c], want, rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(got[:, j], want, rtol=1e-12, atol=1e-12)
 
 
 def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> None:
@@ -143,13 +143,13 @@ def test_sequence_guess_puts_held_points_on_their_anchors(seven: RobotModel) -> 
 def test_the_inverse_kinematics_jacobian_is_the_residuals_derivative(seven: RobotModel) -> None:
     # The guess's least squares take the kinematics' own Jacobian: it must be the derivative
     # of the residual (central differences, points away from the ground's kink).
-    from gaitopt.gait.guess.sequence import _contact_kinematics, _PoseFit
+    from gaitopt.gait.guess.sequence import _PoseFit
 
     names = [c.name for c in seven.contacts]
     targets = {"heel_1": (0.0, 0.0, 10.0), "toe_1": (0.2, 0.0, 10.0),
                "heel_2": (None, 0.03, 1.0), "toe_2": (-0.3, 0.02, 1.0)}
     pose = np.zeros(seven.nq)
-    fit = _PoseFit(_contact_kinematics(seven, names), names, targets, (0.1, 0.9), pose, 1.1)
+    fit = _PoseFit(contact_kinematics(seven, names), names, targets, (0.1, 0.9), pose, 1.1)
     rng = np.random.default_rng(1)
     for _ in range(10):
         q = np.concatenate([[0.0, 1.2, 0.0], rng.uniform(-0.5, 0.5, seven.nq - 3)])

@@ -27,7 +27,7 @@ reports like an unreachable start of the two-link guess.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 
 import casadi as ca
 import numpy as np
@@ -123,24 +123,22 @@ def _targets(rows: Mapping[str, list[tuple[float, float, float | None]]],
       ``x``: the held point and the pose place it;
     * no ground point before or after ``t``: None.
     """
-    def held_at(c: str) -> tuple[float, float, float | None] | None:
-        return next((r for r in rows.get(c, []) if r[0] - 1e-12 <= t <= r[1] + 1e-12), None)
-
+    held = {c: next((r for r in rows.get(c, []) if r[0] - 1e-12 <= t <= r[1] + 1e-12), None)
+            for c in bodies}
+    before = {c: [r for r in rows.get(c, []) if r[1] < t] for c in bodies}
+    after = {c: [r for r in rows.get(c, []) if r[0] > t] for c in bodies}
     out: dict[str, Target] = {}
     for c, mates in bodies.items():
-        row = held_at(c)
+        row = held[c]
         if row is not None:
             out[c] = (row[2], 0.0, W_HELD)
             continue
-        before = {m: [r for r in rows.get(m, []) if r[1] < t] for m in mates}
-        after = {m: [r for r in rows.get(m, []) if r[0] > t] for m in mates}
         if not before[c] or not after[c]:
             out[c] = None
             continue
         (_, ta, xa), (tb, _, xb) = before[c][-1], after[c][0]
         y = lift * float(np.sin(np.pi * (t - ta) / (tb - ta)))
-        flying = all(before.values()) and all(after.values()) and not any(
-            held_at(m) is not None for m in mates)
+        flying = all(before[m] and after[m] and held[m] is None for m in mates)
         if not flying or xa is None or xb is None:
             out[c] = (None, y, W_SWING)
             continue
@@ -167,24 +165,12 @@ def _check_placed(model: RobotModel, phase: str, t: float, q: Array,
                 f"misses it by {miss:.3g} m)")
 
 
-def contact_positions(model: RobotModel, names: list[str]
-                      ) -> Callable[[Array], dict[str, Array]]:
-    """``q -> {contact: world position (2,), m}`` for the contacts ``names``: the kinematics of
-    :func:`~gaitopt.dynamics.kinematics.contact_position` as one CasADi function of ``q``
-    (the same expressions, evaluated by CasADi's virtual machine instead of Python floats)."""
-    fn = _contact_kinematics(model, names)
-
-    def evaluate(qq: Array) -> dict[str, Array]:
-        out = np.asarray(fn(np.asarray(qq, dtype=float))[0], dtype=float)
-        return {c: out[:, j] for j, c in enumerate(names)}
-
-    return evaluate
-
-
-def _contact_kinematics(model: RobotModel, names: list[str]) -> ca.Function:
+def contact_kinematics(model: RobotModel, names: list[str]) -> ca.Function:
     """CasADi function ``q (nq,) -> (P (2, n) m, dP/dq (2 n, nq))``: the world positions of
-    the contacts ``names`` (column ``j`` is ``names[j]``) and the Jacobian of ``P`` stacked
-    by columns (row ``2 j + a`` is coordinate ``a`` of ``names[j]``)."""
+    the contacts ``names`` (column ``j`` is ``names[j]``; the expressions of
+    :func:`~gaitopt.dynamics.kinematics.contact_position`, evaluated by CasADi's virtual
+    machine instead of Python floats) and the Jacobian of ``P`` stacked by columns (row
+    ``2 j + a`` is coordinate ``a`` of ``names[j]``)."""
     q = ca.SX.sym("q", model.nq)
     points = ca.horzcat(*[ca.vertcat(*ca.vertsplit(ca.SX(contact_position(model, q, c))))
                           for c in names])
@@ -202,7 +188,7 @@ class _PoseFit:
     * ``W_BASE (x_b - x*_b)``, ``W_BASE (y_b - y*_b)``, ``W_TORSO theta_b``, ``W_JOINT (q_j -
       pose_j)``.
 
-    The Jacobian comes from :func:`_contact_kinematics` (the kinematics' own derivative; the
+    The Jacobian comes from :func:`contact_kinematics` (the kinematics' own derivative; the
     finite differences it replaces took some 37,000 residual evaluations per guess of the
     seven-link, 8 s); ``min(y, 0)`` takes the derivative of ``y`` below the ground, 0 above.
     """
@@ -224,6 +210,12 @@ class _PoseFit:
         with_y = [(k, t[1]) for k, t in enumerate(tgts) if t is not None and t[1] is not None]
         self.y_rows = np.array([k for k, _ in with_y], dtype=int)
         self.target_y = np.array([y for _, y in with_y], dtype=float)
+        nq = pose.size
+        #: The rows of the base, torso and joint terms in the Jacobian (constant).
+        self.fixed = np.zeros((nq, nq))
+        self.fixed[0, BASE_X] = self.fixed[1, BASE_Y] = W_BASE * per_length
+        self.fixed[2, BASE_ANGLE] = W_TORSO
+        self.fixed[3:, 3:] = W_JOINT * np.eye(nq - 3)
         self._last: tuple[Array, Array, Array] | None = None
 
     def _evaluate(self, q: Array) -> tuple[Array, Array]:
@@ -249,16 +241,11 @@ class _PoseFit:
     def jacobian(self, q: Array) -> Array:
         p, d = self._evaluate(q)
         pl, w = self.per_length, self.weights
-        fixed = np.zeros((q.size, q.size))
-        fixed[0, BASE_X] = W_BASE * pl
-        fixed[1, BASE_Y] = W_BASE * pl
-        fixed[2, BASE_ANGLE] = W_TORSO
-        fixed[3:, 3:] = W_JOINT * np.eye(q.size - 3)
         return np.vstack([
             (W_HELD * pl * (p[1] < 0.0))[:, None] * d[:, 1],
             (w * pl)[self.x_rows, None] * d[self.x_rows, 0],
             (w * pl)[self.y_rows, None] * d[self.y_rows, 1],
-            fixed])
+            self.fixed])
 
 
 def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, str], *,
@@ -296,7 +283,7 @@ def sequence_guess(model: RobotModel, seq: ContactSequence, swap: Mapping[str, s
     q = np.clip(pose.copy(), lo, hi)
     q[BASE_X], q[BASE_Y] = middle - v * total / 2.0, 0.95 * stand
     ends = np.concatenate([[0.0], np.cumsum([ph.fraction for ph in seq.phases])]) * total
-    kinematics = _contact_kinematics(model, names)
+    kinematics = contact_kinematics(model, names)
     bodies = {c.name: tuple(o.name for o in model.contacts if o.link == c.link)
               for c in model.contacts}
     phases: list[PhaseGuess] = []

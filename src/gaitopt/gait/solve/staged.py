@@ -211,11 +211,11 @@ class _Run:
 
     def __init__(self, model: RobotModel, options: GaitOptions, progress: ProgressFn | None,
                  compiled: str | None, stage_seconds: float | None = None,
-                 check_grid: bool = True) -> None:
+                 check_cold: bool = True) -> None:
         self.model, self.options, self.progress, self.compiled = model, options, progress, \
             compiled
         #: Whether :meth:`refine` solves the check grid after the target grid.
-        self.check_grid = check_grid
+        self.check_cold = check_cold
         #: IPOPT's wall-time limit (s) of each stage (``ipopt.max_wall_time``), or None.
         self.stage_seconds = stage_seconds
         #: The model's size (:mod:`gaitopt.gait.options.model_scale`) and reference speed (m/s).
@@ -402,7 +402,7 @@ class _Run:
         if tuple(o.knots) == coarse_knots(o) and o.knot_spacing == "uniform":
             return result
         fine = self.on_grid("target grid", target_grid(self.model, o), result)
-        if fine.success and o.mesh_tol is None and self.check_grid:
+        if fine.success and o.mesh_tol is None and self.check_cold:
             self.check(fine)
         return fine
 
@@ -619,7 +619,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     checked_sequence(model, options)
     evaluation_mode(options, compiled)  # refuses a compilation that would take too long
     start = time.perf_counter()
-    run = _Run(model, options, progress, compiled, stage_seconds, check_grid=check_cold)
+    run = _Run(model, options, progress, compiled, stage_seconds, check_cold=check_cold)
     result: Result | None = None
     if warm_start is not None:
         result = run.stage("warm start", warm_start_grid(model, options, warm_start), Relaxation(),
