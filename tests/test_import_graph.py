@@ -45,7 +45,8 @@ PACKAGE = "gaitopt"
 LAYERS: tuple[str, ...] = ("robot", "dynamics", "ocp", "gait", "analysis", "study", "viz",
                            "cli")
 #: Top-level helper modules, below every package; they import no gaitopt module.
-HELPERS: frozenset[str] = frozenset({"fileio", "units", "codegen", "process_memory", "views"})
+HELPERS: frozenset[str] = frozenset({"fileio", "units", "codegen", "interrupts", "process_memory",
+                                   "views"})
 #: The front door: re-exports from everywhere, outside the layering.
 FRONT_DOOR: frozenset[str] = frozenset({"gaitopt", "gaitopt.__main__"})
 #: The sub-packages at the bottom of gait/: they import no other module of gait/.

@@ -1,5 +1,6 @@
 """Ctrl-C during an IPOPT solve raises KeyboardInterrupt (CasADi alone returns a failed solve,
-and the staged solve went on with its next stage)."""
+and the staged solve went on with its next stage); so does SIGTERM in a process that installed
+:func:`gaitopt.interrupts.terminate_as_interrupt` (as Terminated)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from gaitopt.interrupts import Terminated, raise_terminated, terminate_as_interrupt, terminated
 from gaitopt.ocp.solver import call_solver
 
 
@@ -58,3 +60,45 @@ def test_a_process_that_ignores_sigint_keeps_ignoring_it() -> None:
         signal.signal(signal.SIGINT, previous)
     assert out.error is None
     assert abs(out.x[0] - 2.0) < 1e-6
+
+
+def test_sigterm_during_a_solve_raises_terminated_where_installed() -> None:
+    """With :func:`terminate_as_interrupt` installed (the ``gaitopt`` command), SIGTERM stops
+    IPOPT like Ctrl-C and is raised as Terminated, a KeyboardInterrupt, after the call;
+    the handler is back afterwards and the signal is noted for the exit status."""
+    solver = slow_solver()
+    args = {"x0": np.full(2000, 0.5), "lbg": -0.1, "ubg": 0.1}
+    previous = signal.getsignal(signal.SIGTERM)
+    terminate_as_interrupt()
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGTERM))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(Terminated):
+            call_solver(solver, args)
+        assert signal.getsignal(signal.SIGTERM) is raise_terminated
+        assert terminated()
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGTERM, previous)
+    assert time.monotonic() - start < 30.0  # stopped at the signal, not at the CPU-time cap
+    assert issubclass(Terminated, KeyboardInterrupt)
+
+
+def test_sigterm_keeps_a_handler_the_process_installed_itself() -> None:
+    """Without :func:`terminate_as_interrupt`, a process's own SIGTERM handler is left
+    alone by the solver call."""
+    x = ca.MX.sym("x")
+    solver = ca.nlpsol("quick", "ipopt", {"x": x, "f": (x - 2.0) ** 2},
+                       {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False})
+
+    def own(signum: int, frame: object) -> None:
+        pass
+
+    previous = signal.signal(signal.SIGTERM, own)
+    try:
+        out = call_solver(solver, {"x0": 1.0})
+        assert signal.getsignal(signal.SIGTERM) is own
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert out.error is None

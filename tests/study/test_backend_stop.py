@@ -1,13 +1,17 @@
 """Closing a local backend without waiting (Ctrl-C) ends its running points: the command
-exits at once instead of when each running solve ends."""
+exits at once instead of when each running solve ends; SIGTERM does the same."""
 
 from __future__ import annotations
 
+import os
+import signal
 import subprocess
 import sys
 import textwrap
 import time
 from pathlib import Path
+
+import pytest
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 
@@ -38,3 +42,76 @@ def test_close_without_waiting_ends_the_running_points(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "closed" in done.stdout
     assert elapsed < 60.0, f"the process waited {elapsed:.0f} s for its running point"
+
+
+def descendants(pid: int) -> set[int]:
+    """The processes below ``pid`` (children, grandchildren, ...), from /proc."""
+    parents: dict[int, int] = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        parents[int(entry.name)] = int(stat.rsplit(")", 1)[1].split()[1])
+    found: set[int] = set()
+    frontier = {pid}
+    while frontier:
+        frontier = {p for p, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def alive(pid: int) -> bool:
+    try:
+        state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process tree "
+                    "from /proc")
+def test_sigterm_stops_a_sweep_and_its_workers_like_ctrl_c(tmp_path: Path) -> None:
+    """``kill PID`` (SIGTERM) of a ``gaitopt sweep`` while its worker solves: the command
+    ends its worker processes and exits with 143 at once, saying how to resume, and leaves
+    no half-written file. Before, the main process died alone and its workers went on
+    solving without a parent until their points ended."""
+    out = tmp_path / "sweep"
+    command = [sys.executable, "-c", "import sys; from gaitopt.cli import main; "
+               "sys.exit(main(sys.argv[1:]))", "sweep", "-o", str(out), "--speeds",
+               "12,24,36", "--variants", "plain", "--no-free", "--workers", "1"]
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               text=True, env=env)
+    below: set[int] = set()
+    try:
+        deadline = time.monotonic() + 120.0  # a worker process (the pool's, below its server)
+        while len(descendants(process.pid)) < 2 and time.monotonic() < deadline:
+            assert process.poll() is None, process.stdout.read() if process.stdout else ""
+            time.sleep(0.2)
+        time.sleep(2.0)
+        below = descendants(process.pid)
+        assert len(below) >= 2, "no worker process started"
+        process.send_signal(signal.SIGTERM)
+        try:
+            output, _ = process.communicate(timeout=60)
+        except subprocess.TimeoutExpired:  # the output pipe is still open: some process runs
+            running = sorted(p for p in below if alive(p))
+            pytest.fail(f"60 s after SIGTERM, still running: {running} of the sweep's "
+                        f"processes {sorted(below)} (the command "
+                        f"{'exited' if process.poll() is not None else 'runs'})")
+    finally:
+        if process.poll() is None:
+            process.kill()
+        for pid in descendants(process.pid) | below:
+            if alive(pid):  # no orphan of a failed check outlives the test
+                os.kill(pid, signal.SIGKILL)
+    assert process.returncode == 143, output
+    assert "interrupted" in output and "rerun the same command to resume" in output, output
+    deadline = time.monotonic() + 20.0
+    while any(alive(p) for p in below) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not [p for p in below if alive(p)], "worker processes outlived the sweep"
+    assert not list(out.rglob("*.tmp"))

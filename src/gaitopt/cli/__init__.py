@@ -14,9 +14,12 @@ when one of its commands is looked up (:data:`COMMANDS`):
 from __future__ import annotations
 
 import os
+import signal
+import threading
 from collections.abc import Sequence
 
 from gaitopt.cli.base import PIPE_WIDTH, USER_ERRORS, UserError, cli, make_console
+from gaitopt.interrupts import TERMINATED_STATUS, terminate_as_interrupt, terminated
 
 #: Each command and the module that registers it, imported when the command is looked up
 #: (``gaitopt solve`` imports neither the study's nor the figures' modules).
@@ -43,14 +46,26 @@ PROCESS_ENVIRONMENT: dict[str, str] = {"OPENBLAS_NUM_THREADS": "1"}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``gaitopt`` console script; returns the exit status."""
+    """Entry point of the ``gaitopt`` console script; returns the exit status.
+
+    SIGTERM stops the command as Ctrl-C does (:mod:`gaitopt.interrupts`: a sweep writes what
+    its workers returned and ends them), and the status is then
+    :data:`~gaitopt.interrupts.TERMINATED_STATUS` (143) where Ctrl-C's is 130."""
     for name, value in PROCESS_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGTERM)
+    if main_thread:
+        terminate_as_interrupt()
     try:
         cli.main(args=list(argv) if argv is not None else None, prog_name="gaitopt",
                  standalone_mode=True)
     except SystemExit as exc:
-        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        return TERMINATED_STATUS if terminated() and status != 0 else status
+    finally:
+        if main_thread:  # a caller's own handler (main() called from Python) comes back
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

@@ -17,7 +17,9 @@ Modes (``compiled``):
   evaluate the dynamics at single grid points (the separated Hermite-Simpson form).
 
 A solve never raises: :func:`call_solver` returns the solution or an error message, except
-for Ctrl-C, which it raises as :class:`KeyboardInterrupt` (:func:`interrupt_watch`).
+for Ctrl-C, which it raises as :class:`KeyboardInterrupt`, and SIGTERM where
+:func:`gaitopt.interrupts.terminate_as_interrupt` is installed, which it raises as
+:class:`~gaitopt.interrupts.Terminated` (:func:`interrupt_watch`).
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ import casadi as ca
 import numpy as np
 
 from gaitopt import codegen
+from gaitopt.interrupts import Terminated, raise_terminated
 
 #: The solver options of every transcription. ``ipopt.mumps_mem_percent`` (IPOPT's default
 #: 1000: MUMPS's working space eleven times its own estimate) at 100: on the seven-link
@@ -203,40 +206,59 @@ class SolverOutput:
     error: str | None
 
 
+#: The signals :func:`interrupt_watch` notes, each with the handler it must find installed
+#: (else the process handles or ignores the signal itself, and keeps its handler) and the
+#: exception that handler raises.
+WATCHED_SIGNALS: tuple[tuple[signal.Signals, Any, type[KeyboardInterrupt]], ...] = (
+    (signal.SIGINT, signal.default_int_handler, KeyboardInterrupt),
+    (signal.SIGTERM, raise_terminated, Terminated),
+)
+
+
 @contextmanager
-def interrupt_watch() -> Iterator[Callable[[], bool]]:
-    """Watch for Ctrl-C (SIGINT) during a solver call: yields a function that says whether
-    one came.
+def interrupt_watch() -> Iterator[Callable[[], type[KeyboardInterrupt] | None]]:
+    """Watch for Ctrl-C (SIGINT), and for SIGTERM where
+    :func:`gaitopt.interrupts.terminate_as_interrupt` is installed, during a solver call:
+    yields a function that returns the exception to raise for the first such signal that came
+    (KeyboardInterrupt, :class:`~gaitopt.interrupts.Terminated`), or None.
 
     CasADi checks for Ctrl-C between IPOPT's iterations, stops the solve and returns it as
     a failed one (status ``NonIpopt_Exception_Thrown``, the KeyboardInterrupt only logged as
     a warning), so a staged solve went on with its next stage and Ctrl-C never stopped it.
-    Here Python's SIGINT handler is replaced, for the call, by one that notes the signal and
-    raises KeyboardInterrupt as before (so IPOPT still stops at once); :func:`call_solver`
-    then raises it. Only in the main thread, and only where SIGINT has Python's default
-    handler (a process that ignores it, or handles it itself, keeps its handler)."""
-    if (threading.current_thread() is not threading.main_thread()
-            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
-        yield lambda: False
+    Here each watched signal's handler is replaced, for the call, by one that notes the signal
+    and raises as before (so IPOPT still stops at once); :func:`call_solver` then raises it.
+    Only in the main thread, and only for a signal whose handler is the expected one
+    (:data:`WATCHED_SIGNALS`)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: None
         return
-    seen: list[int] = []
+    seen: list[type[KeyboardInterrupt]] = []
+    restore: list[tuple[signal.Signals, Any]] = []
+    for signum, expected, kind in WATCHED_SIGNALS:
+        if signal.getsignal(signum) is not expected:
+            continue
 
-    def note(signum: int, frame: Any) -> None:
-        seen.append(signum)
-        raise KeyboardInterrupt
+        def note(number: int, frame: Any, kind: type[KeyboardInterrupt] = kind,
+                 handler: Any = expected) -> None:
+            seen.append(kind)
+            handler(number, frame)  # raises ``kind``
 
-    signal.signal(signal.SIGINT, note)
+        signal.signal(signum, note)
+        restore.append((signum, expected))
     try:
-        yield lambda: bool(seen)
+        yield lambda: seen[0] if seen else None
     finally:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+        for signum, handler in restore:
+            signal.signal(signum, handler)
 
 
 def call_solver(solver: ca.Function, args: dict[str, Any]) -> SolverOutput:
     """Run ``solver(**args)``; any exception becomes ``error`` (with x = x0).
 
     Raises:
-        KeyboardInterrupt: Ctrl-C during the call (:func:`interrupt_watch`).
+        KeyboardInterrupt: Ctrl-C during the call, or :class:`~gaitopt.interrupts.Terminated`
+            for SIGTERM where :func:`~gaitopt.interrupts.terminate_as_interrupt` is installed
+            (:func:`interrupt_watch`).
     """
     with interrupt_watch() as interrupted:
         try:
@@ -246,8 +268,8 @@ def call_solver(solver: ca.Function, args: dict[str, Any]) -> SolverOutput:
             sol = None
             error = (f"{type(exc).__name__}: "
                      f"{str(exc).strip().splitlines()[-1] if str(exc) else ''}")
-    if interrupted():
-        raise KeyboardInterrupt
+    if (stop := interrupted()) is not None:
+        raise stop
     try:
         stats = dict(solver.stats())
     except Exception:  # noqa: BLE001
