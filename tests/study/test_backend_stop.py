@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from gaitopt.study.executors import process_exists
+
 SRC = Path(__file__).resolve().parents[2] / "src"
 
 SCRIPT = textwrap.dedent("""
@@ -71,17 +73,13 @@ def alive(pid: int) -> bool:
     return state != "Z"
 
 
-@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process tree "
-                    "from /proc")
-def test_sigterm_stops_a_sweep_and_its_workers_like_ctrl_c(tmp_path: Path) -> None:
-    """``kill PID`` (SIGTERM) of a ``gaitopt sweep`` while its worker solves: the command
-    ends its worker processes and exits with 143 at once, saying how to resume, and leaves
-    no half-written file. Before, the main process died alone and its workers went on
-    solving without a parent until their points ended."""
-    out = tmp_path / "sweep"
+def stop_a_solving_sweep(out: Path, signum: int) -> tuple[int, str, set[int], list[int]]:
+    """Start ``gaitopt sweep`` (one worker), send ``signum`` to it once its worker process
+    runs, and return its exit status, its output, the processes below it just before the
+    signal, and those of them still running 20 s after it exited. None outlives the call."""
     command = [sys.executable, "-c", "import sys; from gaitopt.cli import main; "
                "sys.exit(main(sys.argv[1:]))", "sweep", "-o", str(out), "--speeds",
-               "12,24,36", "--variants", "plain", "--no-free", "--workers", "1"]
+               "3:60:3", "--variants", "all", "--workers", "1"]
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                text=True, env=env)
@@ -94,24 +92,51 @@ def test_sigterm_stops_a_sweep_and_its_workers_like_ctrl_c(tmp_path: Path) -> No
         time.sleep(2.0)
         below = descendants(process.pid)
         assert len(below) >= 2, "no worker process started"
-        process.send_signal(signal.SIGTERM)
-        try:
-            output, _ = process.communicate(timeout=60)
-        except subprocess.TimeoutExpired:  # the output pipe is still open: some process runs
-            running = sorted(p for p in below if alive(p))
-            pytest.fail(f"60 s after SIGTERM, still running: {running} of the sweep's "
-                        f"processes {sorted(below)} (the command "
-                        f"{'exited' if process.poll() is not None else 'runs'})")
+        process.send_signal(signum)
+        status = process.wait(timeout=60)
+        deadline = time.monotonic() + 20.0
+        while any(alive(p) for p in below) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        running = sorted(p for p in below if alive(p))
     finally:
         if process.poll() is None:
             process.kill()
         for pid in descendants(process.pid) | below:
             if alive(pid):  # no orphan of a failed check outlives the test
                 os.kill(pid, signal.SIGKILL)
-    assert process.returncode == 143, output
+    output = process.stdout.read() if process.stdout else ""
+    return status, output, below, running
+
+
+ON_LINUX = pytest.mark.skipif(not Path("/proc/self/stat").exists(),
+                              reason="reads the process tree from /proc")
+
+
+@ON_LINUX
+def test_sigterm_stops_a_sweep_and_its_workers_like_ctrl_c(tmp_path: Path) -> None:
+    """``kill PID`` (SIGTERM) of a ``gaitopt sweep`` while its worker solves: the command
+    ends its worker processes and exits with 143 at once, saying how to resume, and leaves
+    no half-written file. Before, the main process died alone and its workers went on
+    without a parent (see the next test)."""
+    status, output, below, running = stop_a_solving_sweep(tmp_path / "sweep", signal.SIGTERM)
+    assert status == 143, output
     assert "interrupted" in output and "rerun the same command to resume" in output, output
-    deadline = time.monotonic() + 20.0
-    while any(alive(p) for p in below) and time.monotonic() < deadline:
-        time.sleep(0.2)
-    assert not [p for p in below if alive(p)], "worker processes outlived the sweep"
-    assert not list(out.rglob("*.tmp"))
+    assert not running, f"still running 20 s after the sweep: {running} of {sorted(below)}"
+    assert not list((tmp_path / "sweep").rglob("*.tmp"))
+
+
+@ON_LINUX
+def test_the_workers_end_when_the_sweep_is_killed(tmp_path: Path) -> None:
+    """SIGKILL cannot be handled: the workers notice that the driver is gone
+    (``gaitopt.study.executors.end_with_driver``) and end. Before, the worker and its
+    forkserver finished the point for nobody and then waited for work forever."""
+    status, _, below, running = stop_a_solving_sweep(tmp_path / "sweep", signal.SIGKILL)
+    assert status == -signal.SIGKILL
+    assert not running, f"still running 20 s after the sweep: {running} of {sorted(below)}"
+
+
+def test_process_exists_tells_a_running_process_from_an_ended_one() -> None:
+    assert process_exists(os.getpid())
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()  # ended and reaped: its PID names no process
+    assert not process_exists(child.pid)

@@ -20,7 +20,9 @@ itself: that is the executor's (or the Dask scheduler's) work.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import queue
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
@@ -98,7 +100,9 @@ def local_backend(workers: int, *, start_method: str | None = None) -> Backend:
     state: dict[str, ProcessPoolExecutor] = {}
 
     def start() -> None:
-        state["pool"] = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+        state["pool"] = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                            initializer=end_with_driver,
+                                            initargs=(os.getpid(),))
 
     def restart() -> None:
         state["pool"].shutdown(wait=False, cancel_futures=True)
@@ -119,6 +123,48 @@ def local_backend(workers: int, *, start_method: str | None = None) -> Backend:
 
 #: Seconds a stopped worker process is given to end after SIGTERM, before SIGKILL.
 STOP_GRACE_S = 5.0
+#: Seconds between a local worker's checks that the driver process is still there
+#: (:func:`end_with_driver`).
+DRIVER_CHECK_S = 1.0
+
+
+def end_with_driver(driver: int) -> None:
+    """The initializer of each local worker process: a daemon thread ends the worker
+    (``os._exit``) within :data:`DRIVER_CHECK_S` once the driver process ``driver`` (PID) is
+    gone, whatever ended it (SIGKILL, a crash, a closed terminal's SIGHUP) and whatever the
+    worker is doing (IPOPT runs without the GIL).
+
+    Without it a driver killed by SIGKILL left its worker processes and their forkserver
+    running without a parent: each worker finished its point for nobody, then waited for
+    work forever (measured: still there minutes later). POSIX only (``os.kill(pid, 0)``
+    tests a process there; on Windows it would end it)."""
+    if os.name != "posix":
+        return
+
+    def watch() -> None:
+        while True:
+            time.sleep(DRIVER_CHECK_S)
+            if not process_exists(driver):
+                os._exit(1)
+
+    threading.Thread(target=watch, name="gaitopt-driver-watch", daemon=True).start()
+
+
+def process_exists(pid: int) -> bool:
+    """Whether process ``pid`` runs (POSIX; a zombie, ended but not yet reaped by its
+    parent, counts as ended where /proc says so)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process: it exists
+        return True
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as fh:
+            stat = fh.read()
+    except OSError:
+        return True
+    return stat.rsplit(")", 1)[-1].split()[0] != "Z"
 
 
 def stop_workers(pool: ProcessPoolExecutor) -> None:
