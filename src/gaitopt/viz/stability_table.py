@@ -22,6 +22,7 @@ its figures: a PD-tracked analysis of the seven-link walk takes about 10 s, an o
 from __future__ import annotations
 
 import html
+import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass
@@ -88,10 +89,11 @@ def start_stability_rows(optima: Sequence[tuple[str, Gait, Path]],
     go on meanwhile; else on the gaits in this process when the function is called."""
     if workers <= 1 or not optima:
         return lambda: stability_rows([(label, gait) for label, gait, _ in optima], pd)
-    from gaitopt.study.executors import mp_context
+    from gaitopt.study.executors import end_with_driver, mp_context, stop_workers
 
     pool = ProcessPoolExecutor(max_workers=min(workers, 2 * len(optima)),
-                               mp_context=mp_context())
+                               mp_context=mp_context(), initializer=end_with_driver,
+                               initargs=(os.getpid(),))
     tracked = [pool.submit(_file_cell, path, pd) for _, _, path in optima]
     about: list[Future[StabilityCell]] = [pool.submit(_file_cell, path, None)
                                           for _, _, path in optima]
@@ -100,6 +102,9 @@ def start_stability_rows(optima: Sequence[tuple[str, Gait, Path]],
         try:
             return [StabilityRow(label, a.result(), t.result())
                     for (label, _, _), a, t in zip(optima, about, tracked, strict=True)]
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: end the analyses, do not wait for them
+            stop_workers(pool)
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
 
