@@ -36,11 +36,14 @@ def raise_terminated(signum: int, frame: Any) -> None:
 
 
 def terminate_as_interrupt() -> None:
-    """Make SIGTERM stop this process like Ctrl-C (module docstring). Call from the main
-    thread."""
+    """Make SIGTERM stop this process like Ctrl-C (module docstring), and forget a SIGTERM
+    noted before (each ``gaitopt`` command run in one process, as the tests do, asks
+    :func:`terminated` about its own run). Call from the main thread."""
+    _received.clear()
     signal.signal(signal.SIGTERM, raise_terminated)
 
 
 def terminated() -> bool:
-    """Whether this process has received SIGTERM through :func:`raise_terminated`."""
+    """Whether SIGTERM came through :func:`raise_terminated` since
+    :func:`terminate_as_interrupt` was last called."""
     return _received.is_set()

@@ -80,7 +80,9 @@ def test_sigterm_during_a_solve_raises_terminated_where_installed() -> None:
         assert terminated()
     finally:
         timer.cancel()
+        terminate_as_interrupt()  # forgets the signal: other tests call main() here
         signal.signal(signal.SIGTERM, previous)
+    assert not terminated()
     assert time.monotonic() - start < 30.0  # stopped at the signal, not at the CPU-time cap
     assert issubclass(Terminated, KeyboardInterrupt)
 

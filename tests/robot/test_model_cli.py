@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -10,6 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from gaitopt.cli import PIPE_WIDTH, cli, main
+from gaitopt.interrupts import Terminated, raise_terminated, terminated
 from gaitopt.robot import load_model
 
 
@@ -143,9 +146,17 @@ def test_export_into_unwritable_place_is_a_user_error(runner: CliRunner,
 
 def test_main_returns_exit_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["model", "show", "five-link"]) == 0
+    raise_terminated_in_this_process()  # a SIGTERM of an earlier run is not this run's
     assert main(["model", "show", str(write_bad_model(tmp_path))]) == 2
     assert main(["--version"]) == 0
     assert "gaitopt" in capsys.readouterr().out
+
+
+def raise_terminated_in_this_process() -> None:
+    """What a SIGTERM noted in this process before (another test's) leaves behind."""
+    with contextlib.suppress(Terminated):
+        raise_terminated(signal.SIGTERM, None)
+    assert terminated()
 
 
 def test_real_process_prints_no_traceback(tmp_path: Path) -> None:
