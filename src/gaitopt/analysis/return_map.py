@@ -73,6 +73,7 @@ from gaitopt.dynamics.functions import (
 )
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.dynamics.tree import holds
+from gaitopt.ocp.functions import IdentityCache
 from gaitopt.ocp.hermite_simpson import HermiteSimpson
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import swap_matrices
@@ -109,7 +110,7 @@ class PhaseProfile:
     def inputs(self, tau: float) -> tuple[Array, Array | None, Array | None]:
         """``(u, q_ref, qd_ref)`` at ``tau`` (the references None without PD knots)."""
         t = self.t
-        k = int(np.clip(np.searchsorted(t, tau, side="right") - 1, 0, t.size - 2))
+        k = min(max(int(np.searchsorted(t, tau, side="right")) - 1, 0), t.size - 2)
         h = t[k + 1] - t[k]
         s = min(max((tau - t[k]) / h, 0.0), 1.0)
         u = (1.0 - s) * self.u[k] + s * self.u[k + 1]
@@ -304,8 +305,55 @@ def _swap_jump(spec: StepSpec) -> ca.Function:
     return spec.function("swap", build)
 
 
-def _eval(f: ca.Function, *args: Array) -> list[Array]:
-    return [np.asarray(v, dtype=float) for v in f(*args)]
+class _Numeric:
+    """``f``'s outputs on float arrays through CasADi's function buffer: each input copied into
+    an array the buffer reads, each output's nonzeros written into an array the buffer owns
+    and returned dense (shape ``f.size_out(i)``), without the DM conversions of ``f(*args)``.
+    The same values; on the seven-link biped's right-hand side those conversions took more
+    time than the compiled evaluation (docs/stability.md, "Speed": the tracked seven-link
+    analysis 17-19 s before, 4-5 s now, with the interval lookup in :meth:`PhaseProfile.inputs`
+    in plain integers)."""
+
+    def __init__(self, f: ca.Function) -> None:
+        self._buffer, self._run = f.buffer()
+        self._inputs: list[Array] = []
+        for i in range(f.n_in()):
+            values = np.zeros(f.sparsity_in(i).nnz())
+            if values.size != f.numel_in(i):
+                raise ValueError(f"{f.name()}: input {i} is sparse")
+            # The buffer's byte size is read from the memoryview (the stubs' third argument
+            # is not accepted at run time).
+            self._buffer.set_arg(i, memoryview(values))  # type: ignore[call-arg,arg-type]
+            self._inputs.append(values)
+        self._outputs: list[tuple[Array, tuple[int, int], Array, Array]] = []
+        for i in range(f.n_out()):
+            pattern = f.sparsity_out(i)
+            nonzeros = np.zeros(pattern.nnz())
+            self._buffer.set_res(i, memoryview(nonzeros))  # type: ignore[call-arg,arg-type]
+            rows, cols = pattern.get_triplet()
+            self._outputs.append((nonzeros, pattern.shape, np.asarray(rows, dtype=int),
+                                  np.asarray(cols, dtype=int)))
+
+    def __call__(self, *args: Array | float) -> list[Array]:
+        for values, arg in zip(self._inputs, args, strict=True):
+            values[:] = np.ravel(arg, order="F")
+        self._run()
+        out = []
+        for nonzeros, shape, rows, cols in self._outputs:
+            dense = np.zeros(shape)
+            dense[rows, cols] = nonzeros
+            out.append(dense)
+        return out
+
+
+#: The :class:`_Numeric` evaluator of each function in use (found by the function's identity).
+_NUMERIC = IdentityCache(64)
+
+
+def _eval(f: ca.Function, *args: Array | float) -> list[Array]:
+    """``f(*args)`` as float arrays (2-D, ``f.size_out(i)``)."""
+    numeric: _Numeric = _NUMERIC.get((f,), lambda: _Numeric(f))
+    return numeric(*args)
 
 
 # -- integration --------------------------------------------------------------------------------
@@ -323,10 +371,9 @@ def phase_field(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> Ar
     """The vector field ``f(tau, y)`` (2 nq,) of a phase."""
     u, q_ref, qd_ref = phase.inputs(tau)
     zero = np.zeros(spec.nq)
-    f = _rhs(spec, phase.contacts, jacobian=False)
-    return np.asarray(f(y, u, zero if q_ref is None else q_ref,
-                        zero if qd_ref is None else qd_ref, _gains(spec)),
-                      dtype=float).ravel()
+    return _eval(_rhs(spec, phase.contacts, jacobian=False), y, u,
+                 zero if q_ref is None else q_ref, zero if qd_ref is None else qd_ref,
+                 _gains(spec))[0].ravel()
 
 
 def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational: bool,
