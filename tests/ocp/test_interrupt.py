@@ -29,23 +29,30 @@ def slow_solver() -> ca.Function:
                       "ipopt.hessian_approximation": "limited-memory"})
 
 
-def test_ctrl_c_during_a_solve_raises_and_restores_the_handler() -> None:
-    solver = slow_solver()
-    args = {"x0": np.full(2000, 0.5), "lbg": -0.1, "ubg": 0.1}
-    # Python's own handler, as in an interactive command: a test worker (pytest-xdist) or a
-    # process started in the background may ignore SIGINT, and then the call leaves it so.
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+def solve_until(signum: int, raised: type[BaseException]) -> float:
+    """Send ``signum`` to this process 1 s into a long solve; check that ``call_solver``
+    raises ``raised``; return the seconds the call took."""
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signum))
     start = time.monotonic()
     timer.start()
     try:
-        with pytest.raises(KeyboardInterrupt):
-            call_solver(solver, args)
-        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        with pytest.raises(raised):
+            call_solver(slow_solver(), {"x0": np.full(2000, 0.5), "lbg": -0.1, "ubg": 0.1})
     finally:
         timer.cancel()
+    return time.monotonic() - start
+
+
+def test_ctrl_c_during_a_solve_raises_and_restores_the_handler() -> None:
+    # Python's own handler, as in an interactive command: a test worker (pytest-xdist) or a
+    # process started in the background may ignore SIGINT, and then the call leaves it so.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        took = solve_until(signal.SIGINT, KeyboardInterrupt)
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
         signal.signal(signal.SIGINT, previous)
-    assert time.monotonic() - start < 30.0  # stopped at the signal, not at the CPU-time cap
+    assert took < 30.0  # stopped at the signal, not at the CPU-time cap
 
 
 def test_a_process_that_ignores_sigint_keeps_ignoring_it() -> None:
@@ -66,24 +73,17 @@ def test_sigterm_during_a_solve_raises_terminated_where_installed() -> None:
     """With :func:`terminate_as_interrupt` installed (the ``gaitopt`` command), SIGTERM stops
     IPOPT like Ctrl-C and is raised as Terminated, a KeyboardInterrupt, after the call;
     the handler is back afterwards and the signal is noted for the exit status."""
-    solver = slow_solver()
-    args = {"x0": np.full(2000, 0.5), "lbg": -0.1, "ubg": 0.1}
     previous = signal.getsignal(signal.SIGTERM)
     terminate_as_interrupt()
-    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGTERM))
-    start = time.monotonic()
-    timer.start()
     try:
-        with pytest.raises(Terminated):
-            call_solver(solver, args)
+        took = solve_until(signal.SIGTERM, Terminated)
         assert signal.getsignal(signal.SIGTERM) is raise_terminated
         assert terminated()
     finally:
-        timer.cancel()
         terminate_as_interrupt()  # forgets the signal: other tests call main() here
         signal.signal(signal.SIGTERM, previous)
     assert not terminated()
-    assert time.monotonic() - start < 30.0  # stopped at the signal, not at the CPU-time cap
+    assert took < 30.0  # stopped at the signal, not at the CPU-time cap
     assert issubclass(Terminated, KeyboardInterrupt)
 
 
