@@ -160,11 +160,11 @@ def process_exists(pid: int) -> bool:
     except PermissionError:  # another user's process: it exists
         return True
     try:
-        with open(f"/proc/{pid}/stat", encoding="ascii") as fh:
+        with open(f"/proc/{pid}/stat", "rb") as fh:  # the name in it may be any bytes
             stat = fh.read()
     except OSError:
         return True
-    return stat.rsplit(")", 1)[-1].split()[0] != "Z"
+    return stat.rsplit(b")", 1)[-1].split()[0] != b"Z"
 
 
 def stop_workers(pool: ProcessPoolExecutor) -> None:
