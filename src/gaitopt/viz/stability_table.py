@@ -15,8 +15,9 @@ finite-difference check of the monodromy is left to ``gaitopt stability`` (it do
 time).
 
 The report runs the analyses in local processes (:func:`start_stability_rows`) while it draws
-its figures: a PD-tracked analysis of the seven-link walk takes about 10 s, an open-loop one
-2-3 s, and the study's four optima took 36 s of its report in one process.
+its figures: a PD-tracked analysis of the seven-link walk takes 4-5 s, an open-loop one about
+1 s (10-19 s and 2-4 s before 2026-12-04, when the return map's calls went through CasADi's
+DM conversions; docs/stability.md, "Speed").
 """
 
 from __future__ import annotations
