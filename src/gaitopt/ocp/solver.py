@@ -36,7 +36,7 @@ import casadi as ca
 import numpy as np
 
 from gaitopt import codegen
-from gaitopt.interrupts import Terminated, raise_terminated
+from gaitopt.interrupts import raise_terminated
 
 #: The solver options of every transcription. ``ipopt.mumps_mem_percent`` (IPOPT's default
 #: 1000: MUMPS's working space eleven times its own estimate) at 100: on the seven-link
@@ -207,11 +207,11 @@ class SolverOutput:
 
 
 #: The signals :func:`interrupt_watch` notes, each with the handler it must find installed
-#: (else the process handles or ignores the signal itself, and keeps its handler) and the
-#: exception that handler raises.
-WATCHED_SIGNALS: tuple[tuple[signal.Signals, Any, type[KeyboardInterrupt]], ...] = (
-    (signal.SIGINT, signal.default_int_handler, KeyboardInterrupt),
-    (signal.SIGTERM, raise_terminated, Terminated),
+#: (else the process handles or ignores the signal itself, and keeps its handler); each such
+#: handler raises a KeyboardInterrupt (:class:`~gaitopt.interrupts.Terminated` for SIGTERM).
+WATCHED_SIGNALS: tuple[tuple[signal.Signals, Any], ...] = (
+    (signal.SIGINT, signal.default_int_handler),
+    (signal.SIGTERM, raise_terminated),
 )
 
 
@@ -234,14 +234,16 @@ def interrupt_watch() -> Iterator[Callable[[], type[KeyboardInterrupt] | None]]:
         return
     seen: list[type[KeyboardInterrupt]] = []
     restore: list[tuple[signal.Signals, Any]] = []
-    for signum, expected, kind in WATCHED_SIGNALS:
+    for signum, expected in WATCHED_SIGNALS:
         if signal.getsignal(signum) is not expected:
             continue
 
-        def note(number: int, frame: Any, kind: type[KeyboardInterrupt] = kind,
-                 handler: Any = expected) -> None:
-            seen.append(kind)
-            handler(number, frame)  # raises ``kind``
+        def note(number: int, frame: Any, handler: Any = expected) -> None:
+            try:
+                handler(number, frame)
+            except KeyboardInterrupt as exc:
+                seen.append(type(exc))
+                raise
 
         signal.signal(signum, note)
         restore.append((signum, expected))
