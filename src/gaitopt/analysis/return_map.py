@@ -64,6 +64,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
+from gaitopt.analysis.numeric import evaluate
 from gaitopt.codegen import CompileError, compile_functions
 from gaitopt.dynamics.actuation import actuation_rows
 from gaitopt.dynamics.functions import (
@@ -73,7 +74,6 @@ from gaitopt.dynamics.functions import (
 )
 from gaitopt.dynamics.kinematics import contact_position, contact_velocity
 from gaitopt.dynamics.tree import holds
-from gaitopt.ocp.functions import IdentityCache
 from gaitopt.ocp.hermite_simpson import HermiteSimpson
 from gaitopt.robot.model import RobotModel
 from gaitopt.robot.symmetry import swap_matrices
@@ -305,64 +305,13 @@ def _swap_jump(spec: StepSpec) -> ca.Function:
     return spec.function("swap", build)
 
 
-class _Numeric:
-    """``f``'s outputs on float arrays through CasADi's function buffer: each input copied into
-    an array the buffer reads, each output's nonzeros written into an array the buffer owns
-    and returned dense (shape ``f.size_out(i)``), without the DM conversions of ``f(*args)``.
-    The same values; on the seven-link biped's right-hand side those conversions took more
-    time than the compiled evaluation (docs/stability.md, "Speed": the tracked seven-link
-    analysis 17-19 s before, 4-5 s now, with the interval lookup in :meth:`PhaseProfile.inputs`
-    in plain integers)."""
-
-    def __init__(self, f: ca.Function) -> None:
-        self._buffer, self._run = f.buffer()
-        self._inputs: list[Array] = []
-        for i in range(f.n_in()):
-            values = np.zeros(f.sparsity_in(i).nnz())
-            if values.size != f.numel_in(i):
-                raise ValueError(f"{f.name()}: input {i} is sparse")
-            # The buffer's byte size is read from the memoryview (the stubs' third argument
-            # is not accepted at run time).
-            self._buffer.set_arg(i, memoryview(values))  # type: ignore[call-arg,arg-type]
-            self._inputs.append(values)
-        self._outputs: list[tuple[Array, tuple[int, int], Array, Array]] = []
-        for i in range(f.n_out()):
-            pattern = f.sparsity_out(i)
-            nonzeros = np.zeros(pattern.nnz())
-            self._buffer.set_res(i, memoryview(nonzeros))  # type: ignore[call-arg,arg-type]
-            rows, cols = pattern.get_triplet()
-            self._outputs.append((nonzeros, pattern.shape, np.asarray(rows, dtype=int),
-                                  np.asarray(cols, dtype=int)))
-
-    def __call__(self, *args: Array | float) -> list[Array]:
-        for values, arg in zip(self._inputs, args, strict=True):
-            values[:] = np.ravel(arg, order="F")
-        self._run()
-        out = []
-        for nonzeros, shape, rows, cols in self._outputs:
-            dense = np.zeros(shape)
-            dense[rows, cols] = nonzeros
-            out.append(dense)
-        return out
-
-
-#: The :class:`_Numeric` evaluator of each function in use (found by the function's identity).
-_NUMERIC = IdentityCache(64)
-
-
-def _eval(f: ca.Function, *args: Array | float) -> list[Array]:
-    """``f(*args)`` as float arrays (2-D, ``f.size_out(i)``)."""
-    numeric: _Numeric = _NUMERIC.get((f,), lambda: _Numeric(f))
-    return numeric(*args)
-
-
 # -- integration --------------------------------------------------------------------------------
 
 def phase_rhs(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> tuple[Array, Array]:
     """The vector field ``f(tau, y)`` (2 nq,) of a phase and its Jacobian ``A`` (2 nq, 2 nq)."""
     u, q_ref, qd_ref = phase.inputs(tau)
     zero = np.zeros(spec.nq)
-    ydot, a = _eval(_rhs(spec, phase.contacts), y, u, zero if q_ref is None else q_ref,
+    ydot, a = evaluate(_rhs(spec, phase.contacts), y, u, zero if q_ref is None else q_ref,
                     zero if qd_ref is None else qd_ref, _gains(spec))
     return ydot.ravel(), a
 
@@ -371,7 +320,7 @@ def phase_field(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> Ar
     """The vector field ``f(tau, y)`` (2 nq,) of a phase."""
     u, q_ref, qd_ref = phase.inputs(tau)
     zero = np.zeros(spec.nq)
-    return _eval(_rhs(spec, phase.contacts, jacobian=False), y, u,
+    return evaluate(_rhs(spec, phase.contacts, jacobian=False), y, u,
                  zero if q_ref is None else q_ref, zero if qd_ref is None else qd_ref,
                  _gains(spec))[0].ravel()
 
@@ -395,10 +344,10 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     def ahead(tau: float, z: Array) -> float:
         # From the origin, where the stance tip stands at the start of the step (and, held,
         # all through a walk's single support; a run's flight holds no tip).
-        return float(_eval(tip, z[:n])[0][0, 0] - spec.arm_distance)
+        return float(evaluate(tip, z[:n])[0][0, 0] - spec.arm_distance)
 
     def height(tau: float, z: Array) -> float:
-        return float(_eval(tip, z[:n])[0][1, 0])
+        return float(evaluate(tip, z[:n])[0][1, 0])
 
     ahead.terminal, ahead.direction = True, 1.0  # type: ignore[attr-defined]
     height.terminal, height.direction = True, -1.0  # type: ignore[attr-defined]
@@ -434,7 +383,7 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
 def guard_row(spec: StepSpec, y: Array, point: str | None = None) -> Array:
     """``Dg`` (2 nq,): the gradient of a guard (the height of ``point``, by default the swing
     tip) with respect to ``y``."""
-    return _eval(_tip(spec, point or spec.swing), y)[2][1]
+    return evaluate(_tip(spec, point or spec.swing), y)[2][1]
 
 
 def guard_factor(spec: StepSpec, phase: int, tau: float, y_minus: Array) -> Array:
@@ -466,7 +415,7 @@ def saltation_matrix(spec: StepSpec, y_minus: Array, f_minus: Array, f_plus: Arr
 
 def event_jump(spec: StepSpec, event: StepEvent, y_minus: Array) -> tuple[Array, Array]:
     """An event's jump ``y+ = (q, qd+(q, qd-))`` (2 nq,) and its Jacobian (2 nq, 2 nq)."""
-    y_plus, jac = _eval(_event_jump(spec, event), np.asarray(y_minus, float))
+    y_plus, jac = evaluate(_event_jump(spec, event), np.asarray(y_minus, float))
     return y_plus.ravel(), jac
 
 
@@ -505,7 +454,7 @@ def simulate_step(spec: StepSpec, y0: Array, *, variational: bool = False) -> St
                 jump = jump @ guard_factor(spec, i, tau, y_end)
             factors[f"phi_{i}"], factors[f"jump_{i}"] = phi, jump
             monodromy = jump @ phi @ monodromy
-    y_next, d_swap = _eval(_swap_jump(spec), y)
+    y_next, d_swap = evaluate(_swap_jump(spec), y)
     factors["jump_swap"] = d_swap
     return StepResult(y_next=y_next.ravel(), strike_time=t_strike, y_strike=y_strike,
                       y_impact=y_imp, y_liftoff=y, step_time=t_total,
@@ -535,7 +484,7 @@ def section_constraints(spec: StepSpec, y: Array) -> tuple[Array, Array]:
     at the origin; a point held along the normal only at height 0)."""
     rows_p, rows_v, jac_p, jac_v = [], [], [], []
     for hold in holds(spec.model, spec.holds, "section_holds"):
-        p, v, c = _eval(_tip(spec, hold.name), np.asarray(y, float))
+        p, v, c = evaluate(_tip(spec, hold.name), np.asarray(y, float))
         axes = list(hold.axes)
         rows_p.append(p.ravel()[axes])
         rows_v.append(v.ravel()[axes])
@@ -589,7 +538,7 @@ def reference_step(spec: StepSpec) -> StepResult:
             t_strike, y_strike, y_imp = tau, y_end, y
         factors[f"phi_{i}"], factors[f"jump_{i}"] = along(phase), jump
         monodromy = jump @ factors[f"phi_{i}"] @ monodromy
-    y_next, d_swap = _eval(_swap_jump(spec), y)
+    y_next, d_swap = evaluate(_swap_jump(spec), y)
     factors["jump_swap"] = d_swap
     return StepResult(y_next=y_next.ravel(), strike_time=t_strike, y_strike=y_strike,
                       y_impact=y_imp, y_liftoff=y, step_time=t_total,

@@ -31,6 +31,7 @@ from scipy.integrate import solve_ivp
 
 from gaitopt.analysis.checks.check import LIMITS, Check, Worst
 from gaitopt.analysis.checks.knots import state_map
+from gaitopt.analysis.numeric import evaluate
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.record.file import Gait, GaitPhase
 from gaitopt.gait.sequence.contact_sequence import phase_holds
@@ -52,11 +53,12 @@ def _integrate(rhs: Callable[[float, Array], Array], t0: float, t1: float, y0: A
 @functools.lru_cache(maxsize=32)
 def _ode(model: RobotModel, contacts: tuple[str, ...]) -> ca.Function:
     """``(y, u0, u1, s) -> ydot`` for ``y = [q, qd]`` with the contacts held and the controls
-    ``u = u0 + s (u1 - u0)`` (s in [0, 1] along an interval)."""
+    ``u = u0 + s (u1 - u0)`` (s in [0, 1] along an interval): one SX function (the contact
+    dynamics inlined), evaluated by :func:`gaitopt.analysis.numeric.evaluate`."""
     dyn = contact_dynamics_function(model, contacts, inputs="u")
-    y = ca.MX.sym("y", 2 * model.nq)
-    u0, u1 = ca.MX.sym("u0", model.nu), ca.MX.sym("u1", model.nu)
-    s = ca.MX.sym("s")
+    y = ca.SX.sym("y", 2 * model.nq)
+    u0, u1 = ca.SX.sym("u0", model.nu), ca.SX.sym("u1", model.nu)
+    s = ca.SX.sym("s")
     qdd = dyn(y[:model.nq], y[model.nq:], u0 + s * (u1 - u0))[0]
     return ca.Function("verify_ode", [y, u0, u1, s], [ca.vertcat(y[model.nq:], qdd)])
 
@@ -75,7 +77,7 @@ def _interval_ends(gait: Gait, ph: GaitPhase, starts: Array | None) -> Array:
 
         def rhs(t: float, y: Array, t0: float = t0, h: float = h, u0: Array = u0,
                 u1: Array = u1) -> Array:
-            return np.asarray(ode(y, u0, u1, (t - t0) / h), dtype=float).ravel()
+            return evaluate(ode, y, u0, u1, (t - t0) / h)[0].ravel()
 
         start = y if starts is None else starts[k]
         y = _integrate(rhs, t0, t0 + h, start)
