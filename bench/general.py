@@ -20,7 +20,7 @@ Each process: wall time, CPU time (user + system, from ``os.wait4``), peak resid
 the cost and the stages. Byte code is written (by one unmeasured process first) and reused
 in a folder of the temporary directory, as an installed package keeps its ``.pyc`` files
 (``--no-bytecode``: compiled in every process where ``PYTHONDONTWRITEBYTECODE`` is set).
-The function cache on disk (``gaitopt.gait.solve.function_cache``) is whatever the machine
+The function cache on disk (``gaitopt.dynamics.function_cache``) is whatever the machine
 holds; ``--warmup`` runs each cold solve once first, unmeasured.
 
 4. **the warm start through the Python API, broken down** (``--only api``): one process per

@@ -13,7 +13,7 @@ Each process: wall time, CPU time of the process and its workers (user + system)
 peak of their summed resident set sizes, both sampled with psutil (installed with
 dask.distributed), the exit status,
 and the lines of the study's own tally that say what converged (``accuracy: ...``, ``done
-in ...``). The function cache on disk (``gaitopt.gait.solve.function_cache``) is whatever the
+in ...``). The function cache on disk (``gaitopt.dynamics.function_cache``) is whatever the
 machine holds (``GAITOPT_CACHE`` chooses it); the load average is printed before and after.
 
     PYTHONPATH=src python bench/studies.py [--only costs|paper|all] [--workers 2]

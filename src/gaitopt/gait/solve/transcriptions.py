@@ -20,14 +20,14 @@ from typing import Any
 
 import numpy as np
 
+from gaitopt.dynamics.function_cache import cached_functions as cached_functions
+from gaitopt.dynamics.function_cache import disk_cached as disk_cached
+from gaitopt.dynamics.function_cache import function_file as function_file
+from gaitopt.dynamics.function_cache import save_functions as save_functions
+from gaitopt.dynamics.function_cache import source_hash as source_hash
 from gaitopt.gait.formulations.cost import COST_TRAITS
 from gaitopt.gait.formulations.select import problem_for
 from gaitopt.gait.options.gait_options import FIELD_GROUPS, GaitOptions, GaitOptionsError
-from gaitopt.gait.solve.function_cache import cached_functions as cached_functions
-from gaitopt.gait.solve.function_cache import disk_cached as disk_cached
-from gaitopt.gait.solve.function_cache import function_file as function_file
-from gaitopt.gait.solve.function_cache import save_functions as save_functions
-from gaitopt.gait.solve.function_cache import source_hash as source_hash
 from gaitopt.ocp import Guess, Result, Transcription, WarmStart, transcribe
 from gaitopt.process_memory import memory_budget_bytes, release_freed_memory, resident_bytes
 from gaitopt.robot.model import RobotModel

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.dynamics.backend import as_scalars
+from gaitopt.dynamics.function_cache import disk_cached, function_file
 from gaitopt.dynamics.tree import hold_name
 from gaitopt.gait.formulations.full import physics as full
 from gaitopt.gait.formulations.record_points import (
@@ -29,7 +30,6 @@ from gaitopt.gait.formulations.record_points import (
 )
 from gaitopt.gait.record.file import GaitEvent, GaitPhase, GaitSamples
 from gaitopt.gait.sequence.contact_sequence import ContactSequence
-from gaitopt.gait.solve.function_cache import disk_cached, function_file
 from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.robot.model import RobotModel
 

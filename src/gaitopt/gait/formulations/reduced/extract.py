@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from gaitopt.dynamics.backend import as_scalars
+from gaitopt.dynamics.function_cache import disk_cached, function_file
 from gaitopt.gait.formulations.record_points import (
     SAMPLE_RATE,
     RecordParts,
@@ -29,7 +30,6 @@ from gaitopt.gait.formulations.reduced import physics as walking
 from gaitopt.gait.formulations.reduced.physics import DOUBLE, SINGLE
 from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import GaitEvent, GaitPhase, GaitSamples
-from gaitopt.gait.solve.function_cache import disk_cached, function_file
 from gaitopt.gait.solve.staged_run import StagedRun
 from gaitopt.robot.biped import reduced_biped
 from gaitopt.robot.model import RobotModel

@@ -1,7 +1,10 @@
-"""The disk cache of the walking problem's symbolic CasADi functions: a file per function,
-keyed by what built it (the model, the shaping options, the gaitopt sources, CasADi's
-version), pickled atomically and pruned to its size (:mod:`gaitopt.codegen`). Used by the
-transcriptions (:mod:`gaitopt.gait.solve.transcriptions`) and both formulations' records."""
+"""The disk cache of symbolic CasADi functions: a file per function, keyed by what built it
+(the model, the options that shape it, the gaitopt sources, CasADi's version), pickled
+atomically and pruned to its size (:mod:`gaitopt.codegen`). Used by the multibody functions
+(:mod:`gaitopt.dynamics.functions`: contact dynamics, impact and liftoff maps, which
+``verify``, the stability analysis and the records build in every process), the walking
+problem's transcriptions (:mod:`gaitopt.gait.solve.transcriptions`) and both formulations'
+records."""
 
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ from gaitopt.fileio import write_bytes_atomic
 def source_hash() -> str:
     """A hash of every Python file of the installed gaitopt package: the symbolic functions
     cached on disk are those this code builds."""
-    root = Path(__file__).resolve().parents[2]
+    root = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*.py")):
         digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
