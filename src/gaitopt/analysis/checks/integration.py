@@ -32,6 +32,7 @@ from scipy.integrate import solve_ivp
 from gaitopt.analysis.checks.check import LIMITS, Check, Worst
 from gaitopt.analysis.checks.knots import state_map
 from gaitopt.analysis.numeric import evaluate
+from gaitopt.dynamics.function_cache import disk_cached, function_file
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.record.file import Gait, GaitPhase
 from gaitopt.gait.sequence.contact_sequence import phase_holds
@@ -54,13 +55,18 @@ def _integrate(rhs: Callable[[float, Array], Array], t0: float, t1: float, y0: A
 def _ode(model: RobotModel, contacts: tuple[str, ...]) -> ca.Function:
     """``(y, u0, u1, s) -> ydot`` for ``y = [q, qd]`` with the contacts held and the controls
     ``u = u0 + s (u1 - u0)`` (s in [0, 1] along an interval): one SX function (the contact
-    dynamics inlined), evaluated by :func:`gaitopt.analysis.numeric.evaluate`."""
-    dyn = contact_dynamics_function(model, contacts, inputs="u")
-    y = ca.SX.sym("y", 2 * model.nq)
-    u0, u1 = ca.SX.sym("u0", model.nu), ca.SX.sym("u1", model.nu)
-    s = ca.SX.sym("s")
-    qdd = dyn(y[:model.nq], y[model.nq:], u0 + s * (u1 - u0))[0]
-    return ca.Function("verify_ode", [y, u0, u1, s], [ca.vertcat(y[model.nq:], qdd)])
+    dynamics inlined), evaluated by :func:`gaitopt.analysis.numeric.evaluate`; cached on disk
+    (:mod:`gaitopt.dynamics.function_cache`)."""
+
+    def build() -> ca.Function:
+        dyn = contact_dynamics_function(model, contacts, inputs="u")
+        y = ca.SX.sym("y", 2 * model.nq)
+        u0, u1 = ca.SX.sym("u0", model.nu), ca.SX.sym("u1", model.nu)
+        s = ca.SX.sym("s")
+        qdd = dyn(y[:model.nq], y[model.nq:], u0 + s * (u1 - u0))[0]
+        return ca.Function("verify_ode", [y, u0, u1, s], [ca.vertcat(y[model.nq:], qdd)])
+
+    return disk_cached(function_file("verify_ode", (model.content_hash(), contacts)), build)
 
 
 def _interval_ends(gait: Gait, ph: GaitPhase, starts: Array | None) -> Array:

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from gaitopt.analysis.checks.check import Check, Worst
 from gaitopt.dynamics.actuation import generalized_forces
+from gaitopt.dynamics.function_cache import disk_cached, function_file
 from gaitopt.dynamics.kinematics import (
     contact_acceleration,
     contact_jacobian,
@@ -130,21 +131,26 @@ def _unknown(state_names: tuple[str, ...]) -> UnknownStatesError:
 @functools.lru_cache(maxsize=32)
 def knot_function(model: RobotModel, contacts: tuple[str, ...]) -> ca.Function:
     """``(q, qd, qdd, u, f) -> (eom (nq), position, velocity, acceleration (2 |C| each))``
-    with the ``contacts`` C held; ``f`` (2 |C|) stacks their forces ``[fx, fy, ...]``."""
-    q, qd, qdd = (ca.SX.sym(n, model.nq) for n in ("q", "qd", "qdd"))
-    u = ca.SX.sym("u", model.nu)
-    f = ca.SX.sym("f", 2 * len(contacts))
-    if contacts:
-        jac = contact_jacobian(model, q, list(contacts))
-        eom = rnea(model, q, qd, qdd, jac.T @ f)
-    else:
-        eom = rnea(model, q, qd, qdd)
-    eom = eom - generalized_forces(model, q, u, list(contacts))
-    pos = [contact_position(model, q, c) for c in contacts]
-    vel = [contact_velocity(model, q, qd, c) for c in contacts]
-    acc = [contact_acceleration(model, q, qd, qdd, c) for c in contacts]
-    return ca.Function("verify_knots", [q, qd, qdd, u, f],
-                       [eom, ca.vertcat(*pos), ca.vertcat(*vel), ca.vertcat(*acc)])
+    with the ``contacts`` C held; ``f`` (2 |C|) stacks their forces ``[fx, fy, ...]``.
+    Cached on disk (:mod:`gaitopt.dynamics.function_cache`): traced once per model."""
+
+    def build() -> ca.Function:
+        q, qd, qdd = (ca.SX.sym(n, model.nq) for n in ("q", "qd", "qdd"))
+        u = ca.SX.sym("u", model.nu)
+        f = ca.SX.sym("f", 2 * len(contacts))
+        if contacts:
+            jac = contact_jacobian(model, q, list(contacts))
+            eom = rnea(model, q, qd, qdd, jac.T @ f)
+        else:
+            eom = rnea(model, q, qd, qdd)
+        eom = eom - generalized_forces(model, q, u, list(contacts))
+        pos = [contact_position(model, q, c) for c in contacts]
+        vel = [contact_velocity(model, q, qd, c) for c in contacts]
+        acc = [contact_acceleration(model, q, qd, qdd, c) for c in contacts]
+        return ca.Function("verify_knots", [q, qd, qdd, u, f],
+                           [eom, ca.vertcat(*pos), ca.vertcat(*vel), ca.vertcat(*acc)])
+
+    return disk_cached(function_file("verify_knots", (model.content_hash(), contacts)), build)
 
 
 def ground_points(gait: Gait, phase: int | None = None) -> dict[str, Array]:
