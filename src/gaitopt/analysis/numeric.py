@@ -40,24 +40,30 @@ class NumericFunction:
             # is not accepted at run time).
             self._buffer.set_arg(i, memoryview(values))  # type: ignore[call-arg,arg-type]
             self._inputs.append(values)
-        self._outputs: list[tuple[Array, tuple[int, int], Array, Array]] = []
+        # Per output: its nonzeros, its shape, and where they go in the dense matrix (None for
+        # a dense output, whose nonzeros are the matrix in column-major order).
+        self._outputs: list[tuple[Array, tuple[int, int], tuple[Array, Array] | None]] = []
         for i in range(f.n_out()):
             pattern = f.sparsity_out(i)
             nonzeros = np.zeros(pattern.nnz())
             self._buffer.set_res(i, memoryview(nonzeros))  # type: ignore[call-arg,arg-type]
             rows, cols = pattern.get_triplet()
-            self._outputs.append((nonzeros, pattern.shape, np.asarray(rows, dtype=int),
-                                  np.asarray(cols, dtype=int)))
+            places = None if pattern.is_dense() else (np.asarray(rows, dtype=int),
+                                                      np.asarray(cols, dtype=int))
+            self._outputs.append((nonzeros, pattern.shape, places))
 
     def __call__(self, *args: Array | float) -> list[Array]:
         for values, arg in zip(self._inputs, args, strict=True):
-            values[:] = np.ravel(arg, order="F")
+            values[:] = np.asarray(arg, dtype=float).ravel(order="F")
         self._run()
         out = []
-        for nonzeros, shape, rows, cols in self._outputs:
-            dense = np.zeros(shape)
-            dense[rows, cols] = nonzeros
-            out.append(dense)
+        for nonzeros, shape, places in self._outputs:
+            if places is None:
+                out.append(nonzeros.reshape(shape, order="F").copy())
+            else:
+                dense = np.zeros(shape)
+                dense[places] = nonzeros
+                out.append(dense)
         return out
 
 
@@ -65,8 +71,14 @@ class NumericFunction:
 _NUMERIC = IdentityCache(64)
 
 
-def evaluate(f: ca.Function, *args: Array | float) -> list[Array]:
-    """``f(*args)`` as float arrays (2-D, ``f.size_out(i)``), through :class:`NumericFunction`
-    (one per function, kept while the function is in use)."""
+def numeric_function(f: ca.Function) -> NumericFunction:
+    """The :class:`NumericFunction` of ``f`` (one per function, kept while it is in use): a
+    caller that evaluates ``f`` many times in a row takes it once."""
     numeric: NumericFunction = _NUMERIC.get((f,), lambda: NumericFunction(f))
-    return numeric(*args)
+    return numeric
+
+
+def evaluate(f: ca.Function, *args: Array | float) -> list[Array]:
+    """``f(*args)`` as float arrays (2-D, ``f.size_out(i)``), through
+    :func:`numeric_function`."""
+    return numeric_function(f)(*args)

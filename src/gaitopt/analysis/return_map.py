@@ -64,7 +64,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
-from gaitopt.analysis.numeric import evaluate
+from gaitopt.analysis.numeric import evaluate, numeric_function
 from gaitopt.codegen import CompileError, compile_functions
 from gaitopt.dynamics.actuation import actuation_rows
 from gaitopt.dynamics.functions import (
@@ -307,22 +307,32 @@ def _swap_jump(spec: StepSpec) -> ca.Function:
 
 # -- integration --------------------------------------------------------------------------------
 
+def _phase_function(spec: StepSpec, phase: PhaseProfile, jacobian: bool
+                    ) -> Callable[[float, Array], list[Array]]:
+    """``(tau, y) -> [f (2 nq, 1)]``, with ``jacobian`` ``[f, A (2 nq, 2 nq)]``: the phase's
+    vector field at ``tau``, its compiled function and gains looked up once (an integrator
+    calls it tens of thousands of times)."""
+    fn = numeric_function(_rhs(spec, phase.contacts, jacobian=jacobian))
+    gains = _gains(spec)
+    zero = np.zeros(spec.nq)
+
+    def at(tau: float, y: Array) -> list[Array]:
+        u, q_ref, qd_ref = phase.inputs(tau)
+        return fn(y, u, zero if q_ref is None else q_ref, zero if qd_ref is None else qd_ref,
+                  gains)
+
+    return at
+
+
 def phase_rhs(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> tuple[Array, Array]:
     """The vector field ``f(tau, y)`` (2 nq,) of a phase and its Jacobian ``A`` (2 nq, 2 nq)."""
-    u, q_ref, qd_ref = phase.inputs(tau)
-    zero = np.zeros(spec.nq)
-    ydot, a = evaluate(_rhs(spec, phase.contacts), y, u, zero if q_ref is None else q_ref,
-                    zero if qd_ref is None else qd_ref, _gains(spec))
+    ydot, a = _phase_function(spec, phase, jacobian=True)(tau, y)
     return ydot.ravel(), a
 
 
 def phase_field(spec: StepSpec, phase: PhaseProfile, tau: float, y: Array) -> Array:
     """The vector field ``f(tau, y)`` (2 nq,) of a phase."""
-    u, q_ref, qd_ref = phase.inputs(tau)
-    zero = np.zeros(spec.nq)
-    return evaluate(_rhs(spec, phase.contacts, jacobian=False), y, u,
-                 zero if q_ref is None else q_ref, zero if qd_ref is None else qd_ref,
-                 _gains(spec))[0].ravel()
+    return _phase_function(spec, phase, jacobian=False)(tau, y)[0].ravel()
 
 
 def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational: bool,
@@ -335,11 +345,13 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     point = phase.guard or spec.swing
     tip = _tip(spec, point)
 
+    field = _phase_function(spec, phase, jacobian=variational)
+
     def rhs(tau: float, z: Array) -> Array:
         if not variational:
-            return phase_field(spec, phase, tau, z)
-        ydot, a = phase_rhs(spec, phase, tau, z[:n])
-        return np.concatenate([ydot, (a @ z[n:].reshape(n, n)).ravel()])
+            return field(tau, z)[0].ravel()
+        ydot, a = field(tau, z[:n])
+        return np.concatenate([ydot.ravel(), (a @ z[n:].reshape(n, n)).ravel()])
 
     def ahead(tau: float, z: Array) -> float:
         # From the origin, where the stance tip stands at the start of the step (and, held,

@@ -31,7 +31,7 @@ from scipy.integrate import solve_ivp
 
 from gaitopt.analysis.checks.check import LIMITS, Check, Worst
 from gaitopt.analysis.checks.knots import state_map
-from gaitopt.analysis.numeric import evaluate
+from gaitopt.analysis.numeric import numeric_function
 from gaitopt.dynamics.function_cache import disk_cached, function_file
 from gaitopt.dynamics.functions import contact_dynamics_function
 from gaitopt.gait.record.file import Gait, GaitPhase
@@ -74,7 +74,8 @@ def _interval_ends(gait: Gait, ph: GaitPhase, starts: Array | None) -> Array:
     ``starts[k]`` or, if ``starts`` is None, from the previous interval's end (the whole
     phase from its first knot)."""
     i = next(j for j, other in enumerate(gait.phases) if other is ph)
-    ode = _ode(gait.model, phase_holds(gait.contact_sequence, i, tuple(ph.contacts)))
+    ode = numeric_function(_ode(gait.model, phase_holds(gait.contact_sequence, i,
+                                                         tuple(ph.contacts))))
     ends = []
     y = np.hstack([ph.q[0], ph.qd[0]])
     for k in range(ph.t.size - 1):
@@ -83,7 +84,7 @@ def _interval_ends(gait: Gait, ph: GaitPhase, starts: Array | None) -> Array:
 
         def rhs(t: float, y: Array, t0: float = t0, h: float = h, u0: Array = u0,
                 u1: Array = u1) -> Array:
-            return evaluate(ode, y, u0, u1, (t - t0) / h)[0].ravel()
+            return ode(y, u0, u1, (t - t0) / h)[0].ravel()
 
         start = y if starts is None else starts[k]
         y = _integrate(rhs, t0, t0 + h, start)
