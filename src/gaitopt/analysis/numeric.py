@@ -6,7 +6,7 @@ the conversions take longer than the evaluation. :class:`NumericFunction` evalua
 CasADi's function buffer instead: the inputs are copied into arrays the buffer reads and the
 outputs' nonzeros are written into arrays the buffer owns, then returned dense. The values
 are the same as ``f(*args)``'s (the same evaluation; measured in docs/stability.md, "Speed",
-and docs/verify.md, "Speed").
+and docs/outputs.md, section 5, "Speed").
 """
 
 from __future__ import annotations

@@ -55,8 +55,8 @@ def _integrate(rhs: Callable[[float, Array], Array], t0: float, t1: float, y0: A
 def _ode(model: RobotModel, contacts: tuple[str, ...]) -> ca.Function:
     """``(y, u0, u1, s) -> ydot`` for ``y = [q, qd]`` with the contacts held and the controls
     ``u = u0 + s (u1 - u0)`` (s in [0, 1] along an interval): one SX function (the contact
-    dynamics inlined), evaluated by :func:`gaitopt.analysis.numeric.evaluate`; cached on disk
-    (:mod:`gaitopt.dynamics.function_cache`)."""
+    dynamics inlined), evaluated through :func:`gaitopt.analysis.numeric.numeric_function`;
+    cached on disk (:mod:`gaitopt.dynamics.function_cache`)."""
 
     def build() -> ca.Function:
         dyn = contact_dynamics_function(model, contacts, inputs="u")
