@@ -343,8 +343,7 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     (``duration`` None, or ``guard=True``). Returns ``(tau_end, y, Phi)``."""
     n = 2 * spec.nq
     point = phase.guard or spec.swing
-    tip = _tip(spec, point)
-
+    tip = numeric_function(_tip(spec, point))
     field = _phase_function(spec, phase, jacobian=variational)
 
     def rhs(tau: float, z: Array) -> Array:
@@ -356,10 +355,10 @@ def _integrate_phase(spec: StepSpec, phase: PhaseProfile, y0: Array, variational
     def ahead(tau: float, z: Array) -> float:
         # From the origin, where the stance tip stands at the start of the step (and, held,
         # all through a walk's single support; a run's flight holds no tip).
-        return float(evaluate(tip, z[:n])[0][0, 0] - spec.arm_distance)
+        return float(tip(z[:n])[0][0, 0] - spec.arm_distance)
 
     def height(tau: float, z: Array) -> float:
-        return float(evaluate(tip, z[:n])[0][1, 0])
+        return float(tip(z[:n])[0][1, 0])
 
     ahead.terminal, ahead.direction = True, 1.0  # type: ignore[attr-defined]
     height.terminal, height.direction = True, -1.0  # type: ignore[attr-defined]
