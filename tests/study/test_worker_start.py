@@ -93,10 +93,25 @@ def test_a_file_of_another_grid_starts_the_point_with_its_multipliers_mapped(
 
 
 def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
-        five_link: RobotModel, saved: SavedGait) -> None:
+        five_link: RobotModel, saved: SavedGait, monkeypatch: pytest.MonkeyPatch) -> None:
+    """... with the monotone barrier only: the adaptive barrier of a same-grid restart
+    (``solve_walking(adaptive_restart=...)``) is not tried on a start mapped from another
+    grid."""
+    from gaitopt.gait.solve import staged
+
+    given: list[bool] = []
+    solve_walking = staged.solve_walking
+
+    def recording(*args: object, **kwargs: object) -> object:
+        given.append(bool(kwargs.get("adaptive_restart", True)))
+        return solve_walking(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr("gaitopt.study.worker.solve_walking", recording)
     outcome = solve_point(finer(five_link, saved))
     cold = solve_gait(five_link, finer(five_link, saved).options)
     assert outcome.gait is not None and outcome.warm == "file, regridded"
+    assert given == [False]
+    assert [s["name"] for s in outcome.gait["solver"]["stages"]][0] == "warm start"
     assert outcome.gait["cost"]["value"] == pytest.approx(cold.cost_value, rel=1e-5)
 
 

@@ -270,14 +270,8 @@ class Transcription:
                 raise ProblemError(str(exc.args[0])) from None
         b.check()
         opts = merge_options(self.options, options)
-        if (warm_start_multipliers and regrid and isinstance(guess, Result)
-                and guess.layout_signature != self.layout.signature()):
-            guess = regridded(self, guess)
-        if (warm_start_multipliers and isinstance(guess, Result) and guess.constraint_blocks
-                and guess.layout_signature == self.layout.signature()
-                and guess.method == self.method
-                and guess.constraint_blocks != self.constraint_blocks):
-            guess = self.carried_over(guess)
+        if warm_start_multipliers:
+            guess = self._multiplier_start(guess, regrid)
         w0 = self.initial_guess(guess)
         d_w, d_g, s_j = self.nlp.d_w, self.nlp.d_g, self.nlp.objective_scale
         args: dict[str, Any] = dict(x0=w0 / d_w, lbx=b.lbw / d_w, ubx=b.ubw / d_w,
@@ -291,10 +285,7 @@ class Transcription:
             args["x0"][dep] = held
             args["lbx"], args["ubx"] = args["lbx"].copy(), args["ubx"].copy()
             args["lbx"][dep] = args["ubx"][dep] = held
-        restart = isinstance(guess, WarmStart) or (
-            isinstance(guess, Result) and guess.layout_signature == self.layout.signature()
-            and guess.method == self.method and guess.lam_g.size == d_g.size)
-        if warm_start_multipliers and restart:
+        if warm_start_multipliers and self._has_multipliers(guess):
             assert isinstance(guess, Result | WarmStart)
             args["lam_x0"] = guess.lam_x * d_w / s_j
             args["lam_g0"] = guess.lam_g * d_g / s_j
@@ -307,6 +298,36 @@ class Transcription:
         else:
             out = call_solver(solver, args)
         return self._result(out, b)
+
+    def restarts(self, guess: Guess | Result | WarmStart | None, *, regrid: bool = False
+                 ) -> bool:
+        """Whether :meth:`solve` with ``warm_start_multipliers`` (and ``regrid``) passes the
+        multipliers of ``guess`` to IPOPT, so that :data:`WARM_START_OPTIONS` and the
+        ``warm_start_options`` apply: a :class:`WarmStart`, or a Result of this layout and
+        method (of other constraint blocks: carried over by name; of another grid: only
+        with ``regrid``)."""
+        return self._has_multipliers(self._multiplier_start(guess, regrid))
+
+    def _multiplier_start(self, guess: Guess | Result | WarmStart | None, regrid: bool
+                          ) -> Guess | Result | WarmStart | None:
+        """``guess`` as :meth:`solve` starts from it with multipliers: a Result of another
+        grid regridded (with ``regrid``), one of other constraint blocks carried over."""
+        if (regrid and isinstance(guess, Result)
+                and guess.layout_signature != self.layout.signature()):
+            guess = regridded(self, guess)
+        if (isinstance(guess, Result) and guess.constraint_blocks
+                and guess.layout_signature == self.layout.signature()
+                and guess.method == self.method
+                and guess.constraint_blocks != self.constraint_blocks):
+            guess = self.carried_over(guess)
+        return guess
+
+    def _has_multipliers(self, guess: Guess | Result | WarmStart | None) -> bool:
+        """Whether ``guess`` (as :meth:`_multiplier_start` made it) carries multipliers of
+        this NLP's layout."""
+        return isinstance(guess, WarmStart) or (
+            isinstance(guess, Result) and guess.layout_signature == self.layout.signature()
+            and guess.method == self.method and guess.lam_g.size == self.nlp.d_g.size)
 
     @property
     def constraint_blocks(self) -> tuple[tuple[str, int], ...]:

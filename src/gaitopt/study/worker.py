@@ -51,6 +51,9 @@ from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row
 #: from a coarser optimum: at 15 check points (2026-12-04) 8-25 iterations instead of 17-92,
 #: the same optima (within 1e-8) at 14 and at 48 m/min with ankle torques the study grid's
 #: branch (2621.90, the study grid 2621.97) where 1e-4 moved to a dearer one (2623.13).
+#: With the monotone barrier only (``solve_walking(adaptive_restart=False)``): the adaptive
+#: barrier of a same-grid restart (:data:`gaitopt.gait.solve.stages.RESTART_OPTIONS`) once
+#: ran for minutes on these starts in ``gaitopt study --model seven-link``.
 REGRIDDED = "file, regridded"
 #: Problem structures whose transcription this process has built (see module docstring).
 _BUILT: set[str] = set()
@@ -210,7 +213,8 @@ def solve_point(task: PointTask) -> PointOutcome:
         with _LOCK:
             solution = solve_walking(task.model, options, warm_start=warm,
                                      check_warm_start=task.check_grid, check_start=check,
-                                     check_cold=task.check_cold or task.check_grid)
+                                     check_cold=task.check_cold or task.check_grid,
+                                     adaptive_restart=how != REGRIDDED)
             ipopt = sum(s.wall_time_s for s in solution.stages)
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt

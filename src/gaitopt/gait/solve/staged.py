@@ -121,6 +121,7 @@ from gaitopt.gait.solve.stages import (
     held_ankles,
     held_bounds,
     held_stage_options,
+    restart_options,
     sequence_kind,
 )
 from gaitopt.gait.solve.transcriptions import (
@@ -590,7 +591,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   check_start: WarmStart | None = None,
                   stage_seconds: float | None = None,
                   warm_start_options: dict[str, Any] | None = None,
-                  check_cold: bool = True) -> StagedRun:
+                  check_cold: bool = True, adaptive_restart: bool = True) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
     succeeded and which stage failed.
@@ -598,7 +599,13 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     ``warm_start_options``: IPOPT options of stage ``warm start`` merged over the
     transcription's warm-start options, for a ``warm_start`` with multipliers
     (:data:`REGRID_OPTIONS` for one mapped from another grid,
-    :func:`gaitopt.gait.api.regridded_point`).
+    :func:`gaitopt.gait.api.regridded_point`). Without them, a ``warm_start`` that restarts
+    IPOPT with its multipliers on the same grid is first solved with the adaptive barrier
+    (:func:`~gaitopt.gait.solve.stages.restart_options`, at most
+    :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER` iterations) and, if that does not
+    converge, again from the same start with the monotone one (stage ``warm start, monotone
+    barrier``); ``adaptive_restart`` False skips the first attempt (a start mapped from
+    another grid, whose multipliers the caller passes without options).
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
@@ -622,10 +629,19 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     run = _Run(model, options, progress, compiled, stage_seconds, check_cold=check_cold)
     result: Result | None = None
     if warm_start is not None:
-        result = run.stage("warm start", warm_start_grid(model, options, warm_start), Relaxation(),
-                           warm_start, parameter_bounds(options),
-                           solver_options=PRIMAL_WARM_OPTIONS,
-                           warm_start_options=warm_start_options)
+        grid = warm_start_grid(model, options, warm_start)
+        adaptive = (adaptive_restart and warm_start_options is None
+                    and transcription_for(model, options, grid,
+                                          compiled=compiled).restarts(warm_start))
+        if adaptive:
+            result = run.stage("warm start", grid, Relaxation(), warm_start,
+                               parameter_bounds(options), solver_options=PRIMAL_WARM_OPTIONS,
+                               warm_start_options=restart_options(options))
+        if result is None or not result.success:
+            result = run.stage("warm start, monotone barrier" if adaptive else "warm start",
+                               grid, Relaxation(), warm_start, parameter_bounds(options),
+                               solver_options=PRIMAL_WARM_OPTIONS,
+                               warm_start_options=warm_start_options)
         if not result.success:
             result = None
         elif check_warm_start and options.mesh_tol is None:

@@ -60,6 +60,41 @@ ENFORCED_CONTACT_OPTIONS = {"ipopt.mu_init": 1e-4}
 #: warm-start options apply instead.)
 PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
                        "ipopt.bound_frac": 1e-6}
+#: At most this many IPOPT iterations for stage ``warm start`` with :data:`RESTART_OPTIONS`;
+#: a restart that has not converged by then is solved again from the same start with the
+#: monotone barrier (stage ``warm start, monotone barrier``). Restarts from a neighbour's
+#: solution took 8-57 iterations with the adaptive barrier (the seven-link heel-toe walk at
+#: 0.6-1.5 times the file's speed, the five-link walk at 0.6-1.2), one 221 (the five-link at
+#: 1.5 times, where the monotone barrier failed); the bound keeps a restart that wanders
+#: (the adaptive barrier of a study's regridded starts once ran for minutes) to a few
+#: seconds.
+RESTART_MAX_ITER = 100
+#: IPOPT options of stage ``warm start`` when it restarts from a solution of the same NLP on
+#: the same grid with its multipliers (a gait file's point, a sweep's neighbour): merged
+#: over the transcription's warm-start options (barrier 1e-6, tiny pushes off the bounds).
+#: IPOPT's adaptive barrier update (Nocedal, Waechter and Waltz) leaves the 1e-6 barrier
+#: as soon as the start allows, where the monotone update first solves the 1e-6 barrier
+#: problem (11 of its 17 iterations at +5 % speed); MUMPS without its scalings and IPOPT
+#: taking its solutions as they are (``fast_step_computation``) make each iteration about a
+#: fifth cheaper. Measured by ``bench/warm_restart.py`` (docs/results/benchmarks-gait.md,
+#: "The warm start's adaptive barrier"): the seven-link heel-toe walk restarted from its
+#: 60 m/min optimum at 0.8-1.5 times the speed took 8-20 iterations instead of 16-36
+#: (0.28 instead of 0.62 s at +5 %), the five-link walk 13-68 instead of 14-93, to the same
+#: optima (costs within 3e-7 relative, the adaptive ones the lower). Bounded by
+#: :data:`RESTART_MAX_ITER`. Not for starts mapped from another grid (a study's check and
+#: refinement sweeps from files): there the adaptive barrier once ran for minutes.
+RESTART_OPTIONS: dict[str, Any] = {"ipopt.mu_strategy": "adaptive",
+                                   "ipopt.fast_step_computation": "yes",
+                                   "ipopt.mumps_permuting_scaling": 0,
+                                   "ipopt.mumps_scaling": 0}
+
+
+def restart_options(options: GaitOptions) -> dict[str, Any]:
+    """:data:`RESTART_OPTIONS` with at most :data:`RESTART_MAX_ITER` iterations (or the
+    user's ``max_iter``, if fewer)."""
+    return {**RESTART_OPTIONS, "ipopt.max_iter": min(options.max_iter, RESTART_MAX_ITER)}
+
+
 #: IPOPT's tolerance for a held stage on a finer grid (the step length and speed held at the
 #: coarser solution's) when its release follows (stage ``..., all free``): the held stage is
 #: only the release's start, and the release starts its barrier at 1e-6 (the
