@@ -35,6 +35,7 @@ from gaitopt.gait.options.gait_options import GaitOptions
 from gaitopt.gait.record.file import Gait, GaitFileError
 from gaitopt.gait.solve.record import MotionOutOfReachError, gait_from_run
 from gaitopt.gait.solve.staged import StagedRun, solve_walking
+from gaitopt.gait.solve.stages import MONOTONE_RESTART_STAGE, WARM_START_STAGE
 from gaitopt.gait.solve.warm_accuracy import check_point
 from gaitopt.ocp import Guess, ProblemError, Result, WarmStart, secant_start
 from gaitopt.robot.model import RobotModel
@@ -246,7 +247,8 @@ def solve_point(task: PointTask) -> PointOutcome:
     stages = solution.stages if solution is not None else ()
     return PointOutcome(
         key=task.key, row=row, gait=data if row.success else None, result=result, warm=how,
-        fell_back=warm is not None and bool(stages) and not stages[0].success,
+        fell_back=warm is not None and bool(stages) and not any(
+            s.success for s in stages if s.name in (WARM_START_STAGE, MONOTONE_RESTART_STAGE)),
         stages=len(stages), iterations=sum(s.iterations for s in stages),
         wall_time_s=clock() - start, worker=worker_name(),
         structures=frozenset(_BUILT), error=error, timings=timings)

@@ -112,8 +112,10 @@ from gaitopt.gait.solve.stages import (
     COARSE_COMPLETION,
     COLD_CONTROL_MODEL,
     CONTACT_STAGES,
+    MONOTONE_RESTART_STAGE,
     PRIMAL_WARM_OPTIONS,
     RELEASES,
+    WARM_START_STAGE,
     check_grid_options,
     coarse_knots,
     fine_grid_options,
@@ -604,8 +606,9 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     (:func:`~gaitopt.gait.solve.stages.restart_options`, at most
     :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER` iterations) and, if that does not
     converge, again from the same start with the monotone one (stage ``warm start, monotone
-    barrier``); ``adaptive_restart`` False skips the first attempt (a start mapped from
-    another grid, whose multipliers the caller passes without options).
+    barrier``, :data:`~gaitopt.gait.solve.stages.MONOTONE_RESTART_STAGE`);
+    ``adaptive_restart`` False skips the first attempt (a start mapped from another grid,
+    whose multipliers the caller passes without options).
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
@@ -634,11 +637,11 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                     and transcription_for(model, options, grid,
                                           compiled=compiled).restarts(warm_start))
         if adaptive:
-            result = run.stage("warm start", grid, Relaxation(), warm_start,
+            result = run.stage(WARM_START_STAGE, grid, Relaxation(), warm_start,
                                parameter_bounds(options), solver_options=PRIMAL_WARM_OPTIONS,
                                warm_start_options=restart_options(options))
         if result is None or not result.success:
-            result = run.stage("warm start, monotone barrier" if adaptive else "warm start",
+            result = run.stage(MONOTONE_RESTART_STAGE if adaptive else WARM_START_STAGE,
                                grid, Relaxation(), warm_start, parameter_bounds(options),
                                solver_options=PRIMAL_WARM_OPTIONS,
                                warm_start_options=warm_start_options)

@@ -60,33 +60,41 @@ ENFORCED_CONTACT_OPTIONS = {"ipopt.mu_init": 1e-4}
 #: warm-start options apply instead.)
 PRIMAL_WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6,
                        "ipopt.bound_frac": 1e-6}
-#: At most this many IPOPT iterations for stage ``warm start`` with :data:`RESTART_OPTIONS`;
-#: a restart that has not converged by then is solved again from the same start with the
-#: monotone barrier (stage ``warm start, monotone barrier``). Restarts from a neighbour's
-#: solution took 8-57 iterations with the adaptive barrier (the seven-link heel-toe walk at
-#: 0.6-1.5 times the file's speed, the five-link walk at 0.6-1.2), one 221 (the five-link at
-#: 1.5 times, where the monotone barrier failed); the bound keeps a restart that wanders
-#: (the adaptive barrier of a study's regridded starts once ran for minutes) to a few
-#: seconds.
+#: The stage that starts from a given solution or gait file (:func:`~gaitopt.gait.solve.staged.
+#: solve_walking`'s ``warm_start``).
+WARM_START_STAGE = "warm start"
+#: The same start solved again with the monotone barrier, where the adaptive barrier's
+#: restart (:data:`RESTART_OPTIONS`) did not converge.
+MONOTONE_RESTART_STAGE = "warm start, monotone barrier"
+#: At most this many IPOPT iterations for stage :data:`WARM_START_STAGE` with
+#: :data:`RESTART_OPTIONS`; a restart that has not converged by then is solved again from
+#: the same start with the monotone barrier (stage :data:`MONOTONE_RESTART_STAGE`). Restarts
+#: from a neighbour's solution took 8-57 iterations with the adaptive barrier on the
+#: seven-link heel-toe walk at 0.6-1.5 times the file's speed and 21-58 from the secant
+#: starts of the seven-link study's chains where they converged; where they did not, the
+#: monotone barrier needed 96-279 (``bench/warm_restart.py``, docs/results/benchmarks-gait.md,
+#: "The warm start's adaptive barrier"). The bound caps what a restart that wanders costs.
 RESTART_MAX_ITER = 100
-#: IPOPT options of stage ``warm start`` when it restarts from a solution of the same NLP on
-#: the same grid with its multipliers (a gait file's point, a sweep's neighbour): merged
-#: over the transcription's warm-start options (barrier 1e-6, tiny pushes off the bounds).
-#: IPOPT's adaptive barrier update (Nocedal, Waechter and Waltz) leaves the 1e-6 barrier
-#: as soon as the start allows, where the monotone update first solves the 1e-6 barrier
-#: problem (11 of its 17 iterations at +5 % speed); MUMPS without its scalings and IPOPT
-#: taking its solutions as they are (``fast_step_computation``) make each iteration about a
-#: fifth cheaper. Measured by ``bench/warm_restart.py`` (docs/results/benchmarks-gait.md,
-#: "The warm start's adaptive barrier"): the seven-link heel-toe walk restarted from its
-#: 60 m/min optimum at 0.8-1.5 times the speed took 8-20 iterations instead of 16-36
-#: (0.28 instead of 0.62 s at +5 %), the five-link walk 13-68 instead of 14-93, to the same
-#: optima (costs within 3e-7 relative, the adaptive ones the lower). Bounded by
-#: :data:`RESTART_MAX_ITER`. Not for starts mapped from another grid (a study's check and
-#: refinement sweeps from files): there the adaptive barrier once ran for minutes.
-RESTART_OPTIONS: dict[str, Any] = {"ipopt.mu_strategy": "adaptive",
-                                   "ipopt.fast_step_computation": "yes",
-                                   "ipopt.mumps_permuting_scaling": 0,
-                                   "ipopt.mumps_scaling": 0}
+#: IPOPT options of stage :data:`WARM_START_STAGE` when it restarts from a solution of the
+#: same NLP on the same grid with its multipliers (a gait file's point, a sweep's neighbour
+#: or the secant through two): merged over the transcription's warm-start options (barrier
+#: 1e-6, tiny pushes off the bounds). IPOPT's adaptive barrier update (Nocedal, Waechter and
+#: Waltz, with its quality-function oracle) leaves the 1e-6 barrier as soon as the start
+#: allows, where the monotone update first solves the 1e-6 barrier problem (11 of its 17
+#: iterations at +5 % speed on the seven-link). Measured by ``bench/warm_restart.py``
+#: (docs/results/benchmarks-gait.md, "The warm start's adaptive barrier"): the seven-link
+#: heel-toe walk restarted from its 60 m/min optimum at 0.8-1.5 times the speed took 8-32
+#: iterations instead of 16-36, the five-link walk 13-68 instead of 14-93, to the same
+#: optima (costs within 3e-7 relative); the secant starts of the seven-link study's
+#: chains 790 instead of 1,284 iterations over eight points (40 instead of 67 s), two of
+#: them after the fallback. MUMPS's default scalings are kept and IPOPT checks its steps:
+#: with the scalings off or ``fast_step_computation`` an iteration was a fifth cheaper at
+#: +5 % speed, but on a hard secant start (the study's 36 m/min point without ankle
+#: torques) the adaptive restart then did not converge, and without MUMPS's scaling each
+#: iteration took more than a second. Not for starts mapped from another grid (a study's
+#: check and refinement sweeps from files): there the adaptive barrier once ran for
+#: minutes.
+RESTART_OPTIONS: dict[str, Any] = {"ipopt.mu_strategy": "adaptive"}
 
 
 def restart_options(options: GaitOptions) -> dict[str, Any]:
