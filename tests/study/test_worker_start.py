@@ -92,11 +92,8 @@ def test_a_file_of_another_grid_starts_the_point_with_its_multipliers_mapped(
                            Gait.from_dict(without)) is None
 
 
-def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
-        five_link: RobotModel, saved: SavedGait, monkeypatch: pytest.MonkeyPatch) -> None:
-    """... with the monotone barrier only: the adaptive barrier of a same-grid restart
-    (``solve_walking(adaptive_restart=...)``) is not tried on a start mapped from another
-    grid."""
+def adaptive_restarts(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
+    """The ``adaptive_restart`` of every ``solve_walking`` call of the worker, in order."""
     from gaitopt.gait.solve import staged
 
     given: list[bool] = []
@@ -107,6 +104,15 @@ def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
         return solve_walking(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr("gaitopt.study.worker.solve_walking", recording)
+    return given
+
+
+def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
+        five_link: RobotModel, saved: SavedGait, monkeypatch: pytest.MonkeyPatch) -> None:
+    """... with the monotone barrier only: the adaptive barrier of a same-grid restart
+    (``solve_walking(adaptive_restart=...)``) is not tried on a start mapped from another
+    grid."""
+    given = adaptive_restarts(monkeypatch)
     outcome = solve_point(finer(five_link, saved))
     cold = solve_gait(five_link, finer(five_link, saved).options)
     assert outcome.gait is not None and outcome.warm == "file, regridded"
@@ -116,10 +122,11 @@ def test_a_point_started_from_a_file_of_another_grid_reaches_the_cold_optimum(
 
 
 def test_a_chain_point_starts_from_the_secant_through_the_two_before(
-        five_link: RobotModel) -> None:
+        five_link: RobotModel, monkeypatch: pytest.MonkeyPatch) -> None:
     """With the chain's last two Results (``PointTask.secant``) a point starts from their
     secant prediction (values and multipliers), reaches the optimum the last Result alone
-    reaches, and falls back to that Result where the two are of different grids."""
+    reaches, and falls back to that Result where the two are of different grids. The
+    secant start is solved with the monotone barrier only (``worker.MONOTONE_STARTS``)."""
     from gaitopt.gait.solve.staged import solve_walking
     from gaitopt.ocp import WarmStart
 
@@ -139,7 +146,9 @@ def test_a_chain_point_starts_from_the_secant_through_the_two_before(
     assert how == "result, secant" and isinstance(start, WarmStart)
     np.testing.assert_allclose(start.w, last.w + 1.5 * (last.w - first.w))
     np.testing.assert_allclose(start.lam_g, last.lam_g + 1.5 * (last.lam_g - first.lam_g))
+    given = adaptive_restarts(monkeypatch)
     secant, alone = solve_point(point((first, 1.5))), solve_point(point(None))
+    assert given == [False, True]  # the adaptive barrier for the Result as it is only
     assert secant.success and alone.success and alone.warm == "result"
     assert secant.row.cost == pytest.approx(alone.row.cost, rel=1e-6)
     other = solve_walking(five_link, at(0.2, (24, 8))).result

@@ -68,32 +68,30 @@ WARM_START_STAGE = "warm start"
 MONOTONE_RESTART_STAGE = "warm start, monotone barrier"
 #: At most this many IPOPT iterations for stage :data:`WARM_START_STAGE` with
 #: :data:`RESTART_OPTIONS`; a restart that has not converged by then is solved again from
-#: the same start with the monotone barrier (stage :data:`MONOTONE_RESTART_STAGE`). Restarts
-#: from a neighbour's solution took 8-57 iterations with the adaptive barrier on the
-#: seven-link heel-toe walk at 0.6-1.5 times the file's speed and 21-58 from the secant
-#: starts of the seven-link study's chains where they converged; where they did not, the
-#: monotone barrier needed 96-279 (``bench/warm_restart.py``, docs/results/benchmarks-gait.md,
-#: "The warm start's adaptive barrier"). The bound caps what a restart that wanders costs.
+#: the same start with the monotone barrier (stage :data:`MONOTONE_RESTART_STAGE`). The
+#: adaptive restarts of the seven-link study's points from a neighbour's Result took 5-68
+#: iterations, those of the seven-link walk from its 60 m/min file at 0.8-1.5 times the
+#: speed 8-32 (docs/results/benchmarks-gait.md, "The warm start's adaptive barrier"); the
+#: bound caps what a restart that wanders costs.
 RESTART_MAX_ITER = 100
 #: IPOPT options of stage :data:`WARM_START_STAGE` when it restarts from a solution of the
-#: same NLP on the same grid with its multipliers (a gait file's point, a sweep's neighbour
-#: or the secant through two): merged over the transcription's warm-start options (barrier
-#: 1e-6, tiny pushes off the bounds). IPOPT's adaptive barrier update (Nocedal, Waechter and
-#: Waltz, with its quality-function oracle) leaves the 1e-6 barrier as soon as the start
-#: allows, where the monotone update first solves the 1e-6 barrier problem (11 of its 17
-#: iterations at +5 % speed on the seven-link). Measured by ``bench/warm_restart.py``
-#: (docs/results/benchmarks-gait.md, "The warm start's adaptive barrier"): the seven-link
-#: heel-toe walk restarted from its 60 m/min optimum at 0.8-1.5 times the speed took 8-32
-#: iterations instead of 16-36, the five-link walk 13-68 instead of 14-93, to the same
-#: optima (costs within 3e-7 relative); the secant starts of the seven-link study's
-#: chains 790 instead of 1,284 iterations over eight points (40 instead of 67 s), two of
-#: them after the fallback. MUMPS's default scalings are kept and IPOPT checks its steps:
-#: with the scalings off or ``fast_step_computation`` an iteration was a fifth cheaper at
-#: +5 % speed, but on a hard secant start (the study's 36 m/min point without ankle
-#: torques) the adaptive restart then did not converge, and without MUMPS's scaling each
-#: iteration took more than a second. Not for starts mapped from another grid (a study's
-#: check and refinement sweeps from files): there the adaptive barrier once ran for
-#: minutes.
+#: same NLP on the same grid with its multipliers (a gait file's point, a sweep's
+#: neighbour): merged over the transcription's warm-start options (barrier 1e-6, tiny
+#: pushes off the bounds). IPOPT's adaptive barrier update (Nocedal, Waechter and Waltz,
+#: with its quality-function oracle) leaves the 1e-6 barrier as soon as the start allows,
+#: where the monotone update first solves the 1e-6 barrier problem (11 of its 17 iterations
+#: at +5 % speed on the seven-link). Measured (docs/results/benchmarks-gait.md, "The warm
+#: start's adaptive barrier"): ``bench/warm_restart.py``, the seven-link heel-toe walk
+#: restarted from its 60 m/min optimum at 0.8-1.5 times the speed, 8-32 iterations instead
+#: of 16-36, the five-link walk 13-68 instead of 14-93, to the same optima (costs within
+#: 5e-7 relative, the adaptive ones the lower); ``gaitopt study --model seven-link``, the 23
+#: points started from a neighbour's Result, 337 instead of 507 iterations. Not for a
+#: secant prediction or a start mapped from another grid
+#: (:data:`gaitopt.study.worker.MONOTONE_STARTS`). MUMPS's default scalings are kept and
+#: IPOPT checks its steps: with the scalings off or ``fast_step_computation`` an iteration
+#: was a fifth cheaper at +5 % speed, but on a hard start (the study's 36 m/min point
+#: without ankle torques, from the secant) the adaptive restart then did not converge in
+#: 100 iterations, and without MUMPS's scaling each iteration took more than a second.
 RESTART_OPTIONS: dict[str, Any] = {"ipopt.mu_strategy": "adaptive"}
 
 
