@@ -95,3 +95,21 @@ def test_a_start_without_multipliers_is_solved_once(
     run = solve_walking(model, faster, warm_start=guess_from_gait(Gait.load(default_gait_file)))
     assert barriers[0] == "monotone" and run.stages[0].name == "warm start"
     assert "warm start, monotone barrier" not in [s.name for s in run.stages]
+
+
+def test_a_file_restarts_with_the_adaptive_barrier_only_for_its_own_problem(
+        model: RobotModel, default_gait_file: Path, barriers: list[str]) -> None:
+    """``solve_gait`` from a file: the adaptive barrier where the file solved the same
+    problem at another speed; the monotone one from the file of another cost (there the
+    adaptive restart did not converge in the cost study)."""
+    from gaitopt.gait.api import solve_gait
+
+    gait = Gait.load(default_gait_file)
+    same = solve_gait(model, GaitOptions.paper(speed=0.21), warm_start=gait)
+    assert barriers == ["adaptive"] and same.success
+    barriers.clear()
+    work = GaitOptions.paper(speed=0.21, cost="work")
+    assert restart_point(model, options_for_model(model, work), gait) is not None
+    other = solve_gait(model, work, warm_start=gait)
+    assert barriers[0] == "monotone"
+    assert other.solver["stages"][0]["name"] == stages.WARM_START_STAGE

@@ -177,24 +177,38 @@ def test_a_cold_point_leaves_its_check_grid_to_the_sweep_where_asked(
 
 
 def test_a_restart_solved_again_with_the_monotone_barrier_did_not_fall_back(
-        five_link: RobotModel, saved: SavedGait, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A point whose adaptive restart stopped at its iteration bound and whose monotone
-    restart converged is a warm start (``fell_back`` False: the sweep's line does not say
-    ``-> cold``), at the optimum the adaptive restart reaches."""
+        five_link: RobotModel, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A point restarted from its neighbour's Result (``worker.ADAPTIVE_STARTS``) whose
+    adaptive restart stopped at its iteration bound and whose monotone restart converged is
+    a warm start (``fell_back`` False: the sweep's line does not say ``-> cold``), at the
+    optimum the adaptive restart reaches. A start from a file takes the monotone barrier
+    only."""
     from gaitopt.gait.solve import stages
+    from gaitopt.gait.solve.staged import solve_walking
 
+    neighbour = solve_walking(five_link, options(five_link)).result
+    assert neighbour.success
     faster = PointTask(key="k", model=five_link,
                        options=options_for_model(five_link, GaitOptions(speed=0.33,
                                                                         knots=(16, 6))),
                        variant="ankle+impulse", speed_mode="fixed", structure="s",
-                       warm=saved, relfile="k.gait.json")
+                       warm=neighbour, relfile="k.gait.json")
+    given = adaptive_restarts(monkeypatch)
     adaptive = solve_point(faster)
     monkeypatch.setattr(stages, "RESTART_MAX_ITER", 2)
     again = solve_point(faster)
+    assert given == [True, True]
     assert adaptive.gait is not None and again.gait is not None
-    assert adaptive.warm == again.warm == "file"
+    assert adaptive.warm == again.warm == "result"
     names = [[s["name"] for s in o.gait["solver"]["stages"]] for o in (adaptive, again)]
     assert names == [[stages.WARM_START_STAGE],
                      [stages.WARM_START_STAGE, stages.MONOTONE_RESTART_STAGE]]
     assert not adaptive.fell_back and not again.fell_back
     assert again.row.cost == pytest.approx(adaptive.row.cost, rel=1e-6)
+
+
+def test_a_point_from_a_file_of_its_grid_takes_the_monotone_barrier(
+        five_link: RobotModel, saved: SavedGait, monkeypatch: pytest.MonkeyPatch) -> None:
+    given = adaptive_restarts(monkeypatch)
+    outcome = solve_point(task(five_link, saved, check_grid=False))
+    assert outcome.warm == "file" and given == [False]

@@ -52,23 +52,26 @@ from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row
 #: from a coarser optimum: at 15 check points (2026-12-04) 8-25 iterations instead of 17-92,
 #: the same optima (within 1e-8) at 14 and at 48 m/min with ankle torques the study grid's
 #: branch (2621.90, the study grid 2621.97) where 1e-4 moved to a dearer one (2623.13).
-#: With the monotone barrier only (:data:`MONOTONE_STARTS`).
+#: With the monotone barrier only (:data:`ADAPTIVE_STARTS`).
 REGRIDDED = "file, regridded"
 #: How a chain point started from the secant through its chain's last two Results
 #: (:func:`gaitopt.ocp.guess.secant_start`).
 SECANT = "result, secant"
-#: The starts solved with the monotone barrier only (``solve_walking(adaptive_restart=
-#: False)``), not first with the adaptive one of a same-grid restart
-#: (:data:`gaitopt.gait.solve.stages.RESTART_OPTIONS`), which the other starts with
-#: multipliers take (a neighbour's Result, a file's point on its own grid). In ``gaitopt
-#: study --model seven-link`` (2026-12-04, against the monotone barrier everywhere) the
-#: adaptive barrier took 337 instead of 507 iterations over the 23 points started from a
-#: neighbour's Result as it is, but 2,239 instead of 1,602 over the 21 secant starts: three
-#: of them did not converge within :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER`
-#: and were solved again (a prediction is not a solution: its multipliers need not fit its
-#: values, and the adaptive barrier's choices suffer first). On regridded starts the
-#: adaptive barrier once ran for minutes.
-MONOTONE_STARTS = frozenset({REGRIDDED, SECANT})
+#: How a point started from its neighbour's Result as it is (a chain's last point, or the
+#: same speed's point of the variant it is carried over from).
+RESULT = "result"
+#: The starts solved with the adaptive barrier first (``solve_walking(adaptive_restart=
+#: True)``, :data:`gaitopt.gait.solve.stages.RESTART_OPTIONS`); every other start with
+#: multipliers takes the monotone barrier only. Measured on 2026-12-04
+#: (docs/results/benchmarks-gait.md, "The warm start's adaptive barrier"), against the
+#: monotone barrier: ``gaitopt study --model seven-link``, the 23 points started from a
+#: neighbour's Result, 337 instead of 507 iterations; its 21 secant starts 2,239 instead of
+#: 1,602 (three not converged within :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER`:
+#: a prediction is not a solution, its multipliers need not fit its values); ``gaitopt
+#: study --costs --model seven-link``, the speed-free points started from the file of
+#: another cost, none converged within the bound (100 iterations more each). On regridded
+#: starts the adaptive barrier once ran for minutes.
+ADAPTIVE_STARTS = frozenset({RESULT})
 #: Problem structures whose transcription this process has built (see module docstring).
 _BUILT: set[str] = set()
 #: One solve at a time per process: a Dask worker with several threads shares the process's
@@ -179,7 +182,7 @@ def _warm_start(task: PointTask) -> tuple[Guess | Result | WarmStart | None, str
             before, ratio = task.secant
             with contextlib.suppress(ProblemError):  # not of one transcription: the Result
                 return secant_start(before, task.warm, ratio), SECANT, None
-        return task.warm, "result", None
+        return task.warm, RESULT, None
     if isinstance(task.warm, SavedGait):
         try:
             gait = Gait.from_dict(json.loads(task.warm.text), source=task.warm.source)
@@ -228,7 +231,7 @@ def solve_point(task: PointTask) -> PointOutcome:
             solution = solve_walking(task.model, options, warm_start=warm,
                                      check_warm_start=task.check_grid, check_start=check,
                                      check_cold=task.check_cold or task.check_grid,
-                                     adaptive_restart=how not in MONOTONE_STARTS)
+                                     adaptive_restart=how in ADAPTIVE_STARTS)
             ipopt = sum(s.wall_time_s for s in solution.stages)
             timings["ipopt_s"] = ipopt
             timings["build_and_setup_s"] = solution.wall_time_s - ipopt

@@ -70,9 +70,11 @@ MONOTONE_RESTART_STAGE = "warm start, monotone barrier"
 #: :data:`RESTART_OPTIONS`; a restart that has not converged by then is solved again from
 #: the same start with the monotone barrier (stage :data:`MONOTONE_RESTART_STAGE`). The
 #: adaptive restarts of the seven-link study's points from a neighbour's Result took 5-68
-#: iterations, those of the seven-link walk from its 60 m/min file at 0.8-1.5 times the
-#: speed 8-32 (docs/results/benchmarks-gait.md, "The warm start's adaptive barrier"); the
-#: bound caps what a restart that wanders costs.
+#: iterations, those of the seven-link and five-link walks from their 60 m/min files at
+#: 0.8-1.2 times the speed 8-33 (docs/results/benchmarks-gait.md, "The warm start's
+#: adaptive barrier"); at 1.5 times the seven-link's did not converge within the bound
+#: (4.9 s lost; the monotone restart then took 36 iterations). The bound caps what a
+#: restart that wanders costs.
 RESTART_MAX_ITER = 100
 #: IPOPT options of stage :data:`WARM_START_STAGE` when it restarts from a solution of the
 #: same NLP on the same grid with its multipliers (a gait file's point, a sweep's
@@ -82,10 +84,11 @@ RESTART_MAX_ITER = 100
 #: where the monotone update first solves the 1e-6 barrier problem (11 of its 17 iterations
 #: at +5 % speed on the seven-link). Measured (docs/results/benchmarks-gait.md, "The warm
 #: start's adaptive barrier"): ``bench/warm_restart.py``, the seven-link heel-toe walk
-#: restarted from its 60 m/min optimum at 0.8-1.5 times the speed, 8-32 iterations instead
-#: of 16-36, the five-link walk 13-68 instead of 14-93, to the same optima (costs within
-#: 5e-7 relative, the adaptive ones the lower); ``gaitopt study --model seven-link``, the 23
-#: points started from a neighbour's Result, 337 instead of 507 iterations. Not for a
+#: restarted from its 60 m/min optimum at 0.8-1.2 times the speed, 8-22 iterations instead
+#: of 16-23 (at +5 %: 8 instead of 17, 0.38 instead of 0.68 s), the five-link walk 11-33
+#: instead of 15-146, to the same optima (costs 2-4e-7 lower); ``gaitopt study --model
+#: seven-link``, the 23 points started from a neighbour's Result, 337 instead of 507
+#: iterations. Far from the file it can cost more (:data:`RESTART_MAX_ITER`). Not for a
 #: secant prediction or a start mapped from another grid
 #: (:data:`gaitopt.study.worker.MONOTONE_STARTS`). MUMPS's default scalings are kept and
 #: IPOPT checks its steps: with the scalings off or ``fast_step_computation`` an iteration

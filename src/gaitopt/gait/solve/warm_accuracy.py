@@ -146,11 +146,13 @@ def carried_estimate(gait: Gait, run: StagedRun, record: Mapping[str, Any]
     return {**{k: old.get(k) for k in ESTIMATE_KEYS}, "estimate_from": "warm start"}
 
 
-def same_problem(saved: Mapping[str, Any], options: GaitOptions) -> bool:
+def same_problem(saved: Mapping[str, Any], options: GaitOptions,
+                 but: frozenset[str] = frozenset()) -> bool:
     """Whether a gait file's ``options`` state the problem of ``options``: equal but for
-    :data:`NOT_THE_PROBLEM`."""
+    :data:`NOT_THE_PROBLEM` and the options named in ``but`` (e.g. ``{"speed"}``: the same
+    problem at another speed)."""
     new = options.to_dict()
-    keys = (set(saved) | set(new)) - NOT_THE_PROBLEM
+    keys = (set(saved) | set(new)) - NOT_THE_PROBLEM - but
     return all(_plain(saved.get(k)) == _plain(new.get(k)) for k in keys)
 
 
