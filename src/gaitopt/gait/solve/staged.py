@@ -607,8 +607,10 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER` iterations) and, if that does not
     converge, again from the same start with the monotone one (stage ``warm start, monotone
     barrier``, :data:`~gaitopt.gait.solve.stages.MONOTONE_RESTART_STAGE`);
-    ``adaptive_restart`` False skips the first attempt (a start mapped from another grid,
-    whose multipliers the caller passes without options).
+    ``adaptive_restart`` False skips the first attempt: for a start that is not a solution
+    of this problem at another speed (a secant prediction, a start mapped from another
+    grid, the solution of another cost), where the adaptive restart was measured to fail
+    (:data:`gaitopt.study.worker.ADAPTIVE_STARTS`).
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate

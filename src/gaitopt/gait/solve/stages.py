@@ -88,9 +88,11 @@ RESTART_MAX_ITER = 100
 #: of 16-23 (at +5 %: 8 instead of 17, 0.38 instead of 0.68 s), the five-link walk 11-33
 #: instead of 15-146, to the same optima (costs 2-4e-7 lower); ``gaitopt study --model
 #: seven-link``, the 23 points started from a neighbour's Result, 337 instead of 507
-#: iterations. Far from the file it can cost more (:data:`RESTART_MAX_ITER`). Not for a
-#: secant prediction or a start mapped from another grid
-#: (:data:`gaitopt.study.worker.MONOTONE_STARTS`). MUMPS's default scalings are kept and
+#: iterations. Far from the file it can cost more (:data:`RESTART_MAX_ITER`). Only for a
+#: start that solved the same problem (at another speed): a neighbour's Result in a sweep
+#: (:data:`gaitopt.study.worker.ADAPTIVE_STARTS`), a gait file of the problem
+#: (:func:`gaitopt.gait.api.solve_staged_run`); not for a secant prediction, a start mapped
+#: from another grid or the file of another cost. MUMPS's default scalings are kept and
 #: IPOPT checks its steps: with the scalings off or ``fast_step_computation`` an iteration
 #: was a fifth cheaper at +5 % speed, but on a hard start (the study's 36 m/min point
 #: without ankle torques, from the secant) the adaptive restart then did not converge in
