@@ -59,7 +59,7 @@ def barriers(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[str]]:
 def test_a_restart_takes_the_adaptive_barrier_to_the_monotone_optimum(
         model: RobotModel, faster: GaitOptions, start: WarmStart,
         barriers: list[str]) -> None:
-    adaptive = solve_walking(model, faster, warm_start=start)
+    adaptive = solve_walking(model, faster, warm_start=start, adaptive_restart=True)
     monotone = solve_walking(model, faster, warm_start=start, adaptive_restart=False)
     assert barriers == ["adaptive", "monotone"]
     assert [s.name for s in adaptive.stages] == ["warm start"] == [s.name for s in
@@ -73,7 +73,7 @@ def test_a_restart_that_does_not_converge_is_solved_again_with_the_monotone_barr
         model: RobotModel, faster: GaitOptions, start: WarmStart, barriers: list[str],
         monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(stages, "RESTART_MAX_ITER", 2)
-    run = solve_walking(model, faster, warm_start=start)
+    run = solve_walking(model, faster, warm_start=start, adaptive_restart=True)
     first, again = run.stages
     assert barriers == ["adaptive", "monotone"]
     assert (first.name, first.success, first.iterations) == ("warm start", False, 2)
@@ -92,7 +92,8 @@ def test_the_user_iteration_limit_bounds_the_adaptive_attempt(faster: GaitOption
 def test_a_start_without_multipliers_is_solved_once(
         model: RobotModel, faster: GaitOptions, default_gait_file: Path,
         barriers: list[str]) -> None:
-    run = solve_walking(model, faster, warm_start=guess_from_gait(Gait.load(default_gait_file)))
+    run = solve_walking(model, faster, warm_start=guess_from_gait(Gait.load(default_gait_file)),
+                        adaptive_restart=True)
     assert barriers[0] == "monotone" and run.stages[0].name == "warm start"
     assert "warm start, monotone barrier" not in [s.name for s in run.stages]
 
@@ -100,13 +101,17 @@ def test_a_start_without_multipliers_is_solved_once(
 def test_a_file_restarts_with_the_adaptive_barrier_only_for_its_own_problem(
         model: RobotModel, default_gait_file: Path, barriers: list[str]) -> None:
     """``solve_gait`` from a file: the adaptive barrier where the file solved the same
-    problem at another speed; the monotone one from the file of another cost (there the
-    adaptive restart did not converge in the cost study)."""
+    problem at another speed; the monotone one at the file's own speed (it confirms the
+    file's point) and from the file of another cost (there the adaptive restart did not
+    converge in the cost study)."""
     from gaitopt.gait.api import solve_gait
 
     gait = Gait.load(default_gait_file)
     same = solve_gait(model, GaitOptions.paper(speed=0.21), warm_start=gait)
     assert barriers == ["adaptive"] and same.success
+    barriers.clear()
+    own = solve_gait(model, GaitOptions.paper(speed=gait.options["speed"]), warm_start=gait)
+    assert barriers == ["monotone"] and own.success  # the file's own problem: confirmed
     barriers.clear()
     work = GaitOptions.paper(speed=0.21, cost="work")
     assert restart_point(model, options_for_model(model, work), gait) is not None

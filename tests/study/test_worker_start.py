@@ -100,7 +100,7 @@ def adaptive_restarts(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
     solve_walking = staged.solve_walking
 
     def recording(*args: object, **kwargs: object) -> object:
-        given.append(bool(kwargs.get("adaptive_restart", True)))
+        given.append(bool(kwargs.get("adaptive_restart", False)))
         return solve_walking(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr("gaitopt.study.worker.solve_walking", recording)

@@ -185,16 +185,17 @@ def solve_staged_run(model: RobotModel | str | os.PathLike[str],
         if chosen is not None:
             return dataclasses.replace(own, share_release=chosen)
     # A warm start that refines needs its estimate: its check grid (unless the file's holds).
-    # The adaptive barrier's restart where the file solved this problem at another speed (or
-    # the same): from the file of another cost it did not converge (gaitopt.study.worker.
-    # ADAPTIVE_STARTS).
+    # The adaptive barrier's restart where the file solved this problem at another speed:
+    # from the file of another cost it did not converge (gaitopt.study.worker.
+    # ADAPTIVE_STARTS); at the file's own speed the monotone one confirms the file's point.
     first = solve_walking(robot, opts, warm_start=guess, progress=progress, compiled=compiled,
                           check_start=check_point(warm_start) if guess is not None else None,
                           check_warm_start=check_warm_start or (
                               refines and guess is not None and
                               not _file_estimate_may_hold(warm_start, opts)),
                           adaptive_restart=warm_start is not None and same_problem(
-                              warm_start.options, opts, but=frozenset({"speed"})))
+                              warm_start.options, opts, but=frozenset({"speed"}))
+                          and not same_problem(warm_start.options, opts))
     carried = None
     if guess is not None and warm_start is not None and refines:
         carried = carried_estimate(warm_start, first, accuracy_record(first))
@@ -289,8 +290,7 @@ def _smoothed_if_rejected(model: RobotModel, run: StagedRun, judged: Plausibilit
             smoothed = _prefixed(solve_walking(model, start.options.replace(torque_rate_time=tau),
                                                warm_start=start.result,
                                                progress=_prefixed_progress(progress, SMOOTHED),
-                                               compiled=compiled, check_warm_start=True,
-                                               adaptive_restart=False),  # another cost
+                                               compiled=compiled, check_warm_start=True),
                                  SMOOTHED)
             if smoothed.success and accuracy_record(smoothed).get("cost_error") is not None:
                 smoothed = _refined(model, smoothed, progress, compiled, refines, SMOOTHED)

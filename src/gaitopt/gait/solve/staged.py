@@ -593,7 +593,7 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
                   check_start: WarmStart | None = None,
                   stage_seconds: float | None = None,
                   warm_start_options: dict[str, Any] | None = None,
-                  check_cold: bool = True, adaptive_restart: bool = True) -> StagedRun:
+                  check_cold: bool = True, adaptive_restart: bool = False) -> StagedRun:
     """Solve the walking problem (see the module docstring). Never raises for a failed solve:
     the returned (internal) :class:`~gaitopt.gait.solve.staged_run.StagedRun` says whether it
     succeeded and which stage failed.
@@ -601,16 +601,19 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     ``warm_start_options``: IPOPT options of stage ``warm start`` merged over the
     transcription's warm-start options, for a ``warm_start`` with multipliers
     (:data:`REGRID_OPTIONS` for one mapped from another grid,
-    :func:`gaitopt.gait.api.regridded_point`). Without them, a ``warm_start`` that restarts
-    IPOPT with its multipliers on the same grid is first solved with the adaptive barrier
-    (:func:`~gaitopt.gait.solve.stages.restart_options`, at most
-    :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER` iterations) and, if that does not
-    converge, again from the same start with the monotone one (stage ``warm start, monotone
-    barrier``, :data:`~gaitopt.gait.solve.stages.MONOTONE_RESTART_STAGE`);
-    ``adaptive_restart`` False skips the first attempt: for a start that is not a solution
-    of this problem at another speed (a secant prediction, a start mapped from another
-    grid, the solution of another cost), where the adaptive restart was measured to fail
-    (:data:`gaitopt.study.worker.ADAPTIVE_STARTS`).
+    :func:`gaitopt.gait.api.regridded_point`). With ``adaptive_restart`` (and without
+    them), a ``warm_start`` that restarts IPOPT with its multipliers on the same grid is
+    first solved with the adaptive barrier (:func:`~gaitopt.gait.solve.stages.
+    restart_options`, at most :data:`~gaitopt.gait.solve.stages.RESTART_MAX_ITER`
+    iterations) and, if that does not converge, again from the same start with the monotone
+    one (stage ``warm start, monotone barrier``,
+    :data:`~gaitopt.gait.solve.stages.MONOTONE_RESTART_STAGE`): for a solution of this
+    problem at another speed (a gait file's, :func:`gaitopt.gait.api.solve_staged_run`; a
+    sweep neighbour's, :data:`gaitopt.study.worker.ADAPTIVE_STARTS`). Not for a secant
+    prediction, a start mapped from another grid or the solution of another cost, where it
+    was measured to fail, nor for the solution of this very problem (a refinement's
+    restart), which the monotone barrier confirms where it is (the adaptive one moved the
+    step length of a flat optimum by 2e-5).
 
     ``check_warm_start``: after a warm start that converged, solve the check grid too (stage
     ``check grid``), so the answer carries its cost error estimate
