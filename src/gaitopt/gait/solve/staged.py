@@ -638,18 +638,20 @@ def solve_walking(model: RobotModel, options: GaitOptions, *,
     result: Result | None = None
     if warm_start is not None:
         grid = warm_start_grid(model, options, warm_start)
+
+        def restart(name: str, barrier_options: dict[str, Any] | None) -> Result:
+            return run.stage(name, grid, Relaxation(), warm_start, parameter_bounds(options),
+                             solver_options=PRIMAL_WARM_OPTIONS,
+                             warm_start_options=barrier_options)
+
         adaptive = (adaptive_restart and warm_start_options is None
                     and transcription_for(model, options, grid,
                                           compiled=compiled).restarts(warm_start))
         if adaptive:
-            result = run.stage(WARM_START_STAGE, grid, Relaxation(), warm_start,
-                               parameter_bounds(options), solver_options=PRIMAL_WARM_OPTIONS,
-                               warm_start_options=restart_options(options))
+            result = restart(WARM_START_STAGE, restart_options(options))
         if result is None or not result.success:
-            result = run.stage(MONOTONE_RESTART_STAGE if adaptive else WARM_START_STAGE,
-                               grid, Relaxation(), warm_start, parameter_bounds(options),
-                               solver_options=PRIMAL_WARM_OPTIONS,
-                               warm_start_options=warm_start_options)
+            result = restart(MONOTONE_RESTART_STAGE if adaptive else WARM_START_STAGE,
+                             warm_start_options)
         if not result.success:
             result = None
         elif check_warm_start and options.mesh_tol is None:
