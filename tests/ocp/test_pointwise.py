@@ -190,18 +190,28 @@ def test_a_failing_compiler_falls_back_to_the_vm(tmp_path: Path,
     assert not list(tmp_path.glob("pt_*.so"))
 
 
-def test_large_point_functions_compile_with_the_fast_flags() -> None:
-    from gaitopt.ocp.pointwise import LARGE_POINT, LARGE_POINT_FLAGS, POINT_FLAGS, point_flags
+def test_large_point_functions_compile_split_with_the_fast_flags() -> None:
+    from gaitopt.ocp.pointwise import (
+        LARGE_POINT,
+        LARGE_POINT_FLAGS,
+        POINT_FLAGS,
+        point_flags,
+        point_source,
+    )
 
-    x = ca.SX.sym("x", 2)
-    small = ca.Function("small", [x], [ca.sin(x[0]) * x[1]])
-    big_expr = x[0]
+    x, u, p, t = (ca.SX.sym(n) for n in "xupt")
+    args = [x, u, p, t]
+    small = ca.Function("small", args, [ca.sin(x) * u, p, t])
+    big_expr = x
     for k in range(LARGE_POINT):
-        big_expr = ca.sin(big_expr + k * x[1])
-    big = ca.Function("big", [x], [big_expr])
+        big_expr = ca.sin(big_expr + k * u)
+    big = ca.Function("big", args, [big_expr, p * x, t])
     assert small.n_instructions() <= LARGE_POINT < big.n_instructions()
     assert point_flags(small) == POINT_FLAGS and "-O1" in POINT_FLAGS
-    assert point_flags(big) == LARGE_POINT_FLAGS and "-O0" in LARGE_POINT_FLAGS
+    assert point_flags(big) == LARGE_POINT_FLAGS and "-Og" in LARGE_POINT_FLAGS
+    # a large point's C is split into chunk functions, a small one's is not
+    assert "_chunk" in point_source(big, "pt_big", LARGE_POINT_FLAGS)
+    assert "_chunk" not in point_source(small, "pt_small", POINT_FLAGS)
 
 
 def _functions_values(nlp: object, w: np.ndarray, lam: np.ndarray

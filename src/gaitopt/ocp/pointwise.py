@@ -69,18 +69,21 @@ from gaitopt.ocp.nlp import Assembly, IntervalInputs, interval_terms
 #: machine).
 POINT_FLAGS: tuple[str, ...] = ("-O1", "-fPIC", "-shared")
 #: Flags for large point functions (more than :data:`LARGE_POINT` instructions, e.g. the
-#: seven-link model with feet): ``-O0`` compiles 5-6x faster than ``-O1`` and evaluates
-#: 3-4x slower, still about 5x faster than CasADi's VM (the five-link point Hessians on a
-#: busy machine: 3-5 s against 16-33 s to compile, 70-92 against 16-29 us per point, VM
-#: 330-480 us). The size of a point's Hessian grows with its instructions, and the time of
-#: ``-O1`` faster than linearly with the size of one C function.
-LARGE_POINT_FLAGS: tuple[str, ...] = ("-O0", "-fPIC", "-shared")
+#: seven-link model with feet), whose C is split into chunk functions first
+#: (:func:`gaitopt.codegen.split_straight_line`): one C function of 30,000 statements takes
+#: GCC's register allocation most of an optimizing compile. The seven-link's heel-off library
+#: (Jacobian and Hessian of a point): ``-Og`` in chunks 2.5 s to compile and 12.7 us per
+#: point Hessian, against ``-O0`` whole 1.3 s and 36 us, ``-O1`` whole 8.8 s and 11.6 us
+#: (docs/results/benchmarks-gait.md, "Point libraries in chunks").
+LARGE_POINT_FLAGS: tuple[str, ...] = ("-Og", "-fPIC", "-shared")
 LARGE_POINT = 1300
 
 
 def point_flags(point: ca.Function) -> tuple[str, ...]:
     """The compiler flags of ``point``'s library (by its number of instructions)."""
     return POINT_FLAGS if point.n_instructions() <= LARGE_POINT else LARGE_POINT_FLAGS
+
+
 #: The interval templates serve meshes of at least this many intervals (all phases): below,
 #: deriving the outer functions of the mesh is as cheap as building from the templates, and
 #: the templates' fixed cost per evaluation (more nodes and calls) outweighs it over a coarse
@@ -89,8 +92,8 @@ def point_flags(point: ca.Function) -> tuple[str, ...]:
 #: of the derived ones; ``docs/results/benchmarks-gait.md``).
 TEMPLATE_MIN_INTERVALS = 24
 #: Version of the generated point libraries (part of their cache key): change it when the
-#: functions a library holds change.
-FORMAT = "gaitopt-points-1"
+#: functions a library holds, or their C (:data:`gaitopt.codegen.CHUNK_STATEMENTS`), change.
+FORMAT = "gaitopt-points-2"
 
 
 def supports(method: Method, has_midpoint_rows: bool) -> bool:
@@ -158,15 +161,24 @@ _KEYS = IdentityCache(32)
 
 def library_key(point: ca.Function, flags: tuple[str, ...] = POINT_FLAGS) -> str:
     """The cache key of the point library of ``point``: a hash of the serialized point
-    function, CasADi's version, the compiler and its flags, and :data:`FORMAT` (the C is a
+    function, CasADi's version, the compiler and its flags, :data:`FORMAT` and the chunk size
+    of :func:`~gaitopt.codegen.split_straight_line` (the C is a
     deterministic function of these, so a cached library is found without deriving or
     generating anything)."""
     def make() -> str:
-        text = "\0".join([FORMAT, point.serialize(), ca.CasadiMeta.version(),
-                          codegen.compiler(), *flags])
+        text = "\0".join([FORMAT, str(codegen.CHUNK_STATEMENTS), point.serialize(),
+                          ca.CasadiMeta.version(), codegen.compiler(), *flags])
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
     return _KEYS.get((point, codegen.compiler(), *flags), make)
+
+
+def point_source(point: ca.Function, lib: str, flags: tuple[str, ...]) -> str:
+    """The C of library ``lib`` of ``point`` (:meth:`PointDerivatives.derive`), split into
+    chunk functions (:func:`gaitopt.codegen.split_straight_line`) when compiled with
+    :data:`LARGE_POINT_FLAGS`."""
+    source = codegen.generate_source(PointDerivatives.derive(point), lib)
+    return codegen.split_straight_line(source) if flags == LARGE_POINT_FLAGS else source
 
 
 def point_derivatives(points: list[ca.Function], compile_c: bool
@@ -186,8 +198,7 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
         if lib not in missing:
             codegen.mark_used(path)
     if missing:
-        sources = {lib: codegen.generate_source(PointDerivatives.derive(libs[lib]), lib)
-                   for lib in missing}
+        sources = {lib: point_source(libs[lib], lib, flags[lib]) for lib in missing}
         try:
             codegen.compile_libraries(sources, targets={lib: paths[lib] for lib in missing},
                                       flags_by_name={lib: flags[lib] for lib in missing})
