@@ -24,6 +24,7 @@ from gaitopt.ocp import (
     Transcription,
     transcribe,
 )
+from gaitopt.ocp.guess import warm_start_of
 from gaitopt.ocp.solver import EVAL_KINDS
 
 SEPARATED = "hermite-simpson-separated"
@@ -108,6 +109,40 @@ def test_points_mode_reaches_the_same_optimum(tmp_path: Path,
     # solver's accuracy (ipopt.tol 1e-8); iteration counts may differ in the last bits.
     assert res.objective == pytest.approx(plain.objective, rel=1e-7)
     assert np.allclose(res.w, plain.w, rtol=1e-6, atol=1e-7)
+
+
+def test_a_result_reports_through_the_compiled_point_functions(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The result of ``compiled="points"`` evaluates its knot dynamics, path values and
+    interval error estimates through the compiled libraries (not CasADi's VM), and they equal
+    the VM's at the same NLP point to rounding."""
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    problem = nonlinear(1.3, intervals=6)
+    vm = transcribe(problem, method=SEPARATED)
+    tr = transcribe(problem, method=SEPARATED, compiled="points")
+    assert tr._pointwise is not None and tr._pointwise.compiled
+    pf = tr.phase_functions[0]
+    evaluator = tr._pointwise.evaluator(pf.point)
+    assert evaluator is not pf.point and evaluator.is_a("MXFunction")
+    assert tr._pointwise.evaluator(vm.phase_functions[0].point) is vm.phase_functions[0].point
+    start = warm_start_of(vm.solve())
+    asked: list[ca.Function] = []
+    original = type(tr._pointwise).evaluator
+
+    def spy(self: object, point: ca.Function) -> ca.Function:
+        asked.append(point)
+        return original(self, point)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(type(tr._pointwise), "evaluator", spy)
+    a, b = vm.result_at(start), tr.result_at(start)
+    assert asked == [pf.point for pf in tr.phase_functions]  # the result used them
+    for pa, pb in zip(a.phases, b.phases, strict=True):
+        np.testing.assert_allclose(pb.xdot, pa.xdot, rtol=1e-12, atol=1e-12)
+        for name in pa.path:
+            np.testing.assert_allclose(pb.path[name], pa.path[name], rtol=1e-12, atol=1e-12)
+        assert np.all(pa.error > 0)  # the estimate is not trivially zero
+        np.testing.assert_allclose(pb.error, pa.error, rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(pb.error_by_state, pa.error_by_state, rtol=1e-9, atol=1e-15)
 
 
 def test_point_libraries_are_cached_and_rebuilt_when_the_model_changes(

@@ -417,6 +417,17 @@ class PointwiseNlp:
     compiled: bool
     #: The point functions whose derivatives the NLP's are assembled from (one per group).
     point_functions: tuple[ca.Function, ...] = ()
+    #: Each point function with its own signature, evaluated through its library's value
+    #: function where compiled (:func:`unstacked_value`; else the point function itself).
+    point_evaluators: tuple[ca.Function, ...] = ()
+
+    def evaluator(self, point: ca.Function) -> ca.Function:
+        """``point`` (one of :attr:`point_functions`) as :attr:`point_evaluators` has it;
+        ``point`` itself for any other function."""
+        for f, ev in zip(self.point_functions, self.point_evaluators, strict=True):
+            if f is point:
+                return ev
+        return point
 
 
 def _selections(v: ca.SX, u: ca.SX) -> tuple[ca.DM, list[int]]:
@@ -830,4 +841,18 @@ def build_pointwise(assembly: Assembly, groups: list[_Group], compile_c: bool,
     fns["nlp_hess_l"] = ca.Function("nlp_hess_l", [W, P, S, Lam], [ca.triu(H)],
                                     ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
     return PointwiseNlp(fns, compiled=all(d.compiled for d in derivs),
-                        point_functions=tuple(gr.point for gr in groups))
+                        point_functions=tuple(gr.point for gr in groups),
+                        point_evaluators=tuple(unstacked_value(gr.point, d.value)
+                                               if d.compiled else gr.point
+                                               for gr, d in zip(groups, derivs, strict=True)))
+
+
+def unstacked_value(point: ca.Function, value: ca.Function) -> ca.Function:
+    """``point``'s own signature (its inputs, e.g. ``(x, u, p, t)``, and outputs, e.g.
+    ``(xdot, path, L)``) evaluated through ``value(z) -> y`` of its :func:`stacked_point`
+    form (e.g. the compiled library's): the values a result reports, without CasADi's VM."""
+    args = [ca.MX.sym(point.name_in(i), point.sparsity_in(i)) for i in range(point.n_in())]
+    y = value(ca.vertcat(*args))
+    sizes = [point.size1_out(i) for i in range(point.n_out())]
+    outs = ca.vertsplit(y, np.concatenate([[0], np.cumsum(sizes)]).astype(int).tolist())
+    return ca.Function(point.name(), args, outs, point.name_in(), point.name_out())

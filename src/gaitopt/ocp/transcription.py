@@ -405,9 +405,11 @@ class Transcription:
             t = t_start + T * tau
             x = w[pl.state_indices()]
             u = w[pl.control_indices()]
-            xdot, path, _ = point_values(pf.point, t, x, u, p)
+            point = (pf.point if self._pointwise is None
+                     else self._pointwise.evaluator(pf.point))
+            xdot, path, _ = point_values(point, t, x, u, p)
             if np.all(np.isfinite(x)) and np.all(np.isfinite(xdot)) and T > 0:
-                eta, err = interval_errors(method, pf.point, t, x, u, xdot, p)
+                eta, err = interval_errors(method, point, t, x, u, xdot, p)
             else:
                 eta, err = np.full((tau.size - 1, ph.n_states), np.nan), np.full(tau.size - 1,
                                                                                  np.nan)
