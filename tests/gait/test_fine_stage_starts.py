@@ -6,7 +6,12 @@
   the user's tolerance;
 * the walk's check grid starts its barrier at 1e-8
   (:data:`~gaitopt.gait.solve.stages.CHECK_GRID_OPTIONS`): its cost must be the one a start at
-  1e-6 reaches, within the solve's accuracy."""
+  1e-6 reaches, within the solve's accuracy;
+* a check grid started from the target grid's solution mapped with its multipliers (the
+  heel-toe walk's move; here made the five-link walk's) is bounded at
+  :data:`~gaitopt.gait.solve.stages.CHECK_REGRID_MAX_ITER` iterations, and where it does not
+  converge the check grid is solved from the values only (stage ``check grid, from
+  values``), to the check cost of that start, which the answer's estimate then uses."""
 
 from __future__ import annotations
 
@@ -16,8 +21,9 @@ import pytest
 
 from gaitopt.gait.api import solve_staged_run
 from gaitopt.gait.options.gait_options import GaitOptions
-from gaitopt.gait.solve import stages
-from gaitopt.gait.solve.staged_run import StagedRun
+from gaitopt.gait.solve import staged, stages
+from gaitopt.gait.solve.accuracy import accuracy_record
+from gaitopt.gait.solve.staged_run import CHECK_FROM_VALUES_STAGE, StagedRun, check_result
 from gaitopt.gait.solve.stages import CHECK_GRID_OPTIONS, HELD_STAGE_TOL, held_stage_options
 from gaitopt.ocp import Transcription
 from gaitopt.robot import load_model
@@ -95,3 +101,28 @@ def test_the_check_grid_starts_at_a_small_barrier_and_reaches_the_same_cost(
     assert solution.result.objective == pytest.approx(before.result.objective, rel=1e-10)
     # the check costs agree within 10 x the solves' accuracy (about 1e-6 against a tight solve)
     assert _check_cost(solution) == pytest.approx(_check_cost(before), rel=1e-5)
+
+
+def test_a_mapped_check_grid_start_is_bounded_and_falls_back_to_the_values(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    options = GaitOptions(knots=(16, 6), speed=0.4)
+    plain = solve_staged_run(load_model("five-link"), options)  # the check from the values
+    assert plain.success and [s.name for s in plain.stages][-1] == "check grid"
+    monkeypatch.setattr(staged, "REGRID_MOVES", {"walk": frozenset({"check"})})
+    bounds, mapped = _fine_calls(monkeypatch, options, "ipopt.max_iter")
+    names = [s.name for s in mapped.stages]
+    assert names[-1] == "check grid" and CHECK_FROM_VALUES_STAGE not in names
+    assert bounds[-1] == stages.CHECK_REGRID_MAX_ITER  # the mapped start, bounded
+    assert mapped.stages[-1].iterations <= stages.CHECK_REGRID_MAX_ITER
+    # a mapped start that does not converge within the bound: the values-only check after it
+    monkeypatch.setattr(staged, "CHECK_REGRID_MAX_ITER", 1)
+    bounds, fallen = _fine_calls(monkeypatch, options, "ipopt.max_iter")
+    last = fallen.stages[-2:]
+    assert [s.name for s in last] == ["check grid", CHECK_FROM_VALUES_STAGE]
+    assert not last[0].success and last[1].success and bounds[-2:] == [1, None]
+    checked = check_result(fallen)
+    assert checked is not None and checked.objective == pytest.approx(last[1].objective)
+    assert checked.objective == pytest.approx(check_result(plain).objective, rel=1e-6)
+    assert fallen.result.objective == pytest.approx(plain.result.objective, rel=1e-9)
+    estimate = accuracy_record(fallen)["cost_error"]
+    assert estimate == pytest.approx(accuracy_record(plain)["cost_error"], rel=1e-3, abs=1e-6)

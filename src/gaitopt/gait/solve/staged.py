@@ -99,6 +99,8 @@ from gaitopt.gait.solve.cost_continuation import (
     continues_from_paper,
 )
 from gaitopt.gait.solve.staged_run import (
+    CHECK_FROM_VALUES_STAGE,
+    CHECK_GRID_STAGE,
     ProgressFn,
     StagedRun,
     StageRecord,
@@ -109,6 +111,7 @@ from gaitopt.gait.solve.staged_run import (
 )
 from gaitopt.gait.solve.stages import (
     ANKLES,
+    CHECK_REGRID_MAX_ITER,
     COARSE_COMPLETION,
     COLD_CONTROL_MODEL,
     CONTACT_STAGES,
@@ -454,8 +457,16 @@ class _Run:
             if not point.success:
                 return
             warm = None
-        self.stage("check grid", grid, Relaxation(), point, parameter_bounds(o),
-                   solver_options=check_grid_options(o), warm_start_options=warm)
+        # Straight from the mapped start: bounded, then from the values only (a mapped start
+        # that runs away; CHECK_REGRID_MAX_ITER).
+        mapped = isinstance(point, WarmStart)
+        bound = ({"ipopt.max_iter": min(o.max_iter, CHECK_REGRID_MAX_ITER)} if mapped else {})
+        checked = self.stage(CHECK_GRID_STAGE, grid, Relaxation(), point, parameter_bounds(o),
+                             solver_options={**check_grid_options(o), **bound},
+                             warm_start_options=warm)
+        if mapped and not checked.success:
+            self.stage(CHECK_FROM_VALUES_STAGE, grid, Relaxation(), result,
+                       parameter_bounds(o), solver_options=check_grid_options(o))
 
     def grid_start(self, grid: Grid, result: Result, move: str) -> Result | WarmStart:
         """The start on ``grid`` from ``result`` (another grid): for a ``move`` in

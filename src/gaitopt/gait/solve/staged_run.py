@@ -144,10 +144,20 @@ def as_failed(result: Result, failed: Result) -> Result:
                                message=f"{failed.message} (values of an earlier stage)")
 
 
+#: The stage that solves the problem on the check grid (:meth:`gaitopt.gait.solve.staged.
+#: _Run.check`), whose cost the cost error estimate compares with.
+CHECK_GRID_STAGE = "check grid"
+#: The same problem solved again from the target grid's values only, where stage
+#: :data:`CHECK_GRID_STAGE` started from them mapped with their multipliers did not converge
+#: within :data:`~gaitopt.gait.solve.stages.CHECK_REGRID_MAX_ITER` iterations.
+CHECK_FROM_VALUES_STAGE = "check grid, from values"
+
+
 def check_result(run: StagedRun) -> Result | None:
     """The converged result of the run's last ``check grid`` stage (the problem on the check
-    grid of its knots, :meth:`gaitopt.gait.solve.staged._Run.check`), or None."""
+    grid of its knots, :meth:`gaitopt.gait.solve.staged._Run.check`; or of its stage ``check
+    grid, from values`` after it), or None."""
     for name, result in reversed(run.stage_results):
-        if name.endswith("check grid"):
+        if name.endswith((CHECK_GRID_STAGE, CHECK_FROM_VALUES_STAGE)):
             return result if result.success else None
     return None

@@ -66,6 +66,18 @@ WARM_START_STAGE = "warm start"
 #: The same start solved again with the monotone barrier, where the adaptive barrier's
 #: restart (:data:`RESTART_OPTIONS`) did not converge.
 MONOTONE_RESTART_STAGE = "warm start, monotone barrier"
+#: At most this many IPOPT iterations for stage ``check grid``
+#: (:data:`~gaitopt.gait.solve.staged_run.CHECK_GRID_STAGE`) when it starts
+#: from the target grid's solution mapped with its multipliers
+#: (:data:`~gaitopt.gait.solve.staged.REGRID_MOVES`: the heel-toe walk) and no stage of a
+#: smoothing ladder or with the step held comes first. That start is usually the faster one
+#: (the check grids of the feet cost study's accuracy passes: median 20 iterations, at most
+#: 142 on the paper cost) but can run away: the paper cost's pass on 54 + 39 knots ran for
+#: more than 15 minutes with the dual infeasibility at 1e3-1e9, where the values-only start
+#: took 143 iterations (docs/results/benchmarks-gait.md, "Point libraries in chunks"). Such a
+#: start is then solved again from the values only
+#: (:data:`~gaitopt.gait.solve.staged_run.CHECK_FROM_VALUES_STAGE`).
+CHECK_REGRID_MAX_ITER = 300
 #: At most this many IPOPT iterations for stage :data:`WARM_START_STAGE` with
 #: :data:`RESTART_OPTIONS`; a restart that has not converged by then is solved again from
 #: the same start with the monotone barrier (stage :data:`MONOTONE_RESTART_STAGE`). The
