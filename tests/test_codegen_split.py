@@ -100,6 +100,13 @@ def test_code_that_is_not_straight_line_is_left_whole() -> None:
     assert np.array_equal(outputs(whole, [z])[0], outputs(part, [z])[0])
 
 
+def test_a_function_without_its_end_is_left_as_it_is() -> None:
+    head = ("static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, "
+            "casadi_real* w, int mem) {")
+    cut = "\n".join([head, "  casadi_real a0;", *["  a0=(a0+1.);"] * 5])
+    assert codegen.split_straight_line(cut, 2) == cut
+
+
 @pytest.mark.parametrize("bad", [0, -3])
 def test_a_chunk_size_below_one_is_refused(bad: int) -> None:
     with pytest.raises(ValueError, match=r"statements: .*allowed: an integer >= 1"):

@@ -187,7 +187,8 @@ def split_straight_line(source: str, statements: int = CHUNK_STATEMENTS) -> str:
     i, split_any = 0, False
     while i < len(lines):
         head = _FUNCTION.fullmatch(lines[i])
-        end = lines.index("}", i) if head else -1
+        end = _closing(lines, i) if head else -1
+        head = head if end > i else None
         body = lines[i + 1:end] if head else []
         stmts = [line for line in body if not _DECLARATION.fullmatch(line)]
         if (head is None or len(stmts) <= statements + 1 or stmts[-1] != "  return 0;"
@@ -203,6 +204,14 @@ def split_straight_line(source: str, statements: int = CHUNK_STATEMENTS) -> str:
                      or line.startswith("static GAITOPT_NOINLINE"))
         out[first:first] = [_NOINLINE, ""]
     return "\n".join(out)
+
+
+def _closing(lines: list[str], start: int) -> int:
+    """The index of the first line ``}`` after ``start`` (a function's end), or -1."""
+    try:
+        return lines.index("}", start)
+    except ValueError:
+        return -1
 
 
 def _straight(line: str) -> bool:
