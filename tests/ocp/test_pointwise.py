@@ -360,6 +360,21 @@ def test_scatter_is_the_product_with_constant_matrices(selections: bool) -> None
                        rtol=1e-14, atol=1e-14)
 
 
+def test_selections_are_read_off_by_evaluation_and_products_are_not() -> None:
+    """Rows that are a constant times one input are selections; a product of two inputs
+    (whose probe ratio is an integer beyond the inputs: (2 * 3) - 1 = 5 here) and a sum are
+    not, and do not break the probing."""
+    from gaitopt.ocp.pointwise import _selections
+
+    u = ca.SX.sym("u", 3)
+    v = ca.vertcat(2 * u[1], u[1] * u[2], u[0] + u[2], -0.5 * u[0])
+    S, rest = _selections(v, u)
+    assert rest == [1, 2]
+    expected = np.zeros((4, 3))
+    expected[0, 1], expected[3, 0] = 2.0, -0.5
+    np.testing.assert_array_equal(np.array(ca.densify(S)), expected)
+
+
 def test_identity_cache_finds_the_same_objects_and_keeps_the_newest() -> None:
     from gaitopt.ocp.functions import IdentityCache
 

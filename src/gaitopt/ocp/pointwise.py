@@ -446,6 +446,7 @@ def _selections(v: ca.SX, u: ca.SX) -> tuple[ca.DM, list[int]]:
         ok &= np.abs(np.where(ok, col - np.round(col), 1.0)) < 1e-6
     col = np.where(ok, np.round(col), 0).astype(int)
     ok &= (col >= 0) & (col < nu)
+    col = np.where(ok, col, 0)  # a product u_i u_j gives an integer "column" beyond nu
     for x, value in zip(probes[3:], checks, strict=True):
         ok &= np.abs(one * x[col] - value) <= 1e-12 * np.maximum(1.0, np.abs(value))
     rows = np.flatnonzero(ok)
