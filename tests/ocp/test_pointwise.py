@@ -5,6 +5,7 @@ model changes)."""
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -172,6 +173,24 @@ def test_point_libraries_are_cached_and_rebuilt_when_the_model_changes(
     assert [lib.stat().st_ino for lib in libs] == inodes
     a, b = first.solve(), changed.solve()
     assert a.success and b.success and not math.isclose(a.objective, b.objective)
+
+
+def test_compiling_is_logged_and_a_cached_library_is_not(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A first build says that it compiles (the wait of a machine's first solve) and how long
+    it took; a build from the cache says nothing."""
+    monkeypatch.setenv("GAITOPT_CACHE", str(tmp_path))
+    with caplog.at_level(logging.INFO, logger="gaitopt"):
+        transcribe(nonlinear(1.7), method=SEPARATED, compiled="points", build_solver=False)
+    said = [r.getMessage() for r in caplog.records if r.name == "gaitopt.ocp.pointwise"]
+    assert len(said) == 2 and said[0].startswith("compiling 2 point libraries")
+    assert str(tmp_path) in said[0] and said[1].startswith("compiled in ")
+    caplog.clear()
+    with caplog.at_level(logging.INFO, logger="gaitopt"):
+        transcribe(nonlinear(1.7, intervals=7), method=SEPARATED, compiled="points",
+                   build_solver=False)
+    assert not [r for r in caplog.records if r.name == "gaitopt.ocp.pointwise"]
 
 
 def test_points_mode_refuses_the_compressed_form() -> None:

@@ -13,8 +13,10 @@ when one of its commands is looked up (:data:`COMMANDS`):
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
+import sys
 import threading
 from collections.abc import Sequence
 
@@ -45,6 +47,22 @@ cli.lazy_commands.update(COMMANDS)
 PROCESS_ENVIRONMENT: dict[str, str] = {"OPENBLAS_NUM_THREADS": "1"}
 
 
+def show_progress_log() -> logging.Handler:
+    """Show gaitopt's INFO log records (e.g. that point libraries are being compiled,
+    :data:`gaitopt.ocp.pointwise.LOG`) on stderr, one plain line each; the handler (added
+    once per process)."""
+    log = logging.getLogger("gaitopt")
+    for handler in log.handlers:
+        if getattr(handler, "gaitopt_progress", False):
+            return handler
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.gaitopt_progress = True  # type: ignore[attr-defined]
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    return handler
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``gaitopt`` console script; returns the exit status.
 
@@ -53,6 +71,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     :data:`~gaitopt.interrupts.TERMINATED_STATUS` (143) where Ctrl-C's is 130."""
     for name, value in PROCESS_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
+    show_progress_log()
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.getsignal(signal.SIGTERM)
     if main_thread:

@@ -51,6 +51,8 @@ by evaluating them, and only the few others are differentiated for each mesh (se
 from __future__ import annotations
 
 import hashlib
+import logging
+import time
 import warnings
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -91,6 +93,10 @@ def point_flags(point: ca.Function) -> tuple[str, ...]:
 #: 0.71 against 0.43 ms; at 16 + 6: the same evaluations; at 40 + 10 and beyond builds 0.6-0.8
 #: of the derived ones; ``docs/results/benchmarks-gait.md``).
 TEMPLATE_MIN_INTERVALS = 24
+#: Says when point libraries are compiled (the first solve of a model and problem on a
+#: machine waits for it: the seven-link biped's nine libraries about 34 s on two cores); the
+#: ``gaitopt`` command shows its INFO records on stderr (:func:`gaitopt.cli.main`).
+LOG = logging.getLogger(__name__)
 #: Version of the generated point libraries (part of their cache key): change it when the
 #: functions a library holds, or their C (:data:`gaitopt.codegen.CHUNK_STATEMENTS`), change.
 FORMAT = "gaitopt-points-2"
@@ -198,10 +204,15 @@ def point_derivatives(points: list[ca.Function], compile_c: bool
         if lib not in missing:
             codegen.mark_used(path)
     if missing:
+        LOG.info("compiling %d point %s of this model and problem into %s (once per "
+                 "machine) ...", len(missing), "library" if len(missing) == 1 else "libraries",
+                 codegen.cache_dir())
+        start = time.perf_counter()
         sources = {lib: point_source(libs[lib], lib, flags[lib]) for lib in missing}
         try:
             codegen.compile_libraries(sources, targets={lib: paths[lib] for lib in missing},
                                       flags_by_name={lib: flags[lib] for lib in missing})
+            LOG.info("compiled in %.1f s", time.perf_counter() - start)
         except codegen.CompileError as exc:
             warnings.warn(f"compiling the point functions failed, evaluating them in CasADi's "
                           f"VM instead: {str(exc)[:300]}", RuntimeWarning, stacklevel=2)
