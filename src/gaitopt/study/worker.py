@@ -52,7 +52,7 @@ from gaitopt.study.summary import SpeedMode, SummaryRow, failed_row, summary_row
 #: from a coarser optimum: at 15 check points (2026-12-04) 8-25 iterations instead of 17-92,
 #: the same optima (within 1e-8) at 14 and at 48 m/min with ankle torques the study grid's
 #: branch (2621.90, the study grid 2621.97) where 1e-4 moved to a dearer one (2623.13).
-#: With the monotone barrier only (:data:`ADAPTIVE_STARTS`).
+#: With the monotone barrier only (not in :data:`ADAPTIVE_STARTS`).
 REGRIDDED = "file, regridded"
 #: How a chain point started from the secant through its chain's last two Results
 #: (:func:`gaitopt.ocp.guess.secant_start`).

@@ -431,7 +431,10 @@ class _Run:
         grid, eps E W``, everything free); every stage with the transcription's warm-start
         barrier (1e-6) instead of :data:`REGRID_OPTIONS`. The free phase shares of the
         heel-toe walk hold the step too, with any cost that climbs no ladder
-        (:func:`holds_free_shares`).
+        (:func:`holds_free_shares`). A ``check grid`` stage started straight from the mapped
+        point (no stage before it) stops after :data:`~gaitopt.gait.solve.stages.
+        CHECK_REGRID_MAX_ITER` iterations and, where it did not converge, the check grid is
+        solved from ``result``'s values only (stage ``check grid, from values``).
         """
         o = self.options
         grid = target_grid(self.model, o.replace(knots=check_knots(o.knots)))
