@@ -23,6 +23,7 @@ from gaitopt.gait.record.file import Gait
 from gaitopt.gait.sequence.contact_sequence import ContactSequenceError, phase_knots
 from gaitopt.gait.solve.refinement import (
     MAX_ROUNDS,
+    diverging_text,
     refine_to_accuracy,
     relative_estimates,
     solved_shares,
@@ -58,8 +59,10 @@ class FakeSolution:
 
 def _loop(errors: list[float], *, refines: bool = True,
           fail_at: int | None = None, max_rounds: int = MAX_ROUNDS,
+          steps: list[float] | None = None, accuracy: float = 0.01,
           ) -> tuple[Any, dict[str, Any], list[tuple[int, int]]]:
-    """Run the loop on fake solves whose cost estimates are ``errors`` in grid order."""
+    """Run the loop on fake solves whose cost estimates are ``errors`` in grid order (and
+    relative step-length estimates ``steps``, of a 0.1 m step, when given)."""
     grids: list[tuple[int, int]] = []
 
     def solve_on(finer: GaitOptions, before: Any) -> Any:
@@ -67,9 +70,10 @@ def _loop(errors: list[float], *, refines: bool = True,
         return FakeSolution(finer, success=len(grids) != fail_at)
 
     def accuracy_of(sol: Any) -> dict[str, Any]:
-        return {"cost_error_relative": errors[len(grids)]}
+        record = {"cost_error_relative": errors[len(grids)]}
+        return record if steps is None else {**record, "step_length_error": 0.1 * steps[len(grids)]}
 
-    first = FakeSolution(GaitOptions(knots=(16, 6)))
+    first = FakeSolution(GaitOptions(knots=(16, 6), accuracy=accuracy))
     sol, extra = refine_to_accuracy(first, refines=refines, solve_on=solve_on,  # type: ignore[arg-type]
                                     accuracy_of=accuracy_of, max_rounds=max_rounds)
     return sol, extra, grids
@@ -154,6 +158,39 @@ def test_a_caller_may_ask_for_more_rounds() -> None:
     assert extra["within_target"] is False
     _, extra, grids = _loop([0.05] * MAX_ROUNDS + [0.004, 0.004], max_rounds=more)
     assert len(grids) == MAX_ROUNDS and extra["within_target"] is True
+
+
+def test_the_loop_stops_when_the_cost_estimate_grows() -> None:
+    """The seven-link's metabolic walk at 4.8 W/kg (docs/costs.md): cost estimates 1.5, 0.74
+    and 1.9 % on 24 + 18, 36 + 26 and 54 + 39 knots, each finer grid at another local
+    optimum (the step length's 1.06 % the worst on 36 + 26); a fourth grid (a held stage of
+    1,372 iterations) did not bring it within."""
+    sol, extra, grids = _loop([0.015, 0.0074, 0.019, 0.026, 0.004], max_rounds=MAX_ROUNDS + 1,
+                              steps=[0.005, 0.0106, 0.001, 0.001, 0.001])
+    assert grids == [(24, 8), (36, 12)] and tuple(sol.options.knots) == (36, 12)
+    assert extra["within_target"] is False and extra["diverging"] is True
+    assert extra["refinements"] == 2
+    assert extra["cost_estimates"] == [0.015, 0.0074, 0.019]
+    assert diverging_text(extra) == ("; stopped: the cost estimate grew from 0.74 % to 1.9 % "
+                                     "(the grids do not converge: another local optimum?)")
+    # shrinking estimates are refined on and say nothing of it
+    _, extra, grids = _loop([0.05, 0.02, 0.004])
+    assert extra["diverging"] is False and diverging_text(extra) == ""
+    assert extra["cost_estimates"] == [0.05, 0.02, 0.004]
+
+
+def test_a_growing_step_estimate_alone_does_not_stop_the_loop() -> None:
+    """The five-link walk at 30 m/min without ankle torques, ``--accuracy 1e-5`` (measured):
+    step-length estimates 5.0, 0.80, 1.2 and 0.14 % while the cost's shrink (1.6, 0.72, 0.32,
+    0.13 %)."""
+    _, extra, grids = _loop([0.016, 0.0072, 0.0032, 0.0013],
+                            steps=[0.050, 0.0080, 0.0116, 0.0014], accuracy=1e-5)
+    assert len(grids) == MAX_ROUNDS and extra["diverging"] is False
+    assert extra["worst_estimate_of"] == "step_length"
+    assert extra["worst_estimate"] == pytest.approx(0.0014)
+    # and no estimate on a grid (its check failed) is refined on
+    _, extra, grids = _loop([0.05, None, 0.004])  # type: ignore[list-item]
+    assert len(grids) == 2 and extra["within_target"] is True and extra["diverging"] is False
 
 
 def test_a_failed_finer_solve_keeps_the_coarser_answer() -> None:

@@ -91,24 +91,28 @@ def test_a_case_without_its_accurate_gait_is_marked(tmp_path: Path,
 
 def test_a_rerun_refines_again_a_gait_short_of_its_rounds(tmp_path: Path,
                                                            five_link: RobotModel) -> None:
-    """A case's accurate gait is kept by a rerun when within its accuracy or refined
-    ACCURACY_ROUNDS times; one that an older pass left above the accuracy after fewer
-    rounds is solved again (None)."""
+    """A case's accurate gait is kept by a rerun when within its accuracy, refined
+    ACCURACY_ROUNDS times or stopped by a growing cost estimate; one that an older pass left
+    above the accuracy after fewer rounds is solved again (None)."""
     gait = solve_gait(five_link, GaitOptions.paper(speed=0.2, knots=(8, 5), accuracy=None))
     assert gait.success
     source, cost = "five-link/paper/gaits/ankle+impulse/speed-free.gait.json", 431.0
     (tmp_path / ACCURATE_NOTE).write_text(json.dumps({"from": source, "from_cost": cost}))
 
-    def kept(within: bool, rounds: int) -> bool:
+    def kept(within: bool, rounds: int, diverging: bool | None = None) -> bool:
         data = gait.to_dict()
         data["solver"]["accuracy"] = {**(data["solver"].get("accuracy") or {}),
-                                      "within_target": within, "refinements": rounds}
+                                      "within_target": within, "refinements": rounds,
+                                      "diverging": diverging}
         Gait.from_dict(data).save(tmp_path / ACCURATE_FILE)
         return accurate_gait(tmp_path, source, cost) is not None
 
     assert kept(True, 0) and kept(True, ACCURACY_ROUNDS)
     assert not kept(False, ACCURACY_ROUNDS - 1)
+    assert not kept(False, ACCURACY_ROUNDS - 1, diverging=False)
     assert kept(False, ACCURACY_ROUNDS)
+    # a pass that stopped because its cost estimate grew is final: a rerun would repeat it
+    assert kept(False, 2, diverging=True)
     assert accurate_gait(tmp_path, source, cost * 1.01) is None  # another optimum
 
 

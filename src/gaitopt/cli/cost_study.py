@@ -47,6 +47,7 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
     first, whose optimum sets the start of the model's other cases), then the direct solves,
     ``costs.csv``, the report and the findings."""
     from gaitopt.gait.api import as_model
+    from gaitopt.gait.solve.refinement import diverging_text
     from gaitopt.study.cost_accuracy import AccuracyOutcome
     from gaitopt.study.cost_continuation import (
         best_free,
@@ -195,7 +196,8 @@ def run_cost_study(console: Console, directory: Path, model_names: Sequence[str]
                     what = (f"{knots} knots, {acc.get('worst_estimate_of', 'cost')} estimate "
                             f"{'none' if worst is None else f'{100 * worst:.2g} %'} "
                             f"({'within' if acc.get('within_target') else 'NOT within'} "
-                            f"{100 * ACCURACY:g} %), {outcome.iterations} iterations, "
+                            f"{100 * ACCURACY:g} %{diverging_text(acc)}), "
+                            f"{outcome.iterations} iterations, "
                             f"{outcome.wall_time_s:.0f} s")
                 console.print(f"{'ok  ' if path else 'FAIL'} accuracy {sweep.model} "
                               f"{sweep.case.tag}: {what}", soft_wrap=True)

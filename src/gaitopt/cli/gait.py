@@ -416,13 +416,14 @@ def solve_command(model_name: str, speed: str | None, speed_bounds_text: str | N
     console.print(f"wrote {output}")
     record = gait.solver.get("accuracy", {})
     if record.get("within_target") is False:
-        from gaitopt.gait.solve.refinement import MAX_ROUNDS, describe
+        from gaitopt.gait.solve.refinement import MAX_ROUNDS, describe, diverging_text
 
         worst = (record.get("worst_estimate") or float("inf"),
                  record.get("worst_estimate_of", "cost"))
         console.print(f"NOT CONVERGED to {100 * record['target']:g} %: "
                       f"{describe(worst, record['target'])} after "
-                      f"{record.get('refinements', 0)} of at most {MAX_ROUNDS} refinements; "
+                      f"{record.get('refinements', 0)} of at most {MAX_ROUNDS} refinements"
+                      f"{diverging_text(record)}; "
                       f"the gait file says so (gaitopt verify: accuracy.estimate). Try "
                       "--knots with more knots, --mesh-tol 1e-4, or --accuracy 0.02")
         sys.exit(3)

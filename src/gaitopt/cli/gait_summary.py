@@ -95,6 +95,8 @@ def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
     the cost's discretization error estimate and how far speed and step length moved (with
     their estimates relative to the gait's ``speed`` and ``step_length`` when given);
     ``unit``: the cost's, after the error (the paper's; empty for a cost of transport)."""
+    from gaitopt.gait.solve.refinement import diverging_text
+
     errors = ", ".join(f"{name} {'n/a' if e is None else f'{e:.1e}'} "
                        f"({accuracy['knots'][name]} knots)"
                        for name, e in accuracy["collocation_error"].items())
@@ -127,7 +129,8 @@ def accuracy_rows(accuracy: Mapping[str, Any], *, speed: float | None = None,
         verdict = ("converged" if accuracy.get("within_target") else
                    f"NOT CONVERGED to {100 * target:g} %")
         rows.append(("accuracy", f"{verdict}: largest estimate {shown} ({name}); "
-                     f"{accuracy.get('refinements', 0)} refinement(s) of the grid"))
+                     f"{accuracy.get('refinements', 0)} refinement(s) of the grid"
+                     f"{diverging_text(accuracy)}"))
     dv, dl = accuracy.get("speed_change"), accuracy.get("step_length_change")
     if dv is not None and dl is not None and (dv != 0.0 or dl != 0.0):
         text = f"speed {60 * dv:+.3f} m/min, step length {dl:+.4f} m"

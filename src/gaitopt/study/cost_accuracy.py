@@ -104,8 +104,9 @@ def solve_accurate(task: AccuracyTask) -> AccuracyOutcome:
 def accurate_gait(case_folder: Path, source: str, cost: float) -> Gait | None:
     """The case's accurate gait when it was refined from ``source`` (the winning gait file,
     relative to the study's folder) of cost ``cost`` and converged, and is within its
-    accuracy or was refined :data:`ACCURACY_ROUNDS` times; else None (to solve: a gait
-    refined fewer times, by an older pass, is refined again)."""
+    accuracy, was refined :data:`ACCURACY_ROUNDS` times or stopped because its estimate grew
+    (``diverging``); else None (to solve: a gait refined fewer times, by an older pass, is
+    refined again)."""
     try:
         note = json.loads((case_folder / ACCURATE_NOTE).read_text(encoding="utf-8"))
         if note.get("from") != source or not math.isclose(float(note.get("from_cost")), cost,
@@ -113,7 +114,7 @@ def accurate_gait(case_folder: Path, source: str, cost: float) -> Gait | None:
             return None
         gait = Gait.load(case_folder / ACCURATE_FILE)
         record = gait.solver.get("accuracy") or {}
-        short = (record.get("within_target") is False
+        short = (record.get("within_target") is False and not record.get("diverging")
                  and int(record.get("refinements") or 0) < ACCURACY_ROUNDS)
     except (OSError, ValueError, TypeError, GaitFileError):
         return None

@@ -67,6 +67,7 @@ from gaitopt.gait.options.gait_options import (
     KnotSpacing,
 )
 from gaitopt.gait.record.file import Gait, GaitFileError
+from gaitopt.gait.solve.refinement import diverging_text
 from gaitopt.robot.biped import has_reduced_shape
 from gaitopt.robot.model import RobotModel
 from gaitopt.study.cost_accuracy import (
@@ -706,6 +707,7 @@ def collect_rows(spec: CostStudySpec, directory: str | os.PathLike[str]) -> list
                                      f"{100 * worst:.2g} % > {100 * target:g} %"
                                      if target is not None and math.isfinite(worst)
                                      else "; not within the accuracy")
+                fields["status"] += diverging_text(accurate.solver.get("accuracy") or {})
         bound = speed_bound_reached(fields["speed_m_min"], sweep.spec.base.speed_bounds)
         if bound is not None:
             fields["status"] = f"{fields['status']}; {SPEED_BOUND_NOTE.format(bound=bound)}"

@@ -12,9 +12,10 @@ While the largest exceeds ``accuracy`` (and the caller left the knots to the mod
 the gait is solved again on its check grid (:func:`gaitopt.gait.solve.check_grid.check_knots`: 1.5
 times the knots), started from the previous grid's gait, whose own check grid then gives the
 next estimate; at most :data:`MAX_ROUNDS` times (16 + 6 -> 24 + 8 -> 36 + 12 -> 54 + 18 on the
-five-link walk). Where the phases' shares of the step are free, each finer grid's knots per
-phase follow the shares the previous grid solved for (``GaitOptions.phase_shares``,
-:func:`solved_shares`; the density rule of
+five-link walk), and no more once the cost's estimate is larger than the grid's before
+(``accuracy.diverging``, :func:`refine_to_accuracy`). Where the phases' shares of the step are free,
+each finer grid's knots per phase follow the shares the previous grid solved for
+(``GaitOptions.phase_shares``, :func:`solved_shares`; the density rule of
 :func:`gaitopt.gait.sequence.contact_sequence.phase_knots`): a run's flight that grew to 65 %
 of the step after a stance of 35 % gets 1 + 28 knots on 16 + 6, not 6. The answer is the
 finest converged grid's gait, with ``accuracy.target``, ``accuracy.within_target`` and
@@ -72,6 +73,16 @@ def describe(worst: tuple[float, str], target: float) -> str:
     return f"{name.replace('_', ' ')} estimate {shown} {op} {100 * target:g} %"
 
 
+def diverging_text(accuracy: Mapping[str, Any]) -> str:
+    """E.g. ``; stopped: the cost estimate grew from 0.74 % to 1.9 % ...`` for a
+    ``solver.accuracy`` record whose refinement stopped early (``diverging``), else ``""``."""
+    history = [e for e in accuracy.get("cost_estimates") or () if e is not None]
+    if not accuracy.get("diverging") or len(history) < 2:
+        return ""
+    return (f"; stopped: the cost estimate grew from {100 * history[-2]:.2g} % to "
+            f"{100 * history[-1]:.2g} % (the grids do not converge: another local optimum?)")
+
+
 def solved_shares(solution: StagedRun) -> tuple[float, ...] | None:
     """Each phase's share of the step in ``solution`` (its duration over the step time),
     where the contact sequence leaves some share free; else None."""
@@ -97,20 +108,42 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         max_rounds: the most refinements (:data:`MAX_ROUNDS` unless a caller asks for more:
             the cost study's accuracy pass).
 
+    The loop also stops when the cost's relative estimate is larger than the grid's before
+    (``diverging``). On grids in their asymptotic range the first-order estimate shrinks by
+    about 1/1.5 from one grid to the next; the cost's that grows says the grids do not
+    converge, typically because the finer grid's solve reached another local optimum, and a
+    finer grid (3.4 times the work of the last: 1.5 times the knots, solved and checked) is
+    not expected to help. Only the cost's: a flat optimum's speed or step length may move
+    more on one grid than on the coarser one and settle on the next (the five-link walk at
+    30 m/min without ankle torques: step-length estimates 5.0, 0.80, 1.2 and 0.14 %, its
+    cost's 1.6, 0.72, 0.32, 0.13 %). Measured on the seven-link's metabolic walk at 4.8 W/kg
+    (docs/costs.md, "Refinement that does not converge").
+
     Returns:
         The finest converged solution and what to add to its ``solver.accuracy``: ``target``
         (the accuracy, or None where refinement does not apply), ``within_target`` (bool, or
         None without a target), ``refinements`` (rounds solved), ``worst_estimate``
-        (relative, or None) and ``worst_estimate_of`` (its name).
+        (relative, or None), ``worst_estimate_of`` (its name), ``cost_estimates`` (the
+        cost's relative estimate of each grid solved, coarsest first; None for a grid without
+        one; the list None without a target) and ``diverging`` (True when the loop stopped
+        because the cost's estimate grew; None without a target).
     """
     target = solution.options.accuracy if refines else None
     rounds = 0
+    history: list[float | None] = []
     while True:
         record = accuracy_of(solution)
         params = dict(solution.result.parameters)
         worst = worst_estimate(record, params)
         within = worst[0] <= target if target is not None else None
-        if within is not False or rounds >= max_rounds or not solution.success:
+        cost = relative_estimates(record, params)["cost"]
+        cost = cost if cost is not None and math.isfinite(cost) else None
+        before = history[-1] if history else None
+        # a grid without an estimate (its check failed) is refined on
+        diverging = cost is not None and before is not None and cost > before
+        history.append(cost)
+        if (within is not False or rounds >= max_rounds or not solution.success
+                or diverging):
             break
         finer = solution.options.replace(knots=check_knots(solution.options.knots),
                                          phase_shares=solved_shares(solution))
@@ -120,5 +153,7 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         solution, rounds = again, rounds + 1
     extra = {"target": target, "within_target": within, "refinements": rounds,
              "worst_estimate": worst[0] if math.isfinite(worst[0]) else None,
-             "worst_estimate_of": worst[1]}
+             "worst_estimate_of": worst[1],
+             "cost_estimates": history if refines else None,
+             "diverging": diverging if refines else None}
     return dataclasses.replace(solution, accuracy_extra=extra), extra
