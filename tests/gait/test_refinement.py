@@ -173,6 +173,9 @@ def test_the_loop_stops_when_the_cost_estimate_grows() -> None:
     assert extra["cost_estimates"] == [0.015, 0.0074, 0.019]
     assert diverging_text(extra) == ("; stopped: the cost estimate grew from 0.74 % to 1.9 % "
                                      "(the grids do not converge: another local optimum?)")
+    # a cost estimate that grew within the target (the step's refined) is simply within
+    _, extra, grids = _loop([0.001, 0.002, 0.004], steps=[0.05, 0.001, 0.001])
+    assert len(grids) == 1 and extra["within_target"] is True and extra["diverging"] is False
     # shrinking estimates are refined on and say nothing of it
     _, extra, grids = _loop([0.05, 0.02, 0.004])
     assert extra["diverging"] is False and diverging_text(extra) == ""

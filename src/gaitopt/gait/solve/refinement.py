@@ -139,8 +139,10 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         cost = relative_estimates(record, params)["cost"]
         cost = cost if cost is not None and math.isfinite(cost) else None
         before = history[-1] if history else None
-        # a grid without an estimate (its check failed) is refined on
-        diverging = cost is not None and before is not None and cost > before
+        # only short of the target; a grid without an estimate (its check failed) is
+        # refined on
+        diverging = (within is False and cost is not None and before is not None
+                     and cost > before)
         history.append(cost)
         if (within is not False or rounds >= max_rounds or not solution.success
                 or diverging):
