@@ -115,12 +115,12 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
     another local optimum, and a finer grid (3.4 times the work of the last: 1.5 times the
     knots, solved and checked) is not expected to help. Only the cost's: a flat optimum's
     speed or step length may move more on one grid than on the coarser one and settle on the
-    next (the five-link walk at
-    30 m/min without ankle torques: step-length estimates 5.0, 0.80, 1.2 and 0.14 %, its
-    cost's 1.6, 0.72, 0.32, 0.13 %), and only above the target: a cost estimate far within
-    it may grow by noise while the step length's settles (the seven-link run at 150 m/min:
-    0.11 then 0.14 %, its step length's 1.7 % the worst). Measured on the seven-link's
-    metabolic walk at 4.8 W/kg (docs/costs.md, "Refinement that does not converge").
+    next (the five-link walk at 30 m/min without ankle torques: step-length estimates 5.0,
+    0.80, 1.2 and 0.14 %, its cost's 1.6, 0.72, 0.32, 0.13 %), and only above the target: a
+    cost estimate far within it may grow by noise while the step length's settles (the
+    seven-link run at 150 m/min: 0.11 then 0.14 %, its step length's 1.7 % the worst).
+    Measured on the seven-link's metabolic walk at 4.8 W/kg (docs/costs.md, "Refinement that
+    does not converge").
 
     Returns:
         The finest converged solution and what to add to its ``solver.accuracy``: ``target``
@@ -133,7 +133,7 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
     """
     target = solution.options.accuracy if refines else None
     rounds = 0
-    history: list[float | None] = []
+    cost_estimates: list[float | None] = []
     while True:
         record = accuracy_of(solution)
         params = dict(solution.result.parameters)
@@ -141,13 +141,13 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
         within = worst[0] <= target if target is not None else None
         cost = relative_estimates(record, params)["cost"]
         cost = cost if cost is not None and math.isfinite(cost) else None
-        before = history[-1] if history else None
+        before = cost_estimates[-1] if cost_estimates else None
         # only a cost estimate above the target (a small one that grew, with the step's the
         # worst, is refined on: the seven-link run at 150 m/min, 0.11 then 0.14 %, step
         # 1.7 %); a grid without an estimate (its check failed) is refined on
         diverging = (target is not None and cost is not None and cost > target
                      and before is not None and cost > before)
-        history.append(cost)
+        cost_estimates.append(cost)
         if (within is not False or rounds >= max_rounds or not solution.success
                 or diverging):
             break
@@ -160,6 +160,6 @@ def refine_to_accuracy(solution: StagedRun, *, refines: bool,
     extra = {"target": target, "within_target": within, "refinements": rounds,
              "worst_estimate": worst[0] if math.isfinite(worst[0]) else None,
              "worst_estimate_of": worst[1],
-             "cost_estimates": history if refines else None,
+             "cost_estimates": cost_estimates if refines else None,
              "diverging": diverging if refines else None}
     return dataclasses.replace(solution, accuracy_extra=extra), extra
